@@ -1,0 +1,1 @@
+//! The general 7-segment modified-trapezoidal law (spec §3.2).

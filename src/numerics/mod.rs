@@ -1,0 +1,6 @@
+//! Shared numerics: solver budgets and stop reasons, and (as modules need them) roots, quadrature,
+//! interpolation and seeded random numbers. Pure Rust: no I/O, no async runtime.
+
+pub mod budget;
+
+pub use budget::{Budget, SolverReport, StopReason};
