@@ -76,21 +76,21 @@ impl Trig {
             sign = -sign;
         }
         if psi > FRAC_PI_2 {
+            // sin²(φ/2) = (1 − cos φ)/2 = (1 + cos q)/2: no cancellation for q ∈ [0, π/2).
             let q = PI - psi;
             let (s, c) = q.sin_cos();
-            let ch = (0.5 * q).cos();
             Self {
                 sin: sign * s,
                 cos: -c,
-                half_sin2: ch * ch,
+                half_sin2: 0.5 * (1.0 + c),
             }
         } else {
+            // sin²(φ/2) = sin²φ / (2(1 + cos φ)): no cancellation near φ = 0.
             let (s, c) = psi.sin_cos();
-            let sh = (0.5 * psi).sin();
             Self {
                 sin: sign * s,
                 cos: c,
-                half_sin2: sh * sh,
+                half_sin2: s * s / (2.0 * (1.0 + c)),
             }
         }
     }

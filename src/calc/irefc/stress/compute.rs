@@ -17,8 +17,6 @@ use crate::numerics::{Budget, StopReason};
 pub const REFINE_TOL_RAD: f64 = 1e-10;
 /// Iteration cap of one refinement (Brent needs ~10–40 for the smooth, single-peaked σ near its maximum).
 pub const REFINE_MAX_ITER: u32 = 100;
-/// The single-design scan polls the deadline every this many grid points (blocking work cannot be aborted).
-const DEADLINE_POLL_POINTS: usize = 16_384;
 /// Sweeps share one precomputed trig table when the grid has at most this many points (≤ 6 MB).
 pub const TRIG_TABLE_MAX_POINTS: usize = 262_145;
 /// Maximum subsurface shear stress of a Hertz line contact, τ_max/p0 (Johnson, Contact Mechanics §4.2).
@@ -281,10 +279,50 @@ pub fn grid_phi(j: usize, n: usize) -> f64 {
     }
 }
 
-/// Trig table of the grid jπ/N, j = 0..=N.
-#[must_use]
-pub fn trig_table(n: usize) -> Vec<Trig> {
-    (0..=n).map(|j| Trig::of(grid_phi(j, n))).collect()
+/// Trig values of the grid φ_j = jπ/N, j = 0..=N, as separate arrays (vectorisable scans).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TrigTable {
+    /// sin φ_j.
+    pub sin: Vec<f64>,
+    /// cos φ_j.
+    pub cos: Vec<f64>,
+    /// sin²(φ_j/2).
+    pub half_sin2: Vec<f64>,
+}
+
+impl TrigTable {
+    /// Table of the grid with `n` intervals.
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        let mut t = Self::default();
+        t.fill(0, n + 1, n);
+        t
+    }
+
+    /// Replace the contents by the trig values of φ_j, j = j0..j0+len, of the grid with `n` intervals.
+    fn fill(&mut self, j0: usize, len: usize, n: usize) {
+        self.sin.clear();
+        self.cos.clear();
+        self.half_sin2.clear();
+        for j in j0..j0 + len {
+            let t = Trig::of(grid_phi(j, n));
+            self.sin.push(t.sin);
+            self.cos.push(t.cos);
+            self.half_sin2.push(t.half_sin2);
+        }
+    }
+
+    /// Number of grid points held.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.sin.len()
+    }
+
+    /// Whether the table is empty.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.sin.is_empty()
+    }
 }
 
 /// Up to two largest local maxima of a grid sequence (by value).
@@ -353,43 +391,80 @@ struct ScanResult {
     evaluations: u64,
 }
 
-/// Scan the grid (spec steps 4–5); `trig(j)` gives the trig values of φ_j.
+/// Grid points evaluated per chunk of the scan (buffers stay in L1; the deadline is polled per chunk).
+const SCAN_CHUNK: usize = 1024;
+
+/// Scan the grid (spec steps 4–5) with the trig values of a shared table, or computed chunk by chunk.
+///
+/// Only the arg max matters here, so the scan tracks a positive multiple of σ_w²: with
+/// F = Fmax·χ·sinφ/s ("paper_phase0") and K_w = r2·s³/(rb·m_w), m_w = r2·s³ − rb·D_w,
+/// σ_w² = [Fmax·χ·r2·E*/(π·lb·rb)] · sinφ·s²/m_w; "phase_exact" divides by Σsin²α of the cage phase.
+/// Candidate values are re-evaluated exactly by [`finish_wheel`].
 fn scan(
     st: &Stresser<'_>,
     n: usize,
-    trig: impl Fn(usize) -> Trig,
+    table: Option<&TrigTable>,
     budget: Option<&Budget>,
 ) -> Result<ScanResult, IrefcError> {
     let mut cam = PeakTracker::new();
     let mut crown = PeakTracker::new();
-    let z2 = u64::from(st.g.z2);
-    let two_n = 2 * n as u64;
-    for j in 0..=n {
+    let g = st.g;
+    let exact = st.mode == LoadSharing::PhaseExact;
+    let mut local = TrigTable::default();
+    let mut v_cam = vec![0.0; SCAN_CHUNK];
+    let mut v_crown = vec![0.0; SCAN_CHUNK];
+    let mut j0 = 0;
+    while j0 <= n {
         if let Some(b) = budget
-            && j % DEADLINE_POLL_POINTS == DEADLINE_POLL_POINTS - 1
+            && j0 > 0
             && b.expired()
         {
             return Err(IrefcError::Deadline {
-                evaluations: j as u64,
+                evaluations: j0 as u64,
             });
         }
-        let t = trig(j);
-        // Phase fraction that puts an element at φ_j = jπ/N: frac(j·Z2/(2N)), exact in integers.
-        let s = st.sample(&t, || {
-            let num = (j as u64 * z2) % two_n;
-            // num < 2N ≤ 4e6: exact in f64.
-            #[allow(clippy::cast_precision_loss)]
-            let p = num as f64 / two_n as f64;
-            p
-        });
-        if s.margin <= 0.0 {
+        let len = SCAN_CHUNK.min(n + 1 - j0);
+        let (sin, cos, hs2) = match table {
+            Some(t) if t.len() == n + 1 => (
+                &t.sin[j0..j0 + len],
+                &t.cos[j0..j0 + len],
+                &t.half_sin2[j0..j0 + len],
+            ),
+            _ => {
+                local.fill(j0, len, n);
+                (&local.sin[..], &local.cos[..], &local.half_sin2[..])
+            }
+        };
+        let min_margin = scan_kernel(g, sin, cos, hs2, &mut v_cam[..len], &mut v_crown[..len]);
+        if min_margin <= 0.0 {
+            // Locate the first cusp of this chunk for the message.
+            let j = (j0..j0 + len)
+                .find(|&j| g.kernel(&Trig::of(grid_phi(j, n))).margin <= 0.0)
+                .unwrap_or(j0);
+            let t = Trig::of(grid_phi(j, n));
             return Err(IrefcError::Cusp {
-                wheel: cusp_wheel(st.g, &t),
+                wheel: cusp_wheel(g, &t),
                 phi_deg: grid_phi(j, n).to_degrees(),
             });
         }
-        cam.push(j, s.s2_cam);
-        crown.push(j, s.s2_crown);
+        if exact {
+            let z2 = g.z2 as usize;
+            for i in 0..len {
+                // Phase fraction that puts an element at φ_j = jπ/N: frac(j·Z2/(2N)), exact in integers.
+                let num = ((j0 + i) * z2) % (2 * n);
+                // num < 2N ≤ 4e6: exact in f64.
+                #[allow(clippy::cast_precision_loss)]
+                let p = num as f64 / (2 * n) as f64;
+                let q = g.sum_sin2(p);
+                v_cam[i] /= q;
+                v_crown[i] /= q;
+            }
+        }
+        for i in 0..len {
+            cam.push(j0 + i, v_cam[i]);
+            crown.push(j0 + i, v_crown[i]);
+        }
+        j0 += len;
     }
     cam.finish(n);
     crown.finish(n);
@@ -398,6 +473,48 @@ fn scan(
         crown: crown.top,
         evaluations: n as u64 + 1,
     })
+}
+
+/// The branch-free hot loop: scaled σ² of both wheels for a chunk; returns the smallest cusp margin.
+///
+/// Plain `a * b + c` instead of `mul_add`: without the `fma` target feature `mul_add` is a libm call,
+/// which is slower and stops the loop from vectorising.
+#[allow(clippy::suboptimal_flops)]
+fn scan_kernel(
+    g: &Geometry,
+    sin: &[f64],
+    cos: &[f64],
+    hs2: &[f64],
+    v_cam: &mut [f64],
+    v_crown: &mut [f64],
+) -> f64 {
+    let chi = g.chi;
+    let cm1sq = (chi - 1.0) * (chi - 1.0);
+    let four_chi = 4.0 * chi;
+    let (r2, rb) = (g.r2, g.rb);
+    // rb·D_w = rb·(a_w − b_w·cos φ)
+    let a_cam = rb * (g.z2f + chi * chi);
+    let b_cam = rb * (g.z2f + 1.0) * chi;
+    let a_crown = rb * (g.z2f - chi * chi);
+    let b_crown = rb * (g.z2f - 1.0) * chi;
+    let mut min_margin = f64::INFINITY;
+    for ((((&s, &c), &h), vc), vk) in sin
+        .iter()
+        .zip(cos)
+        .zip(hs2)
+        .zip(v_cam.iter_mut())
+        .zip(v_crown.iter_mut())
+    {
+        let s2 = cm1sq + four_chi * h;
+        let r2s3 = r2 * s2 * s2.sqrt();
+        let m_cam = r2s3 - (a_cam - b_cam * c);
+        let m_crown = r2s3 - (a_crown - b_crown * c);
+        let a = s * s2;
+        *vc = a / m_cam;
+        *vk = a / m_crown;
+        min_margin = min_margin.min(m_cam.min(m_crown));
+    }
+    min_margin
 }
 
 /// Which wheel has a non-positive cusp margin at `t`.
@@ -435,7 +552,10 @@ fn finish_wheel(
             continue;
         }
         let phi_grid = grid_phi(j, n);
-        let mut cand = (phi_grid, v);
+        // The scan tracked a scaled σ²; evaluate the candidate exactly.
+        let s_grid = st.sample_at(phi_grid);
+        *evaluations += 1;
+        let mut cand = (phi_grid, s2_of(&s_grid, w));
         if refine {
             let lo = grid_phi(j.saturating_sub(1), n);
             let hi = grid_phi((j + 1).min(n), n);
@@ -469,7 +589,8 @@ fn finish_wheel(
             best = Some(cand);
         }
     }
-    let Some((phi, _)) = best else {
+    // No positive σ (zero torque, or σ² underflowing at absurdly small torques): no arg max.
+    let Some((phi, _)) = best.filter(|&(_, v)| v > 0.0) else {
         return Ok(WheelMaxResult::zero(w));
     };
     let (s, point) = st.state_at(phi);
@@ -489,10 +610,10 @@ fn finish_wheel(
 /// Source of grid trig values.
 #[derive(Debug, Clone, Copy)]
 pub enum GridTrig<'a> {
-    /// Evaluate Trig::of(jπ/N) on the fly.
+    /// Evaluate Trig::of(jπ/N) chunk by chunk.
     OnTheFly,
-    /// Precomputed table of N + 1 values.
-    Table(&'a [Trig]),
+    /// Precomputed table of the N + 1 grid points (shared by the combinations of a sweep).
+    Table(&'a TrigTable),
 }
 
 /// Compute one feasible design (spec steps 2–7). `curves_stride`: also sample curves.
@@ -524,8 +645,8 @@ pub fn compute_design(
 
     let (cam, crown, evaluations) = if t_cam > 0.0 {
         let sr = match grid {
-            GridTrig::Table(t) if t.len() == n + 1 => scan(&st, n, |j| t[j], budget)?,
-            _ => scan(&st, n, |j| Trig::of(grid_phi(j, n)), budget)?,
+            GridTrig::Table(t) => scan(&st, n, Some(t), budget)?,
+            GridTrig::OnTheFly => scan(&st, n, None, budget)?,
         };
         let mut ev = sr.evaluations;
         let cam = finish_wheel(&st, Wheel::Cam, &sr.cam, n, p.refine, &mut ev)?;
@@ -639,8 +760,8 @@ pub fn compute_sweep(input: &SweepInput, budget: &Budget) -> SweepResult {
     let total = input.len();
     let p = input.params;
     let n = p.n_intervals;
-    let table = (n < TRIG_TABLE_MAX_POINTS).then(|| trig_table(n));
-    let grid = table.as_deref().map_or(GridTrig::OnTheFly, GridTrig::Table);
+    let table = (n < TRIG_TABLE_MAX_POINTS).then(|| TrigTable::new(n));
+    let grid = table.as_ref().map_or(GridTrig::OnTheFly, GridTrig::Table);
     let threads = std::thread::available_parallelism()
         .map_or(1, NonZeroUsize::get)
         .min(total)
