@@ -357,7 +357,9 @@ proptest! {
             }
             let l = t.l_mm / 1e3;
             let closed = 4.0 * w1 * (l - z * g.rb) / (z * (z * z - 1.0));
-            prop_assert!((t.vs_m_s - closed).abs() <= 1e-15);
+            // 1e-15 absolute at the spec's scale; in general relative to the terms V12, V23 that cancel.
+            let scale = 2.0 * w1 * (l + g.rb) / (z * (z - 1.0));
+            prop_assert!((t.vs_m_s - closed).abs() <= 1e-14 * scale);
             let d = l - z * g.rb;
             if d.abs() > 1e-9 * g.r2 {
                 prop_assert_eq!(t.vs_m_s > 0.0, d > 0.0);

@@ -487,7 +487,11 @@ fn check_lb(is: &mut Issues, lb: Option<f64>, r2s_mm: &[f64]) -> Option<f64> {
         is.push(
             BAD_RANGE,
             "/lb_mm",
-            format!("contact length lb_mm must be in (0, 100*r2 = {hi}], got {v}"),
+            if hi.is_finite() {
+                format!("contact length lb_mm must be in (0, 100*r2 = {hi}], got {v}")
+            } else {
+                format!("contact length lb_mm must be in (0, 100*r2], got {v}")
+            },
         );
     }
     ok.then_some(v)
