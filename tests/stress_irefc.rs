@@ -190,7 +190,7 @@ fn z2_and_chi_at_the_ends_of_their_ranges() {
             let (uc, ov) = limits_mm(20.0, z2, chi);
             for frac in [1e-6, 0.3, 0.9] {
                 let rb = frac * uc.min(ov);
-                if !(rb > 0.0) {
+                if rb.is_nan() || rb <= 0.0 {
                     continue;
                 }
                 for mode in ["paper_phase0", "phase_exact"] {
