@@ -650,7 +650,18 @@ impl SevenSegmentLaw {
         for k in 0..7 {
             t[k + 1] = t[k] + dur[k];
         }
+        // Pin t_7 = t_b and the knots of empty trailing segments with it; round-off of the
+        // cumulative sum must never put a knot beyond t_b (spec §6 item 5).
         t[7] = bc.t_b;
+        for k in (1..7).rev() {
+            if dur[k] > 0.0 {
+                break;
+            }
+            t[k] = bc.t_b;
+        }
+        for tk in &mut t {
+            *tk = tk.min(bc.t_b);
+        }
 
         // (base acceleration, amplitude, shape) per segment, spec §3.2 table.
         let shapes = [
@@ -880,8 +891,8 @@ impl SevenSegmentLaw {
             };
             if let Some(r) = ratio {
                 let r = r.clamp(0.0, 1.0);
-                let tau = if k == 0 { r.asin() } else { r.acos() } * seg.inv_w;
-                consider(seg.t0 + tau, seg.v(tau));
+                let tau = (if k == 0 { r.asin() } else { r.acos() } * seg.inv_w).clamp(0.0, seg.c);
+                consider((seg.t0 + tau).min(self.bc.t_b), seg.v(tau));
             }
             consider(self.t[k + 1], self.v[k + 1]);
         }
