@@ -43,7 +43,10 @@ async fn main() -> std::process::ExitCode {
             .init();
     } else {
         let ansi = std::io::IsTerminal::is_terminal(&std::io::stdout());
-        tracing_subscriber::fmt().with_env_filter(filter).with_ansi(ansi).init();
+        tracing_subscriber::fmt()
+            .with_env_filter(filter)
+            .with_ansi(ansi)
+            .init();
     }
 
     let listener = match tokio::net::TcpListener::bind(config.bind).await {

@@ -50,12 +50,21 @@ async fn named_law_is_evaluated() {
     let s = b["curves"]["s"].as_array().expect("s");
     assert_eq!(s.len(), 11);
     assert!((s[10].as_f64().expect("n") - 3.0).abs() < 1e-12);
-    assert!(b["curves"].get("v").is_none(), "only the requested quantities are returned");
+    assert!(
+        b["curves"].get("v").is_none(),
+        "only the requested quantities are returned"
+    );
 }
 
 #[tokio::test]
 async fn malformed_json_is_400() {
-    let r = send("POST", PATH, Some("application/json"), br#"{"coefficients": [0.1, "#.to_vec()).await;
+    let r = send(
+        "POST",
+        PATH,
+        Some("application/json"),
+        br#"{"coefficients": [0.1, "#.to_vec(),
+    )
+    .await;
     let p = r.problem(400);
     assert_eq!(p["type"], "/problems/malformed-json");
 }
@@ -104,7 +113,11 @@ async fn empty_pulse_is_422_on_coefficients() {
     b["coefficients"] = json!([0.5, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0]);
     let r = post_json(PATH, &b).await;
     r.problem(422);
-    assert!(r.pointers().iter().any(|p| p.starts_with("/coefficients")), "{:?}", r.pointers());
+    assert!(
+        r.pointers().iter().any(|p| p.starts_with("/coefficients")),
+        "{:?}",
+        r.pointers()
+    );
 }
 
 #[tokio::test]
@@ -113,7 +126,11 @@ async fn sample_outside_the_interval_is_422_on_abscissa() {
     b["abscissa"] = json!({"values": [0.0, 0.5, 1.5]});
     let r = post_json(PATH, &b).await;
     r.problem(422);
-    assert!(r.pointers().iter().any(|p| p.starts_with("/abscissa")), "{:?}", r.pointers());
+    assert!(
+        r.pointers().iter().any(|p| p.starts_with("/abscissa")),
+        "{:?}",
+        r.pointers()
+    );
 }
 
 #[tokio::test]
@@ -152,19 +169,44 @@ async fn named_law_outside_the_class_with_end_rates_is_422() {
 
 #[tokio::test]
 async fn oversized_body_is_413() {
-    let config = ServiceConfig { max_body_bytes: 1024, ..common::config() };
+    let config = ServiceConfig {
+        max_body_bytes: 1024,
+        ..common::config()
+    };
     let mut b = table1();
     b["abscissa"] = json!({"values": (0..2000).map(|i| f64::from(i) / 1999.0).collect::<Vec<_>>()});
-    let r = send_to(AppState::new(config), "POST", PATH, Some("application/json"), serde_json::to_vec(&b).expect("json")).await;
+    let r = send_to(
+        AppState::new(config),
+        "POST",
+        PATH,
+        Some("application/json"),
+        serde_json::to_vec(&b).expect("json"),
+    )
+    .await;
     assert_eq!(r.problem(413)["type"], "/problems/body-too-large");
 }
 
 #[tokio::test]
 async fn saturated_pool_is_503_with_retry_after() {
-    let config = ServiceConfig { compute_slots: 1, queue_depth: 0, ..common::config() };
+    let config = ServiceConfig {
+        compute_slots: 1,
+        queue_depth: 0,
+        ..common::config()
+    };
     let state = AppState::new(config);
-    let _held = state.pool.acquire(Duration::from_millis(10)).await.expect("the only slot is free");
-    let r = send_to(state, "POST", PATH, Some("application/json"), serde_json::to_vec(&table1()).expect("json")).await;
+    let _held = state
+        .pool
+        .acquire(Duration::from_millis(10))
+        .await
+        .expect("the only slot is free");
+    let r = send_to(
+        state,
+        "POST",
+        PATH,
+        Some("application/json"),
+        serde_json::to_vec(&table1()).expect("json"),
+    )
+    .await;
     let p = r.problem(503);
     assert_eq!(p["type"], "/problems/overloaded");
     assert!(r.headers.get("retry-after").is_some());
