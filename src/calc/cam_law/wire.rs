@@ -34,12 +34,14 @@ pub struct EvaluateRequest {
     /// the 7-segment class (constant_velocity, cubic, polynomial_*, double_harmonic) require zero
     /// end rates.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub law: Option<NamedLaw>,
     /// Boundary conditions of the motion segment (paper constraint vector λ).
     #[serde(default)]
     pub constraints: ConstraintsIn,
     /// Where to evaluate the curves; omit it to get only the law's description and peaks.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub abscissa: Option<AbscissaIn>,
     /// Quantities returned in `curves` (default all four: s, v, a, j). Duplicates are ignored.
     #[serde(default)]
@@ -50,6 +52,7 @@ pub struct EvaluateRequest {
     pub normalize: bool,
     /// Free-text unit labels, echoed back (spec §2).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub units: Option<Units>,
 }
 
@@ -94,6 +97,7 @@ pub struct AbscissaIn {
     pub values: Option<Vec<f64>>,
     /// Uniform grid `x_k = start + k·(end − start)/(count − 1)`, `k = 0..count−1`.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub grid: Option<GridIn>,
 }
 
@@ -173,6 +177,7 @@ pub struct PeaksOut {
     pub jerk_max_abs_finite: Option<f64>,
     /// Dimensionless Appendix-A factors Cv, Ca, Cj of a named law (only with zero end rates).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub peak_factors: Option<PeakFactors>,
 }
 
@@ -200,6 +205,7 @@ pub struct Curves {
 pub struct EvaluateResponse {
     /// The named law evaluated, when the request gave `law`.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub law: Option<NamedLaw>,
     /// Normalized coefficients `ĉ0..ĉ6` (Σ = 1); absent for named laws outside the class.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -217,10 +223,12 @@ pub struct EvaluateResponse {
     pub acceleration_jumps: Vec<Jump>,
     /// Curves at the requested abscissae; absent when the request has no `abscissa`.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub curves: Option<Curves>,
     /// Warning codes (may be empty).
     pub warnings: Vec<Warning>,
     /// The request's unit labels, echoed.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub units: Option<Units>,
 }
