@@ -435,8 +435,7 @@ fn scan(
                 (&local.sin[..], &local.cos[..], &local.half_sin2[..])
             }
         };
-        let min_margin = scan_kernel(g, sin, cos, hs2, &mut v_cam[..len], &mut v_crown[..len]);
-        if min_margin <= 0.0 {
+        if scan_kernel(g, sin, cos, hs2, &mut v_cam[..len], &mut v_crown[..len]) {
             // Locate the first cusp of this chunk for the message.
             let j = (j0..j0 + len)
                 .find(|&j| g.kernel(&Trig::of(grid_phi(j, n))).margin <= 0.0)
@@ -475,10 +474,13 @@ fn scan(
     })
 }
 
-/// The branch-free hot loop: scaled σ² of both wheels for a chunk; returns the smallest cusp margin.
+/// The branch-free hot loop: scaled σ² of both wheels for a chunk; returns whether a cusp margin
+/// m_w ≤ 0 was met.
 ///
-/// Plain `a * b + c` instead of `mul_add`: without the `fma` target feature `mul_add` is a libm call,
-/// which is slower and stops the loop from vectorising.
+/// Works in units of r2 (m_w/r2 = s³ − (rb/r2)·D_w is O(1), so the one shared division below can neither
+/// overflow nor underflow) and divides once: a/m_cam = a·m_crown/(m_cam·m_crown). Plain `a * b + c`
+/// instead of `mul_add`: without the `fma` target feature `mul_add` is a libm call, which is slower and
+/// stops the loop from vectorising.
 #[allow(clippy::suboptimal_flops)]
 fn scan_kernel(
     g: &Geometry,
@@ -487,17 +489,18 @@ fn scan_kernel(
     hs2: &[f64],
     v_cam: &mut [f64],
     v_crown: &mut [f64],
-) -> f64 {
+) -> bool {
     let chi = g.chi;
     let cm1sq = (chi - 1.0) * (chi - 1.0);
     let four_chi = 4.0 * chi;
-    let (r2, rb) = (g.r2, g.rb);
-    // rb·D_w = rb·(a_w − b_w·cos φ)
-    let a_cam = rb * (g.z2f + chi * chi);
-    let b_cam = rb * (g.z2f + 1.0) * chi;
-    let a_crown = rb * (g.z2f - chi * chi);
-    let b_crown = rb * (g.z2f - 1.0) * chi;
-    let mut min_margin = f64::INFINITY;
+    let q = g.rb / g.r2;
+    // (rb/r2)·D_w = a_w − b_w·cos φ
+    let a_cam = q * (g.z2f + chi * chi);
+    let b_cam = q * (g.z2f + 1.0) * chi;
+    let a_crown = q * (g.z2f - chi * chi);
+    let b_crown = q * (g.z2f - 1.0) * chi;
+    // A bool OR reduction vectorises; an f64::min reduction (NaN semantics) does not.
+    let mut cusp = false;
     for ((((&s, &c), &h), vc), vk) in sin
         .iter()
         .zip(cos)
@@ -506,15 +509,15 @@ fn scan_kernel(
         .zip(v_crown.iter_mut())
     {
         let s2 = cm1sq + four_chi * h;
-        let r2s3 = r2 * s2 * s2.sqrt();
-        let m_cam = r2s3 - (a_cam - b_cam * c);
-        let m_crown = r2s3 - (a_crown - b_crown * c);
-        let a = s * s2;
-        *vc = a / m_cam;
-        *vk = a / m_crown;
-        min_margin = min_margin.min(m_cam.min(m_crown));
+        let s3 = s2 * s2.sqrt();
+        let m_cam = s3 - (a_cam - b_cam * c);
+        let m_crown = s3 - (a_crown - b_crown * c);
+        let inv = s * s2 / (m_cam * m_crown);
+        *vc = inv * m_crown;
+        *vk = inv * m_cam;
+        cusp |= (m_cam <= 0.0) | (m_crown <= 0.0);
     }
-    min_margin
+    cusp
 }
 
 /// Which wheel has a non-positive cusp margin at `t`.
