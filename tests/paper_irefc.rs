@@ -435,8 +435,8 @@ fn stress_json_example_maxima_golden() {
         "cam {} @ {:?}, crown {} @ {:?}",
         c.sigma_mpa, c.phi2_deg, k.sigma_mpa, k.phi2_deg
     );
-    assert_relative_eq!(c.sigma_mpa, 2951.872_751_472_897, max_relative = 1e-9);
-    assert_relative_eq!(k.sigma_mpa, 2681.232_162_516_496_4, max_relative = 1e-9);
+    assert_relative_eq!(c.sigma_mpa, 2_951.872_751_472_897, max_relative = 1e-9);
+    assert_relative_eq!(k.sigma_mpa, 2_681.232_162_516_496_4, max_relative = 1e-9);
     assert!((c.phi2_deg.expect("argmax") - 72.756_496_12).abs() < 1e-6);
     assert!((k.phi2_deg.expect("argmax") - 75.513_559_86).abs() < 1e-6);
 }
