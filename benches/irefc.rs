@@ -241,7 +241,7 @@ fn efficiency_table() {
         for n_phase in [1u32, 4, 16, 64, 256, 1024] {
             let r = eff(eff_req(z2, n_phase));
             let (p, l) = match &r.phase_stats {
-                Some(s) => (s.eta_product.expect("positive").mean, s.eta_linear.mean),
+                Some(s) => (s.eta_product.mean.expect("positive"), s.eta_linear.mean),
                 None => (r.totals.eta_product.expect("positive"), r.totals.eta_linear),
             };
             let (m, w) = time_us(n, || eff(eff_req(z2, n_phase)));

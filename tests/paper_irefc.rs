@@ -411,8 +411,8 @@ fn e1_phase_statistics() {
         s.ns_total_w
     );
     assert!(r.totals.ns_total_w <= s.ns_total_w.min + 1e-9);
-    let ep = s.eta_product.expect("positive");
-    assert!((ep.mean - 0.9319).abs() <= 5e-5, "{ep:?}");
+    let ep = s.eta_product.mean.expect("positive");
+    assert!((ep - 0.9319).abs() <= 5e-5, "{ep:?}");
 }
 
 /// Golden values for the spec's single-design JSON example (step 1° + refine): the maxima over φ2 from an

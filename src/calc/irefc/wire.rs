@@ -192,6 +192,7 @@ pub struct GeometryOut {
     pub ratio_crown_output: f64,
     /// Profile point sets, only when `include.profiles` is true.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub profiles: Option<Profiles>,
 }
 

@@ -14,7 +14,7 @@ use compute::PhaseTotals;
 use input::{EfficiencyInput, ROLLING_FRICTION_HIGH_MM};
 use wire::{
     EfficiencyElement, EfficiencyMeta, EfficiencyTotals, IrefcEfficiencyRequest,
-    IrefcEfficiencyResponse, PhaseStats, Stat,
+    IrefcEfficiencyResponse, NullableStat, PhaseStats, Stat,
 };
 
 use super::error::IrefcError;
@@ -98,7 +98,11 @@ pub fn run_efficiency(
     let phase_stats = out.stats.map(|s| PhaseStats {
         n_phase: inp.n_phase,
         ns_total_w: stat(s.ns_total),
-        eta_product: s.eta_product.map(stat),
+        eta_product: NullableStat {
+            mean: s.eta_product.map(|x| x.mean),
+            min: s.eta_product.map(|x| x.min),
+            max: s.eta_product.map(|x| x.max),
+        },
         eta_linear: stat(s.eta_linear),
     });
     Ok(IrefcEfficiencyResponse {

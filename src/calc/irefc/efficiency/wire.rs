@@ -77,6 +77,7 @@ pub struct IrefcEfficiencyRequest {
     #[schema(minimum = 0.0, maximum = 1.0, example = 0.1)]
     pub sliding_friction: Option<f64>,
     /// "paper_table" (default), "paper_abs" or "rigid_body".
+    #[schema(nullable = false)]
     pub model: Option<EfficiencyModel>,
     /// Cage phase: element k at φ2 = phase + 360k/Z2 [deg], in [0, 360/Z2) (default 0, the paper).
     #[schema(minimum = 0.0, example = 0.0)]
@@ -85,6 +86,7 @@ pub struct IrefcEfficiencyRequest {
     #[schema(minimum = 1, maximum = 10_000, example = 1)]
     pub n_phase: Option<u32>,
     /// Optional outputs.
+    #[schema(nullable = false)]
     pub include: Option<EfficiencyInclude>,
 }
 
@@ -162,6 +164,17 @@ pub struct Stat {
     pub max: f64,
 }
 
+/// Mean, minimum and maximum over the cage phases, null where undefined.
+#[derive(Debug, Clone, Copy, Serialize, ToSchema)]
+pub struct NullableStat {
+    /// Mean (midpoint rule over the phase); null when undefined.
+    pub mean: Option<f64>,
+    /// Minimum; null when undefined.
+    pub min: Option<f64>,
+    /// Maximum; null when undefined.
+    pub max: Option<f64>,
+}
+
 /// Statistics over `n_phase` equally spaced cage phases (midpoints).
 #[derive(Debug, Clone, Serialize, ToSchema)]
 pub struct PhaseStats {
@@ -170,8 +183,8 @@ pub struct PhaseStats {
     /// Σ NS [W].
     #[serde(rename = "NS_total_W")]
     pub ns_total_w: Stat,
-    /// η product; null when some phase has an η_k ≤ 0.
-    pub eta_product: Option<Stat>,
+    /// η product; its fields are null when some phase has an η_k ≤ 0.
+    pub eta_product: NullableStat,
     /// η from the energy balance.
     pub eta_linear: Stat,
 }
@@ -215,6 +228,7 @@ pub struct IrefcEfficiencyResponse {
     pub totals: EfficiencyTotals,
     /// Phase statistics (n_phase > 1).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub phase_stats: Option<PhaseStats>,
     /// Warnings.
     pub warnings: Vec<Warning>,

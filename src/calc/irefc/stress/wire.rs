@@ -113,6 +113,7 @@ pub struct SweepSpec {
     "step_deg":1,"refine":true,"load_sharing":"paper_phase0","include":{"elements":true,"curves":false}}))]
 pub struct IrefcStressRequest {
     /// "single" (default without `sweep`) or "sweep" (default when `sweep` is present).
+    #[schema(nullable = false)]
     pub mode: Option<StressMode>,
     /// Cage generating (pitch) circle radius r2 [mm]; required unless `sweep.r2_mm` is given.
     #[schema(exclusive_minimum = 0.0, maximum = 10_000.0, example = 20.0)]
@@ -133,13 +134,16 @@ pub struct IrefcStressRequest {
     #[schema(minimum = 0.0, maximum = 1e7, example = 119.366207)]
     pub torque_nm: f64,
     /// Output link: "cam" (crown fixed, default) or "crown" (cam rotation locked).
+    #[schema(nullable = false)]
     pub output_link: Option<OutputLink>,
     /// Contact (roller) length lb [mm]; default 2·rb ("equal to the diameter"). 0 < lb ≤ 100·r2.
     #[schema(exclusive_minimum = 0.0, example = 4.0)]
     pub lb_mm: Option<f64>,
     /// Cam and crown material; default steel {210000, 0.3}.
+    #[schema(nullable = false)]
     pub wheel_material: Option<Material>,
     /// Rolling element material; default steel {210000, 0.3}.
+    #[schema(nullable = false)]
     pub roller_material: Option<Material>,
     /// φ2 grid step over [0°, 180°] [deg]; 0 < step ≤ 10 and 180/step ≤ 2·10⁶. Default 1 with refine
     /// (see the module docs; the paper used 0.02 without refinement).
@@ -148,8 +152,10 @@ pub struct IrefcStressRequest {
     /// Polish each grid maximum with a bounded Brent search to |Δφ2| ≤ 1e-10 rad (default true).
     pub refine: Option<bool>,
     /// "paper_phase0" (default, the paper) or "phase_exact".
+    #[schema(nullable = false)]
     pub load_sharing: Option<LoadSharing>,
     /// Optional outputs.
+    #[schema(nullable = false)]
     pub include: Option<StressInclude>,
     /// Keep every n-th grid point in `curves` (the last point is always kept; default 1).
     #[schema(minimum = 1, example = 1)]
@@ -158,6 +164,7 @@ pub struct IrefcStressRequest {
     #[schema(minimum = 8, maximum = 100_000, example = 720)]
     pub profile_points: Option<u32>,
     /// The structured array (mode "sweep").
+    #[schema(nullable = false)]
     pub sweep: Option<SweepSpec>,
 }
 
@@ -288,6 +295,7 @@ pub struct StressSingleResponse {
     pub max: MaxOut,
     /// Curves (`include.curves`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub curves: Option<Curves>,
     /// Warnings (geometry and request).
     pub warnings: Vec<Warning>,
@@ -320,6 +328,7 @@ pub struct SweepRecord {
     pub valid: bool,
     /// Why not, when `valid` is false.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub reason: Option<Reason>,
     /// Fmax [N].
     #[serde(rename = "Fmax_N", skip_serializing_if = "Option::is_none")]
