@@ -10,7 +10,7 @@ use super::input::{Design, StressParams, SweepInput};
 use super::wire::{LoadSharing, OutputLink};
 use crate::calc::irefc::brent;
 use crate::calc::irefc::error::IrefcError;
-use crate::calc::irefc::geometry::{AnglePoint, Geometry, Infeasibility, Trig, Wheel};
+use crate::calc::irefc::geometry::{AnglePoint, Geometry, Trig, Wheel};
 use crate::numerics::{Budget, StopReason};
 
 /// Refinement stops when the bracket half-width is below this [rad] (spec step 6).
@@ -845,10 +845,4 @@ pub fn compute_sweep(input: &SweepInput, budget: &Budget) -> SweepResult {
         evaluated: evaluated.load(Ordering::Relaxed),
         threads: u32::try_from(threads).unwrap_or(u32::MAX),
     }
-}
-
-/// Infeasibility of a design without computing it (for callers that only need the check).
-#[must_use]
-pub fn infeasibilities(d: &Design) -> Vec<Infeasibility> {
-    Geometry::new_unchecked(d.r2, d.z2, d.chi, d.rb).infeasibilities()
 }
