@@ -62,16 +62,7 @@ fn run_single(inp: &SingleInput, budget: &Budget) -> Result<StressSingleResponse
         }
         .into());
     }
-    let mut warnings = geometry_warnings(g);
-    if inp.params.lb.is_none() {
-        warnings.push(Warning::new(
-            "DEFAULT_CONTACT_LENGTH",
-            format!(
-                "lb_mm not given: using 2*rb = {} mm (the paper's default)",
-                r.lb * MM
-            ),
-        ));
-    }
+    let warnings = geometry_warnings(g);
     let elements = inp.elements.then(|| {
         r.forces
             .elements
