@@ -319,8 +319,11 @@ proptest! {
         prop_assert!(rel(rc.t_in_nm, rd.t_in_nm) < 1e-14);
     }
 
-    /// Grid vs refine: the refined maximum is ≥ the grid maximum and lies within one step of it; both load
-    /// sharing modes.
+    /// Grid vs refine: the refined maximum is ≥ the grid maximum and equals the maximum found with a fine
+    /// grid (0.05° + refine) to 1e-9, in both load-sharing modes. In "paper_phase0" (one bump per wheel) it
+    /// also lies within one step of the grid maximum; in "phase_exact" the curve can have several bumps
+    /// and a coarse grid may rank them wrongly (regression: Z2 = 9, step 2.93°), so only the value is
+    /// compared there.
     #[test]
     fn refine_never_worse(g in design(), step in 0.3f64..5.0, exact in any::<bool>()) {
         let mode = if exact { "phase_exact" } else { "paper_phase0" };
@@ -330,13 +333,21 @@ proptest! {
         a["refine"] = json!(false);
         let mut b = a.clone();
         b["refine"] = json!(true);
-        let (ra, rb) = (single(a), single(b));
+        let mut c = b.clone();
+        c["step_deg"] = json!(0.05);
+        let (ra, rb, rc) = (single(a), single(b), single(c));
         let n = (180.0 / step).round();
         let h = 180.0 / n;
-        for (x, y) in [(&ra.max.cam, &rb.max.cam), (&ra.max.crown, &rb.max.crown)] {
+        for (x, y, z) in [
+            (&ra.max.cam, &rb.max.cam, &rc.max.cam),
+            (&ra.max.crown, &rb.max.crown, &rc.max.crown),
+        ] {
             prop_assert!(y.sigma_mpa >= x.sigma_mpa);
-            let (px, py) = (x.phi2_deg.unwrap_or(0.0), y.phi2_deg.unwrap_or(0.0));
-            prop_assert!((px - py).abs() <= h * (1.0 + 1e-9), "{px} vs {py}, step {h}");
+            prop_assert!(rel(y.sigma_mpa, z.sigma_mpa) < 1e-9, "{} vs fine {}", y.sigma_mpa, z.sigma_mpa);
+            if !exact {
+                let (px, py) = (x.phi2_deg.unwrap_or(0.0), y.phi2_deg.unwrap_or(0.0));
+                prop_assert!((px - py).abs() <= h * (1.0 + 1e-9), "{px} vs {py}, step {h}");
+            }
         }
     }
 

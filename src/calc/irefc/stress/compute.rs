@@ -1,7 +1,7 @@
 //! Element forces and Hertz contact stresses of one design, and the parallel sweep (spec `irefc_stress.md`,
 //! "Algorithm" and "Sweep").
 
-use std::f64::consts::PI;
+use std::f64::consts::{PI, TAU};
 use std::num::NonZeroUsize;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -248,6 +248,8 @@ pub struct DesignResult {
     pub crown: WheelMaxResult,
     /// Stress evaluations (grid + refinement).
     pub evaluations: u64,
+    /// Grid intervals scanned (see [`scan_intervals`]).
+    pub n_intervals: usize,
     /// Curves, when requested.
     pub curves: Option<CurveData>,
 }
@@ -325,44 +327,111 @@ impl TrigTable {
     }
 }
 
-/// Up to two largest local maxima of a grid sequence (by value).
-#[derive(Debug, Clone, Copy)]
-struct Top2 {
-    best: [(usize, f64); 2],
+/// Local maxima of a grid sequence, (index, value). Bounded: beyond [`PEAKS_KEEP_MAX`] entries only the
+/// largest half is kept (rounding ripples on very fine grids can create many tiny local maxima).
+#[derive(Debug, Clone, Default)]
+struct Peaks {
+    list: Vec<(usize, f64)>,
 }
 
-impl Top2 {
-    const fn new() -> Self {
-        Self {
-            best: [(usize::MAX, f64::NEG_INFINITY); 2],
+/// Most local maxima kept per wheel during a scan.
+const PEAKS_KEEP_MAX: usize = 1024;
+
+impl Peaks {
+    #[inline]
+    fn offer(&mut self, j: usize, v: f64) {
+        self.list.push((j, v));
+        if self.list.len() > PEAKS_KEEP_MAX {
+            self.list.sort_by(|a, b| b.1.total_cmp(&a.1));
+            self.list.truncate(PEAKS_KEEP_MAX / 2);
         }
     }
 
-    #[inline]
-    fn offer(&mut self, j: usize, v: f64) {
-        if v > self.best[0].1 {
-            self.best[1] = self.best[0];
-            self.best[0] = (j, v);
-        } else if v > self.best[1].1 {
-            self.best[1] = (j, v);
+    /// Refinement candidates (spec step 6, defensive): local maxima by decreasing value whose grid value
+    /// is at least [`CANDIDATE_FRACTION`] of the largest, at most `max_candidates`, skipping those whose
+    /// bracket overlaps a better candidate's.
+    fn candidates(mut self, max_candidates: usize) -> Vec<(usize, f64)> {
+        self.list
+            .sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        let Some(&(_, top)) = self.list.first() else {
+            return Vec::new();
+        };
+        let mut out: Vec<(usize, f64)> = Vec::new();
+        for &(j, v) in &self.list {
+            if out.len() >= max_candidates || v < CANDIDATE_FRACTION * top {
+                break;
+            }
+            if out.iter().all(|&(k, _)| k.abs_diff(j) > 2) {
+                out.push((j, v));
+            }
         }
+        out
+    }
+}
+
+/// Local grid maxima down to this fraction of the largest are refined: with "phase_exact" the stress
+/// curve has several bumps (the cage phase changes the load sharing) and a coarse grid can rank them
+/// wrongly; the spec's "two largest" is the minimum.
+pub const CANDIDATE_FRACTION: f64 = 0.5;
+/// Most refinements per wheel ("paper_phase0": one smooth bump per wheel, a few spare).
+pub const MAX_CANDIDATES: usize = 16;
+/// Most refinements per wheel with "phase_exact": near the top of the sin α envelope many load-sharing
+/// ripples have nearly equal heights.
+pub const MAX_CANDIDATES_PHASE_EXACT: usize = 64;
+/// With "phase_exact" and refine, the scan uses at least this many grid intervals per 180°/Z2, the
+/// spacing of the load-sharing breakpoints (an element enters or leaves [0, π]; σ is smooth only between
+/// them and can have one bump per piece), so that every bump shows up as a grid maximum. Coarser grids
+/// missed the bump holding the maximum in the property tests (Z2 = 65, step 1.6°: 7e-5 low).
+pub const PHASE_EXACT_POINTS_PER_SEGMENT: usize = 8;
+
+/// Element angles in (lo, hi) where an element of the cage enters or leaves [0, π] when an element sits at
+/// φ: φ = 2πm/Z2 (an element at 0) and φ = π − 2πm/Z2 (an element at π), sorted.
+#[must_use]
+pub fn load_sharing_breakpoints(z2: u32, lo: f64, hi: f64) -> Vec<f64> {
+    let per = TAU / f64::from(z2);
+    let mut v = Vec::new();
+    for base in [0.0, PI] {
+        // φ = base ± m·per; m ranges over the integers that land in (lo, hi).
+        let (m0, m1) = (((lo - base) / per).ceil(), ((hi - base) / per).floor());
+        let mut m = m0;
+        while m <= m1 {
+            let x = m.mul_add(per, base);
+            if x > lo && x < hi {
+                v.push(x);
+            }
+            m += 1.0;
+        }
+    }
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| (*a - *b).abs() <= REFINE_TOL_RAD);
+    v
+}
+
+/// Grid intervals actually scanned: the requested N, raised with "phase_exact" + refine to
+/// [`PHASE_EXACT_POINTS_PER_SEGMENT`] per 180°/Z2 (N ≥ 8·Z2).
+#[must_use]
+pub fn scan_intervals(p: &StressParams, z2: u32) -> usize {
+    if p.refine && p.load_sharing == LoadSharing::PhaseExact {
+        p.n_intervals.max(z2 as usize * PHASE_EXACT_POINTS_PER_SEGMENT)
+    } else {
+        p.n_intervals
     }
 }
 
 /// Streaming local-maximum detector of one wheel.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct PeakTracker {
     prev2: f64,
     prev1: f64,
-    top: Top2,
+    peaks: Peaks,
 }
 
 impl PeakTracker {
-    const fn new() -> Self {
+    fn new() -> Self {
         Self {
             prev2: f64::NEG_INFINITY,
             prev1: f64::NEG_INFINITY,
-            top: Top2::new(),
+            peaks: Peaks::default(),
         }
     }
 
@@ -370,7 +439,7 @@ impl PeakTracker {
     #[inline]
     fn push(&mut self, j: usize, v: f64) {
         if j >= 1 && self.prev1 >= self.prev2 && self.prev1 > v {
-            self.top.offer(j - 1, self.prev1);
+            self.peaks.offer(j - 1, self.prev1);
         }
         self.prev2 = self.prev1;
         self.prev1 = v;
@@ -379,15 +448,15 @@ impl PeakTracker {
     /// Finish after the last value at index `n` (the end is a maximum if still rising).
     fn finish(&mut self, n: usize) {
         if self.prev1 > self.prev2 {
-            self.top.offer(n, self.prev1);
+            self.peaks.offer(n, self.prev1);
         }
     }
 }
 
 /// Grid scan result of both wheels.
 struct ScanResult {
-    cam: Top2,
-    crown: Top2,
+    cam: Peaks,
+    crown: Peaks,
     evaluations: u64,
 }
 
@@ -468,8 +537,8 @@ fn scan(
     cam.finish(n);
     crown.finish(n);
     Ok(ScanResult {
-        cam: cam.top,
-        crown: crown.top,
+        cam: cam.peaks,
+        crown: crown.peaks,
         evaluations: n as u64 + 1,
     })
 }
@@ -544,14 +613,15 @@ const fn s2_of(s: &StressSample, w: Wheel) -> f64 {
 fn finish_wheel(
     st: &Stresser<'_>,
     w: Wheel,
-    top: &Top2,
+    peaks: Peaks,
     n: usize,
     refine: bool,
+    max_candidates: usize,
     evaluations: &mut u64,
 ) -> Result<WheelMaxResult, IrefcError> {
     let mut best: Option<(f64, f64)> = None; // (φ, σ²)
-    for &(j, v) in &top.best {
-        if j == usize::MAX || v <= 0.0 || !v.is_finite() {
+    for (j, v) in peaks.candidates(max_candidates) {
+        if v <= 0.0 || !v.is_finite() {
             continue;
         }
         let phi_grid = grid_phi(j, n);
@@ -562,30 +632,43 @@ fn finish_wheel(
         if refine {
             let lo = grid_phi(j.saturating_sub(1), n);
             let hi = grid_phi((j + 1).min(n), n);
-            let mut cusp = false;
-            let r = brent::maximize(
-                |phi| {
-                    let s = st.sample_at(phi);
-                    if s.margin <= 0.0 {
-                        cusp = true;
-                        return 0.0;
-                    }
-                    s2_of(&s, w)
-                },
-                lo,
-                hi,
-                REFINE_TOL_RAD,
-                REFINE_MAX_ITER,
-            );
-            *evaluations += r.evaluations;
-            if cusp {
-                return Err(IrefcError::Cusp {
-                    wheel: w,
-                    phi_deg: r.x.to_degrees(),
-                });
+            // "phase_exact": σ is smooth only between the load-sharing breakpoints (an element enters or
+            // leaves [0, π]); maximise each smooth piece of the bracket on its own.
+            let mut edges = vec![lo];
+            if st.mode == LoadSharing::PhaseExact {
+                edges.extend(load_sharing_breakpoints(st.g.z2, lo, hi));
             }
-            if r.fx > cand.1 {
-                cand = (r.x, r.fx);
+            edges.push(hi);
+            for piece in edges.windows(2) {
+                let (a, b) = (piece[0], piece[1]);
+                if b - a <= REFINE_TOL_RAD {
+                    continue;
+                }
+                let mut cusp = false;
+                let r = brent::maximize(
+                    |phi| {
+                        let s = st.sample_at(phi);
+                        if s.margin <= 0.0 {
+                            cusp = true;
+                            return 0.0;
+                        }
+                        s2_of(&s, w)
+                    },
+                    a,
+                    b,
+                    REFINE_TOL_RAD,
+                    REFINE_MAX_ITER,
+                );
+                *evaluations += r.evaluations;
+                if cusp {
+                    return Err(IrefcError::Cusp {
+                        wheel: w,
+                        phi_deg: r.x.to_degrees(),
+                    });
+                }
+                if r.fx > cand.1 {
+                    cand = (r.x, r.fx);
+                }
             }
         }
         if best.is_none_or(|(_, bv)| cand.1 > bv) {
@@ -644,7 +727,11 @@ pub fn compute_design(
     let forces = element_forces(&g, t_cam, 0.0);
     finite("Fmax", forces.fmax, None)?;
     let st = Stresser::new(&g, t_cam, forces.fmax, p.e_star, lb, p.load_sharing);
-    let n = p.n_intervals;
+    let n = scan_intervals(p, g.z2);
+    let max_candidates = match p.load_sharing {
+        LoadSharing::PaperPhase0 => MAX_CANDIDATES,
+        LoadSharing::PhaseExact => MAX_CANDIDATES_PHASE_EXACT,
+    };
 
     let (cam, crown, evaluations) = if t_cam > 0.0 {
         let sr = match grid {
@@ -652,8 +739,24 @@ pub fn compute_design(
             GridTrig::OnTheFly => scan(&st, n, None, budget)?,
         };
         let mut ev = sr.evaluations;
-        let cam = finish_wheel(&st, Wheel::Cam, &sr.cam, n, p.refine, &mut ev)?;
-        let crown = finish_wheel(&st, Wheel::Crown, &sr.crown, n, p.refine, &mut ev)?;
+        let cam = finish_wheel(
+            &st,
+            Wheel::Cam,
+            sr.cam,
+            n,
+            p.refine,
+            max_candidates,
+            &mut ev,
+        )?;
+        let crown = finish_wheel(
+            &st,
+            Wheel::Crown,
+            sr.crown,
+            n,
+            p.refine,
+            max_candidates,
+            &mut ev,
+        )?;
         (cam, crown, ev)
     } else {
         (
@@ -668,7 +771,7 @@ pub fn compute_design(
         finite("F", m.f, at)?;
         finite("b", m.b, at)?;
     }
-    let curves = curves_stride.map(|stride| curves(&st, n, stride.max(1)));
+    let curves = curves_stride.map(|stride| curves(&st, p.n_intervals, stride.max(1)));
     if let Some(c) = &curves
         && !(c.f.iter().chain(&c.sigma_cam).chain(&c.sigma_crown)).all(|v| v.is_finite())
     {
@@ -688,6 +791,7 @@ pub fn compute_design(
         cam,
         crown,
         evaluations,
+        n_intervals: n,
         curves,
     })
 }

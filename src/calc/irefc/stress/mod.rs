@@ -62,7 +62,18 @@ fn run_single(inp: &SingleInput, budget: &Budget) -> Result<StressSingleResponse
         }
         .into());
     }
-    let warnings = geometry_warnings(g);
+    let mut warnings = geometry_warnings(g);
+    if r.n_intervals > inp.params.n_intervals {
+        warnings.push(Warning::new(
+            "GRID_REFINED",
+            format!(
+                "phase_exact with refine: the maximum search used {} grid intervals ({} deg) instead of {} so that every load-sharing ripple (period 360/Z2 deg) is resolved",
+                r.n_intervals,
+                180.0 / r.n_intervals as f64,
+                inp.params.n_intervals
+            ),
+        ));
+    }
     let elements = inp.elements.then(|| {
         r.forces
             .elements
@@ -107,7 +118,7 @@ fn run_single(inp: &SingleInput, budget: &Budget) -> Result<StressSingleResponse
             step_deg: p.step_deg,
             refine: p.refine,
             load_sharing: p.load_sharing,
-            n_grid: p.n_intervals as u64 + 1,
+            n_grid: r.n_intervals as u64 + 1,
             evaluations: r.evaluations,
             compute_ms: t0.elapsed().as_secs_f64() * 1e3,
         },

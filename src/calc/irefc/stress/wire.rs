@@ -254,7 +254,8 @@ pub struct StressMeta {
     pub refine: bool,
     /// Load-sharing mode.
     pub load_sharing: LoadSharing,
-    /// Grid points N + 1.
+    /// Grid points scanned, N + 1 (with "phase_exact" + refine at least 4·Z2 + 1, see warning
+    /// `GRID_REFINED`; curves always use the requested step).
     pub n_grid: u64,
     /// Stress evaluations (grid + refinement).
     pub evaluations: u64,
@@ -377,7 +378,8 @@ pub struct SweepMeta {
     pub refine: bool,
     /// Load-sharing mode.
     pub load_sharing: LoadSharing,
-    /// Grid points per combination.
+    /// Grid points per combination as requested (with "phase_exact" + refine each combination scans at
+    /// least 4·Z2 + 1 points).
     pub n_grid: u64,
     /// Combinations in the sweep.
     pub n_combinations: u64,
