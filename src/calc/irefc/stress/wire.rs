@@ -151,7 +151,9 @@ pub struct IrefcStressRequest {
     pub step_deg: Option<f64>,
     /// Polish each grid maximum with a bounded Brent search to |Δφ2| ≤ 1e-10 rad (default true).
     pub refine: Option<bool>,
-    /// "paper_phase0" (default, the paper) or "phase_exact".
+    /// "paper_phase0" (default, the paper) or "phase_exact". With "phase_exact" and refine the maximum
+    /// search scans at least 8 points per 180/Z2 deg (the load-sharing breakpoints; warning `GRID_REFINED`)
+    /// and refines each smooth piece, because σ then has several bumps.
     #[schema(nullable = false)]
     pub load_sharing: Option<LoadSharing>,
     /// Optional outputs.
