@@ -6,6 +6,7 @@
 //! spec states per case (6 printed decimals → 5e-7 absolute unless a documented deviation
 //! applies). Every comparison prints both sides on failure.
 #![allow(clippy::unwrap_used)] // tests: a panic is the failure report
+#![allow(clippy::suboptimal_flops)] // tests spell formulas as printed, for readability
 
 use std::collections::HashMap;
 

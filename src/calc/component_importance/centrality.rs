@@ -143,7 +143,7 @@ pub fn kendall_tau_b(x: &[f64], y: &[f64]) -> Option<f64> {
         let f = v as f64;
         f
     };
-    let con_minus_dis = u(tot) - u(xtie) - u(ytie) + u(ntie) - 2.0 * u(dis);
+    let con_minus_dis = 2.0f64.mul_add(-u(dis), u(tot) - u(xtie) - u(ytie) + u(ntie));
     Some(con_minus_dis / ((u(tot) - u(xtie)).sqrt() * (u(tot) - u(ytie)).sqrt()))
 }
 
@@ -186,12 +186,13 @@ fn merge_count(a: &mut [f64], buf: &mut [f64]) -> u64 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 
     fn naive(x: &[f64], y: &[f64]) -> Option<f64> {
         let n = x.len();
-        let (mut c, mut d, mut tx, mut ty) = (0.0, 0.0, 0.0, 0.0);
+        let (mut c, mut d, mut tx, mut ty) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
         for i in 0..n {
             for j in i + 1..n {
                 let a = cmp_f64(x[i], x[j]);

@@ -142,7 +142,7 @@ fn response(
             let rel = flags.reliability;
             TimeResult {
                 time_h: t.time_h,
-                tail_bound: ind.then(|| TailBound {
+                tail_bound: ind.then_some(TailBound {
                     probability: t.probability.tail_bound,
                     risk: t.risk.tail_bound,
                 }),

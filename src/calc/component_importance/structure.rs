@@ -615,6 +615,7 @@ pub(crate) fn to_f64(x: usize) -> f64 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 
@@ -627,7 +628,7 @@ mod tests {
         let mut w = Work::default();
         let plain = simple_path_betweenness_dag(&g, &topo, &Budget::unlimited(), &mut w).unwrap();
         let mut logb = vec![0.0; g.m()];
-        let mut pos = vec![0; 5];
+        let mut pos = [0; 5];
         for (k, &v) in topo.iter().enumerate() {
             pos[v] = k;
         }
