@@ -578,12 +578,23 @@ pub fn assemble(
     let sum_b: f64 = betweenness.iter().sum();
     let sum_i: f64 = efficiency.iter().sum();
     let ratio = |x: f64, total: f64| if total > 0.0 { x / total } else { 0.0 };
+    // I_i/ΣI on values scaled by max I, so that overrides near f64::MAX cannot overflow ΣI.
+    let max_i = efficiency.iter().copied().fold(0.0, f64::max);
+    let scaled_sum_i: f64 = if max_i > 0.0 {
+        efficiency.iter().map(|x| x / max_i).sum()
+    } else {
+        0.0
+    };
     let hc: Vec<f64> = betweenness.iter().map(|&b| ratio(b, sum_b)).collect();
     let mut he = vec![0.0; g.m()];
     let mut he_row_sum = vec![0.0; g.n()];
     let mut he_diag_display = vec![0.0; g.n()];
     for i in 0..g.n() {
-        let ii = ratio(efficiency[i], sum_i);
+        let ii = if max_i > 0.0 {
+            ratio(efficiency[i] / max_i, scaled_sum_i)
+        } else {
+            0.0
+        };
         he_diag_display[i] = t[i] * ii;
         let mut row = 0.0;
         for e in g.out_edges(i) {
