@@ -187,8 +187,8 @@ proptest! {
     #[test]
     fn dag_betweenness_equals_enumeration(c in case(Some(true))) {
         let g = graph(&c);
-        let topo = g.topological_order().unwrap();
-        let dp = structure::simple_path_betweenness_dag(&g, &topo, &Budget::unlimited(), &mut Work::default()).unwrap();
+        prop_assert!(g.topological_order().is_some());
+        let dp = structure::simple_path_betweenness_dag(&g, &Budget::unlimited(), &mut Work::default()).unwrap();
         let en = structure::simple_path_betweenness_enumerated(&g, u64::MAX, &Budget::unlimited(), &mut Work::default()).unwrap();
         for (a, b) in dp.iter().zip(&en) {
             prop_assert!(close(*a, *b, EXACT_TOL), "{a} vs {b}");
@@ -341,6 +341,69 @@ proptest! {
         let b = run_ok(req);
         for (x, y) in a.results.iter().zip(&b.results) {
             prop_assert_eq!(x.ci.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), y.ci.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+        }
+    }
+
+    /// Brandes edge/node betweenness equals the pair-by-pair definition
+    /// Σ_{s≠t} σ_st(e)/σ_st, and its distance summaries equal the plain BFS ones bit for bit.
+    #[test]
+    fn brandes_matches_definition(c in case(None)) {
+        let g = graph(&c);
+        let b = structure::shortest_path_betweenness(&g, &Budget::unlimited(), &mut Work::default()).unwrap();
+        let n = c.n;
+        // All-pairs BFS distances and shortest-path counts.
+        let mut dist = vec![vec![usize::MAX; n]; n];
+        let mut sigma = vec![vec![0.0f64; n]; n];
+        for s in 0..n {
+            dist[s][s] = 0;
+            sigma[s][s] = 1.0;
+            let mut queue = vec![s];
+            let mut h = 0;
+            while h < queue.len() {
+                let v = queue[h];
+                h += 1;
+                for &w in g.succ(v) {
+                    if dist[s][w] == usize::MAX {
+                        dist[s][w] = dist[s][v] + 1;
+                        queue.push(w);
+                    }
+                    if dist[s][w] == dist[s][v] + 1 {
+                        sigma[s][w] += sigma[s][v];
+                    }
+                }
+            }
+        }
+        let mut edge = vec![0.0; g.m()];
+        let mut node = vec![0.0; n];
+        for s in 0..n {
+            for t in 0..n {
+                if s == t || dist[s][t] == usize::MAX {
+                    continue;
+                }
+                for e in 0..g.m() {
+                    let (v, w) = (g.tail(e), g.head(e));
+                    if dist[s][v] != usize::MAX && dist[w][t] != usize::MAX && dist[s][v] + 1 + dist[w][t] == dist[s][t] {
+                        edge[e] += sigma[s][v] * sigma[w][t] / sigma[s][t];
+                    }
+                }
+                for v in 0..n {
+                    if v != s && v != t && dist[s][v] != usize::MAX && dist[v][t] != usize::MAX && dist[s][v] + dist[v][t] == dist[s][t] {
+                        node[v] += sigma[s][v] * sigma[v][t] / sigma[s][t];
+                    }
+                }
+            }
+        }
+        for (a, w) in b.edge.iter().zip(&edge) {
+            prop_assert!(close(*a, *w, EXACT_TOL), "edge {a} vs {w}");
+        }
+        for (a, w) in b.node.iter().zip(&node) {
+            prop_assert!(close(*a, *w, EXACT_TOL), "node {a} vs {w}");
+        }
+        let bfs = structure::distances(&g, &Budget::unlimited(), &mut Work::default()).unwrap();
+        for i in 0..n {
+            prop_assert_eq!(bfs.efficiency[i].to_bits(), b.reach.efficiency[i].to_bits());
+            prop_assert_eq!(bfs.reach[i], b.reach.reach[i]);
+            prop_assert_eq!(bfs.dist_sum[i].to_bits(), b.reach.dist_sum[i].to_bits());
         }
     }
 

@@ -178,23 +178,44 @@ fn longest_path(g: &Digraph, topo: &[usize]) -> usize {
     len.into_iter().max().unwrap_or(0)
 }
 
-/// Compute the time-independent structure (spec §3.1–3.6).
+/// The time-independent part of a run.
+#[derive(Debug, Clone)]
+pub struct StructureParts {
+    /// B, I, levels, T, Hc, HE.
+    pub structure: Structure,
+    /// How B was computed.
+    pub algorithm: BetweennessAlgorithm,
+    /// Distance summaries (when efficiency or centralities needed them).
+    pub reach: Option<structure::Reach>,
+    /// Unnormalized shortest-path node betweenness (when the Brandes pass ran).
+    pub node_betweenness: Option<Vec<f64>>,
+}
+
+/// Compute the time-independent structure (spec §3.1–3.6). One Brandes pass serves the
+/// shortest-path betweenness, the distances and the comparison centralities when any of them is
+/// needed; otherwise a plain BFS gives the distances.
 ///
 /// # Errors
 /// Budget and enumeration failures of the betweenness stage.
 pub fn compute_structure(
     input: &ComponentImportanceInput,
-    topo: Option<&[usize]>,
+    is_dag: bool,
     budget: &Budget,
     work: &mut Work,
-) -> Result<(Structure, BetweennessAlgorithm, Option<structure::Reach>), ComponentImportanceError> {
+) -> Result<StructureParts, ComponentImportanceError> {
     let g = &input.graph;
     let need_bfs =
         input.efficiency_override.iter().any(Option::is_none) || input.outputs.centralities;
-    let reach = if need_bfs {
-        Some(structure::distances(g, budget, work)?)
-    } else {
-        None
+    let brandes =
+        if input.betweenness == BetweennessMode::ShortestPaths || input.outputs.centralities {
+            Some(structure::shortest_path_betweenness(g, budget, work)?)
+        } else {
+            None
+        };
+    let reach = match &brandes {
+        Some(b) => Some(b.reach.clone()),
+        None if need_bfs => Some(structure::distances(g, budget, work)?),
+        None => None,
     };
     let efficiency_computed = reach
         .as_ref()
@@ -204,18 +225,17 @@ pub fn compute_structure(
         .zip(&input.efficiency_override)
         .map(|(&c, o)| o.unwrap_or(c))
         .collect();
-    let (betweenness, algo) = match (input.betweenness, topo) {
-        (BetweennessMode::AllSimplePaths, Some(t)) => (
-            structure::simple_path_betweenness_dag(g, t, budget, work)?,
+    let (betweenness, algorithm) = match (input.betweenness, is_dag, &brandes) {
+        (BetweennessMode::ShortestPaths, _, Some(b)) => {
+            (b.edge.clone(), BetweennessAlgorithm::BrandesShortestPaths)
+        }
+        (_, true, _) => (
+            structure::simple_path_betweenness_dag(g, budget, work)?,
             BetweennessAlgorithm::DagPathCounting,
         ),
-        (BetweennessMode::AllSimplePaths, None) => (
+        (_, false, _) => (
             structure::simple_path_betweenness_enumerated(g, input.max_simple_paths, budget, work)?,
             BetweennessAlgorithm::SimplePathEnumeration,
-        ),
-        (BetweennessMode::ShortestPaths, _) => (
-            structure::shortest_path_betweenness(g, budget, work)?.edge,
-            BetweennessAlgorithm::BrandesShortestPaths,
         ),
     };
     let levels = structure::hierarchy_levels(g, input.levels, &input.level_override);
@@ -228,7 +248,12 @@ pub fn compute_structure(
         input.q_in,
         input.o_out,
     );
-    Ok((s, algo, reach))
+    Ok(StructureParts {
+        structure: s,
+        algorithm,
+        reach,
+        node_betweenness: brandes.map(|b| b.node),
+    })
 }
 
 /// Per-length propagation sums for edge values `p` with the chosen algorithm.
@@ -324,8 +349,12 @@ pub fn compute(
     let mut warnings = input.warnings.clone();
     let topo = g.topological_order();
     let is_dag = topo.is_some();
-    let (st, betweenness_algorithm, reach) =
-        compute_structure(input, topo.as_deref(), budget, &mut work)?;
+    let StructureParts {
+        structure: st,
+        algorithm: betweenness_algorithm,
+        reach,
+        node_betweenness,
+    } = compute_structure(input, is_dag, budget, &mut work)?;
     let k = input.path_cap;
     let propagation_algorithm = match (input.path_method, is_dag) {
         (_, true) => PropagationAlgorithm::DagWalks,
@@ -499,7 +528,10 @@ pub fn compute(
     }
 
     let centralities = if input.outputs.centralities {
-        let node_bc = structure::shortest_path_betweenness(g, budget, &mut work)?.node;
+        let node_bc = match node_betweenness {
+            Some(b) => b,
+            None => structure::shortest_path_betweenness(g, budget, &mut work)?.node,
+        };
         let pr = centrality::pagerank_reversed(g, budget, &mut work)?;
         let closeness = reach
             .as_ref()

@@ -124,57 +124,65 @@ impl LogSum {
     }
 }
 
-/// Edge betweenness over all simple paths on a DAG by path counting (spec §3.3, exact,
-/// O(n·(n+m))): B_ij = Σ_{e≠f} π(e,i)·π(j,f)/π(e,f) − 1/π(i,j).
+/// Edge betweenness over all simple paths on a DAG by path counting (spec §3.3, exact):
+/// B_ij = Σ_{e≠f} π(e,i)·π(j,f)/π(e,f) − 1/π(i,j).
 ///
-/// Per source e: a forward DP gives π(e,·); a backward DP gives
-/// g(j) = Σ_f π(j,f)/π(e,f) = 1/π(e,j) + Σ_{k∈succ(j)} g(k); then B_ij += π(e,i)·g(j), where for
-/// i = e the own pair (e, j) is left out by using Σ_{k∈succ(j)} g(k) instead of g(j). Sources
-/// whose counts exceed [`PATH_COUNT_LIMIT`] are recounted in log space (spec §6 H3).
+/// Per source e, restricted to the nodes reachable from e (found by a depth-first search whose
+/// reverse postorder is a topological order of them): a forward DP gives π(e,·); a backward DP
+/// gives g(j) = Σ_f π(j,f)/π(e,f) = 1/π(e,j) + Σ_{k∈succ(j)} g(k); then B_ij += π(e,i)·g(j),
+/// where for i = e the own pair (e, j) is left out by using Σ_{k∈succ(j)} g(k) instead of g(j).
+/// Cost O(Σ_e edges reachable from e) ≤ O(n·m). Sources whose counts exceed
+/// [`PATH_COUNT_LIMIT`] are recounted in log space (spec §6 H3).
 ///
-/// `topo` must be a topological order of `g`. Returns B per CSR edge.
+/// `g` must be acyclic. Returns B per CSR edge.
 ///
 /// # Errors
 /// [`ComponentImportanceError::Stopped`] when the budget runs out.
 pub fn simple_path_betweenness_dag(
     g: &Digraph,
-    topo: &[usize],
     budget: &Budget,
     work: &mut Work,
 ) -> Result<Vec<f64>, ComponentImportanceError> {
     let n = g.n();
-    let mut pos = vec![0usize; n];
-    for (k, &v) in topo.iter().enumerate() {
-        pos[v] = k;
-    }
     let mut b = vec![0.0; g.m()];
     let mut pi = vec![0.0; n];
     let mut gsum = vec![0.0; n];
     let mut tail_sum = vec![0.0; n];
     let mut mark = vec![false; n];
     let mut reached: Vec<usize> = Vec::with_capacity(n);
+    let mut stack: Vec<(usize, usize)> = Vec::new();
     for e in 0..n {
         work.passes += 1;
         work.check(budget, "simple-path betweenness (DAG counting)")?;
+        // Reachable set in topological order: reverse DFS postorder.
         reached.clear();
-        reached.push(e);
         mark[e] = true;
+        stack.push((e, g.out_edges(e).start));
+        while let Some(top) = stack.last_mut() {
+            let v = top.0;
+            if top.1 < g.out_edges(v).end {
+                let w = g.head(top.1);
+                top.1 += 1;
+                if !mark[w] {
+                    mark[w] = true;
+                    stack.push((w, g.out_edges(w).start));
+                }
+            } else {
+                reached.push(v);
+                stack.pop();
+            }
+        }
+        reached.reverse();
+        for &v in &reached {
+            pi[v] = 0.0;
+        }
         pi[e] = 1.0;
         let mut overflow = false;
-        for &v in &topo[pos[e] + 1..] {
-            let mut s = 0.0;
-            let mut any = false;
-            for &u in g.pred(v) {
-                if mark[u] {
-                    s += pi[u];
-                    any = true;
-                }
-            }
-            if any {
-                mark[v] = true;
-                pi[v] = s;
-                reached.push(v);
-                overflow |= s > PATH_COUNT_LIMIT;
+        for &v in &reached {
+            let pv = pi[v];
+            overflow |= pv > PATH_COUNT_LIMIT;
+            for &w in g.succ(v) {
+                pi[w] += pv;
             }
         }
         if overflow {
@@ -189,9 +197,10 @@ pub fn simple_path_betweenness_dag(
                 gsum[j] = 1.0 / pi[j] + t;
             }
             for &i in &reached {
+                let pi_i = pi[i];
                 for ed in g.out_edges(i) {
                     let j = g.head(ed);
-                    b[ed] += if i == e { tail_sum[j] } else { pi[i] * gsum[j] };
+                    b[ed] += if i == e { tail_sum[j] } else { pi_i * gsum[j] };
                 }
             }
         }
@@ -340,18 +349,23 @@ pub fn simple_path_betweenness_enumerated(
     Ok(b)
 }
 
-/// Shortest-path betweenness (Brandes 2001/2008), directed, unnormalized.
+/// Shortest-path betweenness (Brandes 2001/2008), directed, unnormalized, with the hop-distance
+/// summaries of the same BFS runs.
 #[derive(Debug, Clone)]
 pub struct ShortestPathBetweenness {
     /// Edge betweenness per CSR edge (no own-pair exclusion).
     pub edge: Vec<f64>,
     /// Node betweenness per node (unnormalized).
     pub node: Vec<f64>,
+    /// Efficiency, reach and distance sums from the same breadth-first searches.
+    pub reach: Reach,
 }
 
-/// Brandes' algorithm with level-synchronous BFS; path counts σ are rescaled per BFS level by
-/// exact powers of two, so they never overflow (a layered graph of width 3 and 650 levels has
-/// 3^650 shortest paths).
+/// Brandes' algorithm with level-synchronous BFS. The forward pass records the edges of the
+/// shortest-path DAG, so the dependency accumulation visits only those (in reverse discovery
+/// order, deepest level first). Path counts σ are rescaled per BFS level by exact powers of two,
+/// so they never overflow (a layered graph of width 3 and 650 levels has 3^650 shortest paths).
+/// Also returns the distance summaries of [`distances`] (one BFS per source serves both).
 ///
 /// # Errors
 /// [`ComponentImportanceError::Stopped`] when the budget runs out.
@@ -361,12 +375,17 @@ pub fn shortest_path_betweenness(
     work: &mut Work,
 ) -> Result<ShortestPathBetweenness, ComponentImportanceError> {
     let n = g.n();
+    let n_f = to_f64(n);
     let mut edge = vec![0.0; g.m()];
     let mut node = vec![0.0; n];
+    let mut efficiency = vec![0.0; n];
+    let mut reach = vec![1usize; n];
+    let mut dist_sum = vec![0.0; n];
     let mut dist = vec![usize::MAX; n];
     let mut sigma = vec![0.0f64; n];
     let mut delta = vec![0.0f64; n];
     let mut order: Vec<usize> = Vec::with_capacity(n);
+    let mut dag: Vec<usize> = Vec::new();
     let mut level_start: Vec<usize> = Vec::new();
     let mut level_exp: Vec<i32> = Vec::new();
     let threshold = 2f64.powi(SIGMA_RESCALE_EXP);
@@ -374,6 +393,7 @@ pub fn shortest_path_betweenness(
         work.passes += 1;
         work.check(budget, "shortest-path betweenness (Brandes)")?;
         order.clear();
+        dag.clear();
         level_start.clear();
         level_exp.clear();
         order.push(s);
@@ -381,6 +401,7 @@ pub fn shortest_path_betweenness(
         sigma[s] = 1.0;
         level_start.push(0);
         level_exp.push(0);
+        let mut rescaled = false;
         let mut d = 0usize;
         loop {
             let (lo, hi) = (level_start[d], order.len());
@@ -390,14 +411,17 @@ pub fn shortest_path_betweenness(
             level_start.push(hi);
             for k in lo..hi {
                 let v = order[k];
-                for &w in g.succ(v) {
+                let sv = sigma[v];
+                for ed in g.out_edges(v) {
+                    let w = g.head(ed);
                     if dist[w] == usize::MAX {
                         dist[w] = d + 1;
                         sigma[w] = 0.0;
                         order.push(w);
                     }
                     if dist[w] == d + 1 {
-                        sigma[w] += sigma[v];
+                        sigma[w] += sv;
+                        dag.push(ed);
                     }
                 }
             }
@@ -409,37 +433,51 @@ pub fn shortest_path_betweenness(
                     sigma[w] *= f;
                 }
                 exp += SIGMA_RESCALE_EXP;
+                rescaled = true;
             }
             level_exp.push(exp);
             d += 1;
         }
-        // level_start[d] == order.len() marks the (empty) last level.
+        // Distance summaries: level l (≥ 1) holds level_start[l+1] − level_start[l] nodes.
+        let (mut eff, mut dsum) = (0.0, 0.0);
+        for l in 1..d {
+            let c = to_f64(level_start[l + 1] - level_start[l]);
+            let lf = to_f64(l);
+            eff += c / lf;
+            dsum += c * lf;
+        }
+        efficiency[s] = eff / n_f;
+        reach[s] = order.len();
+        dist_sum[s] = dsum;
+        // Dependency accumulation over the shortest-path DAG, deepest edges first.
         for &v in &order {
             delta[v] = 0.0;
         }
-        for lvl in (0..d).rev() {
-            let scale = 2f64.powi(level_exp[lvl] - level_exp[lvl + 1]);
-            for &v in &order[level_start[lvl]..level_start[lvl + 1]] {
-                let mut dv = 0.0;
-                for ed in g.out_edges(v) {
-                    let w = g.head(ed);
-                    if dist[w] == lvl + 1 {
-                        let c = sigma[v] / sigma[w] * scale * (1.0 + delta[w]);
-                        edge[ed] += c;
-                        dv += c;
-                    }
-                }
-                delta[v] = dv;
-                if v != s {
-                    node[v] += dv;
-                }
+        for &ed in dag.iter().rev() {
+            let (v, w) = (g.tail(ed), g.head(ed));
+            let mut c = sigma[v] / sigma[w] * (1.0 + delta[w]);
+            if rescaled {
+                c *= 2f64.powi(level_exp[dist[v]] - level_exp[dist[w]]);
             }
+            edge[ed] += c;
+            delta[v] += c;
+        }
+        for &v in &order[1..] {
+            node[v] += delta[v];
         }
         for &v in &order {
             dist[v] = usize::MAX;
         }
     }
-    Ok(ShortestPathBetweenness { edge, node })
+    Ok(ShortestPathBetweenness {
+        edge,
+        node,
+        reach: Reach {
+            efficiency,
+            reach,
+            dist_sum,
+        },
+    })
 }
 
 /// How hierarchy numbers are derived from the ISM partition (spec §3.4).
@@ -637,7 +675,7 @@ mod tests {
         let (g, _) = Digraph::from_edges(5, &edges).unwrap();
         let topo = g.topological_order().unwrap();
         let mut w = Work::default();
-        let plain = simple_path_betweenness_dag(&g, &topo, &Budget::unlimited(), &mut w).unwrap();
+        let plain = simple_path_betweenness_dag(&g, &Budget::unlimited(), &mut w).unwrap();
         let mut logb = vec![0.0; g.m()];
         let mut pos = [0; 5];
         for (k, &v) in topo.iter().enumerate() {
