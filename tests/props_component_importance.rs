@@ -380,10 +380,10 @@ proptest! {
                 if s == t || dist[s][t] == usize::MAX {
                     continue;
                 }
-                for e in 0..g.m() {
+                for (e, be) in edge.iter_mut().enumerate() {
                     let (v, w) = (g.tail(e), g.head(e));
                     if dist[s][v] != usize::MAX && dist[w][t] != usize::MAX && dist[s][v] + 1 + dist[w][t] == dist[s][t] {
-                        edge[e] += sigma[s][v] * sigma[w][t] / sigma[s][t];
+                        *be += sigma[s][v] * sigma[w][t] / sigma[s][t];
                     }
                 }
                 for v in 0..n {
