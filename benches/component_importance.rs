@@ -232,8 +232,44 @@ fn compute(inp: &ComponentImportanceInput) -> ComponentImportanceOutput {
 // accuracy-vs-cost sweeps
 // ---------------------------------------------------------------------------------------------
 
-/// Median and worst wall time [ms] of `f` (at least 3 runs, more for fast functions).
-fn timed<T>(mut f: impl FnMut() -> T) -> (f64, f64, T) {
+/// Wall-clock median and worst of several runs, and the mean on-CPU time of this thread per run
+/// (from `/proc/thread-self/schedstat`; the shared 2-core machine is heavily loaded, so wall
+/// time includes waiting for a core while CPU time does not).
+#[derive(Clone, Copy)]
+struct Timing {
+    median_ms: f64,
+    worst_ms: f64,
+    cpu_ms: Option<f64>,
+}
+
+impl std::fmt::Display for Timing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let p = |x: f64| {
+            if x < 1.0 {
+                format!("{x:.4}")
+            } else {
+                format!("{x:.2}")
+            }
+        };
+        write!(
+            f,
+            "{} / {} / {}",
+            p(self.median_ms),
+            p(self.worst_ms),
+            self.cpu_ms.map_or("—".to_owned(), p)
+        )
+    }
+}
+
+/// On-CPU time of the calling thread [ns], if the kernel exposes it.
+fn thread_cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+/// Time `f`: at least 3 runs, more for fast functions (about 0.3 s in total, at most 31 runs).
+fn timed<T>(mut f: impl FnMut() -> T) -> (Timing, T) {
+    let cpu0 = thread_cpu_ns();
     let t0 = Instant::now();
     let mut last = f();
     let first = t0.elapsed();
@@ -245,8 +281,19 @@ fn timed<T>(mut f: impl FnMut() -> T) -> (f64, f64, T) {
         last = f();
         v.push(t.elapsed().as_secs_f64() * 1e3);
     }
+    let cpu1 = thread_cpu_ns();
     v.sort_by(f64::total_cmp);
-    (v[v.len() / 2], v[v.len() - 1], last)
+    let cpu_ms = cpu0
+        .zip(cpu1)
+        .map(|(a, b)| (b - a) as f64 / 1e6 / reps as f64);
+    (
+        Timing {
+            median_ms: v[v.len() / 2],
+            worst_ms: v[v.len() - 1],
+            cpu_ms,
+        },
+        last,
+    )
 }
 
 fn normalize(raw: &[f64]) -> Vec<f64> {
@@ -284,19 +331,18 @@ fn fmt_e(x: f64) -> String {
 /// K = 3, Kendall τ_b of CI vs the K = ∞ ranking, the reported bound.
 fn sweep_k_dag() {
     println!(
-        "\n### K (path_cap) on random DAGs — full request, 1 time, all-simple-path betweenness\n"
+        "\n### K (path_cap) on random DAGs — full request (`compute`), 1 time, all-simple-path betweenness\n"
     );
     println!(
-        "| n | d | m | longest path | K | median ms | worst ms | max abs Δfp vs K=∞ | max abs ΔCI vs K=∞ | τ_b vs K=∞ | max abs ΔCI vs K=3 | bound ρ^K/(1−ρ) |"
+        "| n | d | m | longest path | K | median / worst / CPU ms | max abs Δfp vs K=∞ | max abs ΔCI vs K=∞ | τ_b vs K=∞ | max abs ΔCI vs K=3 | bound ρ^K/(1−ρ) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for &n in &SIZES {
         for &d in &DEGREES {
-            let mut ci_k3 = Vec::new();
             let mut rows = Vec::new();
             for k in 1..=6 {
                 let inp = input(&Case::dag(n, d, k));
-                let (med, worst, out) = timed(|| compute(&inp));
+                let (tm, out) = timed(|| compute(&inp));
                 let g = &inp.graph;
                 let topo = g.topological_order().unwrap();
                 let t = &out.times[0];
@@ -316,13 +362,9 @@ fn sweep_k_dag() {
                     .tail_bound
                     .unwrap_or(f64::INFINITY)
                     .max(t.risk.tail_bound.unwrap_or(f64::INFINITY));
-                if k == 3 {
-                    ci_k3 = t.ci.clone();
-                }
                 rows.push((
                     k,
-                    med,
-                    worst,
+                    tm,
                     dfp,
                     dci,
                     tau,
@@ -332,10 +374,11 @@ fn sweep_k_dag() {
                     out.longest_path_edges.unwrap_or(0),
                 ));
             }
-            for (k, med, worst, dfp, dci, tau, ci, bound, m, lp) in rows {
+            let ci_k3 = rows[2].5.clone();
+            for (k, tm, dfp, dci, tau, ci, bound, m, lp) in rows {
                 let mark = if k == 3 { " (default)" } else { "" };
                 println!(
-                    "| {n} | {d} | {m} | {lp} | {k}{mark} | {med:.3} | {worst:.3} | {} | {} | {tau:.6} | {} | {} |",
+                    "| {n} | {d} | {m} | {lp} | {k}{mark} | {tm} | {} | {} | {tau:.6} | {} | {} |",
                     fmt_e(dfp),
                     fmt_e(dci),
                     fmt_e(max_abs(&ci, &ci_k3)),
@@ -346,15 +389,15 @@ fn sweep_k_dag() {
     }
 }
 
-/// Propagation methods on cyclic digraphs (probability index at 2000 h, structure from
-/// shortest-path betweenness): time of one index evaluation and error of the normalized index
-/// against the exact DFS value at the same K.
+/// Propagation methods on cyclic digraphs (probability index, structure from shortest-path
+/// betweenness): time of one index evaluation and error of the normalized index against the
+/// exact DFS value at the same K.
 fn sweep_methods_cyclic() {
     println!(
         "\n### Propagation method on random cyclic digraphs — one index (F at 500 h), stage time only\n"
     );
     println!(
-        "| n | d | K | DFS exact median / worst ms | closed form (K≤3) median / worst ms | walks median / worst ms | max abs Δfp closed form vs DFS | max abs Δfp walks vs exact | τ_b walks vs exact | bound |"
+        "| n | d | K | DFS exact ms | closed form (K≤3) ms | walks ms | max abs Δfp closed form vs DFS | max abs Δfp walks vs exact | τ_b walks vs exact | bound |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for &n in &SIZES {
@@ -384,17 +427,16 @@ fn sweep_methods_cyclic() {
                     .then(|| timed(|| run_algo(PropagationAlgorithm::SimplePathDfs, k)));
                 let cf =
                     (k <= 3).then(|| timed(|| run_algo(PropagationAlgorithm::ClosedFormK3, k)));
-                let (wm, ww, walks) = timed(|| run_algo(PropagationAlgorithm::Walks, k));
+                let (wt, walks) = timed(|| run_algo(PropagationAlgorithm::Walks, k));
                 let exact = dfs
                     .as_ref()
-                    .map(|t| t.2.fp.clone())
-                    .or_else(|| cf.as_ref().map(|t| t.2.fp.clone()));
-                let t = |o: &Option<(f64, f64, _)>| {
-                    o.as_ref()
-                        .map_or("—".to_owned(), |(m, w, _)| format!("{m:.3} / {w:.3}"))
+                    .map(|t| t.1.fp.clone())
+                    .or_else(|| cf.as_ref().map(|t| t.1.fp.clone()));
+                let show = |o: &Option<(Timing, _)>| {
+                    o.as_ref().map_or("—".to_owned(), |(t, _)| t.to_string())
                 };
                 let cf_err = match (&dfs, &cf) {
-                    (Some(a), Some(b)) => fmt_e(max_abs(&a.2.fp, &b.2.fp)),
+                    (Some(a), Some(b)) => fmt_e(max_abs(&a.1.fp, &b.1.fp)),
                     _ => "—".to_owned(),
                 };
                 let (werr, wtau) =
@@ -408,9 +450,9 @@ fn sweep_methods_cyclic() {
                         });
                 let mark = if k == 3 { " (default)" } else { "" };
                 println!(
-                    "| {n} | {d} | {k}{mark} | {} | {} | {wm:.3} / {ww:.3} | {cf_err} | {werr} | {wtau} | {} |",
-                    t(&dfs),
-                    t(&cf),
+                    "| {n} | {d} | {k}{mark} | {} | {} | {wt} | {cf_err} | {werr} | {wtau} | {} |",
+                    show(&dfs),
+                    show(&cf),
                     walks.tail_bound.map_or("void".to_owned(), fmt_e)
                 );
             }
@@ -425,7 +467,7 @@ fn sweep_betweenness() {
         "\n### Betweenness on random DAGs — stage time; CI effect of the shortest-path definition (K = 3, 1 time)\n"
     );
     println!(
-        "| n | d | simple paths | DAG counting median / worst ms | DFS enumeration median / worst ms | max rel Δ counting vs DFS | Brandes median / worst ms | max abs ΔCI shortest vs all-simple | τ_b |"
+        "| n | d | simple paths | DAG counting ms | DFS enumeration ms | max rel Δ counting vs DFS | Brandes ms | max abs ΔCI shortest vs all-simple | τ_b |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     for &n in &SIZES {
@@ -434,7 +476,7 @@ fn sweep_betweenness() {
             let inp = input(&case);
             let g = &inp.graph;
             let topo = g.topological_order().unwrap();
-            let (dm, dw, bdag) = timed(|| {
+            let (dt, bdag) = timed(|| {
                 structure::simple_path_betweenness_dag(
                     g,
                     &Budget::unlimited(),
@@ -442,7 +484,6 @@ fn sweep_betweenness() {
                 )
                 .unwrap()
             });
-            // Number of simple paths (pairs weighted by counts) from the DP: Σ_e Σ_f π(e,f).
             let paths = count_paths(g, &topo);
             let dfs = (paths <= 2e7).then(|| {
                 timed(|| {
@@ -455,7 +496,7 @@ fn sweep_betweenness() {
                     .unwrap()
                 })
             });
-            let (bm, bw, _) = timed(|| {
+            let (bt, _) = timed(|| {
                 structure::shortest_path_betweenness(g, &Budget::unlimited(), &mut Work::default())
                     .unwrap()
             });
@@ -466,20 +507,18 @@ fn sweep_betweenness() {
             }));
             let dci = max_abs(&exact.times[0].ci, &sp.times[0].ci);
             let tau = kendall_tau_b(&exact.times[0].ci, &sp.times[0].ci).unwrap_or(f64::NAN);
-            let dfs_cols =
+            let (dfs_t, dfs_err) =
                 dfs.as_ref()
-                    .map_or(("—".to_owned(), "—".to_owned()), |(m, w, b)| {
+                    .map_or(("—".to_owned(), "—".to_owned()), |(t, b)| {
                         let rel = b
                             .iter()
                             .zip(&bdag)
                             .map(|(x, y)| (x - y).abs() / y.abs().max(1e-300))
                             .fold(0.0, f64::max);
-                        (format!("{m:.3} / {w:.3}"), fmt_e(rel))
+                        (t.to_string(), fmt_e(rel))
                     });
             println!(
-                "| {n} | {d} | {paths:.3e} | {dm:.3} / {dw:.3} | {} | {} | {bm:.3} / {bw:.3} | {} | {tau:.6} |",
-                dfs_cols.0,
-                dfs_cols.1,
+                "| {n} | {d} | {paths:.3e} | {dt} | {dfs_t} | {dfs_err} | {bt} | {} | {tau:.6} |",
                 fmt_e(dci)
             );
         }
@@ -487,7 +526,7 @@ fn sweep_betweenness() {
 }
 
 fn count_paths(g: &Digraph, topo: &[usize]) -> f64 {
-    // Σ_e (paths from e) = Σ_v (paths ending at v, any start) by one DP: q(v) = Σ_{u∈pred(v)} (1 + q(u)).
+    // Σ_v (simple paths ending at v): q(v) = Σ_{u∈pred(v)} (1 + q(u)).
     let mut q = vec![0.0f64; g.n()];
     for &v in topo {
         q[v] = g.pred(v).iter().map(|&u| 1.0 + q[u]).sum();
@@ -502,7 +541,7 @@ type LabelledGraph = (String, Vec<(usize, usize)>, usize);
 fn sweep_enumeration_budget() {
     println!("\n### max_simple_paths — all-simple-path enumeration on cyclic digraphs\n");
     println!(
-        "| graph | n | m | simple paths | enumeration median / worst ms | ns per path (2 passes) | Brandes median ms | max abs ΔCI shortest vs all-simple | τ_b |"
+        "| graph | n | m | simple paths | enumeration ms | CPU ns per path (2 passes) | Brandes ms | max abs ΔCI shortest vs all-simple | τ_b |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut cases: Vec<LabelledGraph> = Vec::new();
@@ -519,7 +558,7 @@ fn sweep_enumeration_budget() {
     }
     for n in [10usize, 14, 18, 22, 26] {
         cases.push((
-            format!("random d=3 seed {n}"),
+            format!("random d=3 seed {}", 77 + n),
             random_edges(n, 3.0, false, 77 + n as u64),
             n,
         ));
@@ -527,18 +566,19 @@ fn sweep_enumeration_budget() {
     for (label, edges, n) in cases {
         let (g, _) = Digraph::from_edges(n, &edges).unwrap();
         let mut w = Work::default();
-        let res = structure::simple_path_betweenness_enumerated(
+        if structure::simple_path_betweenness_enumerated(
             &g,
             100_000_000,
             &Budget::unlimited(),
             &mut w,
-        );
-        if res.is_err() {
+        )
+        .is_err()
+        {
             println!("| {label} | {n} | {} | > 1e8 | — | — | — | — | — |", g.m());
             continue;
         }
         let paths = w.paths / 2;
-        let (em, ew, _) = timed(|| {
+        let (et, _) = timed(|| {
             structure::simple_path_betweenness_enumerated(
                 &g,
                 u64::MAX,
@@ -547,7 +587,7 @@ fn sweep_enumeration_budget() {
             )
             .unwrap()
         });
-        let (bm, _, _) = timed(|| {
+        let (bt, _) = timed(|| {
             structure::shortest_path_betweenness(&g, &Budget::unlimited(), &mut Work::default())
                 .unwrap()
         });
@@ -561,10 +601,10 @@ fn sweep_enumeration_budget() {
         let exact = compute(&a);
         a.betweenness = BetweennessMode::ShortestPaths;
         let sp = compute(&a);
+        let per_path = et.cpu_ms.unwrap_or(et.median_ms) * 1e6 / (2.0 * paths as f64);
         println!(
-            "| {label} | {n} | {} | {paths} | {em:.3} / {ew:.3} | {:.1} | {bm:.3} | {} | {:.6} |",
+            "| {label} | {n} | {} | {paths} | {et} | {per_path:.1} | {bt} | {} | {:.6} |",
             g.m(),
-            em * 1e6 / (2.0 * paths as f64),
             fmt_e(max_abs(&exact.times[0].ci, &sp.times[0].ci)),
             kendall_tau_b(&exact.times[0].ci, &sp.times[0].ci).unwrap_or(f64::NAN)
         );
@@ -573,20 +613,27 @@ fn sweep_enumeration_budget() {
 
 /// Number of times per request and the acceptance targets.
 fn sweep_times_and_acceptance() {
-    println!("\n### Times per request and acceptance targets (full request, K = 3)\n");
-    println!("| request | median ms | worst ms | target |");
-    println!("|---|---|---|---|");
+    println!("\n### Times per request and acceptance targets (K = 3)\n");
+    println!("| request | median / worst / CPU ms | target |");
+    println!("|---|---|---|");
     let paper = paper_request();
-    let (m, w, _) = timed(|| run(paper.clone(), &Budget::unlimited()).unwrap());
-    println!("| paper machining center (n = 10, 2 times, via `run`) | {m:.4} | {w:.4} | < 1 ms |");
+    let (t, _) = timed(|| run(paper.clone(), &Budget::unlimited()).unwrap());
+    println!(
+        "| paper machining center (n = 10, 2 times, `run`: validation + compute + response) | {t} | < 1 ms |"
+    );
     let mut ten = paper_request();
     ten.overrides.clear();
     ten.times_h = (1..=10).map(|i| 400.0 * f64::from(i)).collect();
-    let (m, w, _) = timed(|| run(ten.clone(), &Budget::unlimited()).unwrap());
-    println!("| paper machining center, 10 times | {m:.4} | {w:.4} | < 1 ms |");
+    let (t, _) = timed(|| run(ten.clone(), &Budget::unlimited()).unwrap());
+    println!("| paper machining center, 10 times (`run`) | {t} | < 1 ms |");
     let r50 = mechcalc::calc::component_importance::synthetic::random_request(50, 3.0, true, 5);
-    let (m, w, _) = timed(|| run(r50.clone(), &Budget::unlimited()).unwrap());
-    println!("| random DAG n = 50, d = 3, 2 times (via `run`) | {m:.4} | {w:.4} | < 1 ms |");
+    let (t, _) = timed(|| run(r50.clone(), &Budget::unlimited()).unwrap());
+    println!("| random DAG n = 50, d = 3, 2 times (`run`) | {t} | < 1 ms |");
+    let mut r50c =
+        mechcalc::calc::component_importance::synthetic::random_request(50, 3.0, false, 5);
+    r50c.options.betweenness = BetweennessMode::ShortestPaths;
+    let (t, _) = timed(|| run(r50c.clone(), &Budget::unlimited()).unwrap());
+    println!("| random cyclic n = 50, d = 3, shortest paths, 2 times (`run`) | {t} | < 1 ms |");
     for (label, acyclic) in [
         ("DAG, all-simple-path betweenness", true),
         ("cyclic, shortest-path betweenness", false),
@@ -600,9 +647,9 @@ fn sweep_times_and_acceptance() {
                 };
                 c.n_times = nt;
                 let inp = input(&c);
-                let (m, w, _) = timed(|| compute(&inp));
+                let (t, _) = timed(|| compute(&inp));
                 let target = if n == 1000 { "< 100 ms" } else { "" };
-                println!("| {label}, n = {n}, d = 4, {nt} time(s) | {m:.2} | {w:.2} | {target} |");
+                println!("| {label}, n = {n}, d = 4, {nt} time(s) (`compute`) | {t} | {target} |");
             }
         }
     }
