@@ -267,9 +267,10 @@ fn thread_cpu_ns() -> Option<u64> {
     s.split_whitespace().next()?.parse().ok()
 }
 
-/// Time `f`: at least 3 runs, more for fast functions (about 0.3 s in total, at most 31 runs).
+/// Time `f`: at least 3 runs, more for fast functions (about 0.3 s in total, at most 31 runs),
+/// then the mean CPU time per run over a separate loop of at least 0.25 s (the kernel's CPU
+/// accounting advances in scheduler ticks, so short totals would read as 0).
 fn timed<T>(mut f: impl FnMut() -> T) -> (Timing, T) {
-    let cpu0 = thread_cpu_ns();
     let t0 = Instant::now();
     let mut last = f();
     let first = t0.elapsed();
@@ -281,11 +282,17 @@ fn timed<T>(mut f: impl FnMut() -> T) -> (Timing, T) {
         last = f();
         v.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    let cpu1 = thread_cpu_ns();
     v.sort_by(f64::total_cmp);
+    let cpu0 = thread_cpu_ns();
+    let t1 = Instant::now();
+    let mut runs = 0u32;
+    while runs < 3 || t1.elapsed() < Duration::from_millis(250) {
+        black_box(f());
+        runs += 1;
+    }
     let cpu_ms = cpu0
-        .zip(cpu1)
-        .map(|(a, b)| (b - a) as f64 / 1e6 / reps as f64);
+        .zip(thread_cpu_ns())
+        .map(|(a, b)| (b - a) as f64 / 1e6 / f64::from(runs));
     (
         Timing {
             median_ms: v[v.len() / 2],
