@@ -12,6 +12,23 @@ use crate::numerics::SolverReport;
 /// Request: one fault graph, one or more operating ages.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "components": [
+        {"id": "S", "weibull": {"eta_h": 7832.7, "beta": 0.6414}, "mode_sum": 0.1450546},
+        {"id": "M", "weibull": {"eta_h": 2458.1, "beta": 1.3117}, "mode_sum": 0.1415337},
+        {"id": "J", "weibull": {"eta_h": 2606.4, "beta": 1.2949}, "mode_sum": 0.1721013},
+        {"id": "NC", "weibull": {"eta_h": 7912.4, "beta": 0.5422}, "mode_sum": 0.5},
+        {"id": "D", "weibull": {"eta_h": 8905.1, "beta": 0.6556}, "mode_sum": 0.1249006},
+        {"id": "V", "weibull": {"eta_h": 7935.7, "beta": 0.7712}, "mode_sum": 0.2998578},
+        {"id": "G", "weibull": {"eta_h": 27503.4, "beta": 0.5243}, "mode_sum": 0.2617428},
+        {"id": "L", "weibull": {"eta_h": 8161.5, "beta": 0.7910}, "mode_sum": 0.3283729},
+        {"id": "W", "weibull": {"eta_h": 4145.7, "beta": 0.9101}, "mode_sum": 0.1369623},
+        {"id": "K", "weibull": {"eta_h": 5960.8, "beta": 0.9314}, "mode_sum": 0.5}
+    ],
+    "edges": [["S","M"],["S","J"],["NC","S"],["NC","J"],["D","S"],["D","M"],["V","S"],["V","NC"],
+              ["V","W"],["G","S"],["G","M"],["L","S"],["L","M"],["L","J"],["W","J"],["K","J"]],
+    "times_h": [500, 2000]
+}))]
 pub struct ComponentImportanceRequest {
     /// Components in output order (also the tie-break order of the ranking); 2–2000 entries.
     pub components: Vec<ComponentSpec>,
@@ -41,6 +58,7 @@ pub struct ComponentSpec {
     /// Two-parameter Weibull life distribution (paper Table 4). Required unless `overrides`
     /// give both F and RI of this component at every time.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub weibull: Option<Weibull>,
     /// Failure modes {α, impact} (paper Table 5). Required unless `mode_sum` is given (or RI is
     /// overridden at every time).
@@ -159,43 +177,69 @@ pub enum BetweennessMode {
     ShortestPaths,
 }
 
-/// Method options.
+/// Method options. Every field is optional; the defaults reproduce the paper.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields, default)]
+#[serde(deny_unknown_fields)]
 pub struct Options {
-    /// In-degree coefficient Q [–] (Eq. 4), in [0, 1]; Q + O = 1.
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.25)]
+    /// In-degree coefficient Q [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.25.
+    #[serde(default = "default_q_in")]
+    #[schema(minimum = 0.0, maximum = 1.0, example = 0.25, default = 0.25)]
     pub q_in: f64,
-    /// Out-degree coefficient O [–] (Eq. 4), in [0, 1]; Q + O = 1.
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.75)]
+    /// Out-degree coefficient O [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.75.
+    #[serde(default = "default_o_out")]
+    #[schema(minimum = 0.0, maximum = 1.0, example = 0.75, default = 0.75)]
     pub o_out: f64,
-    /// Constant weights ω_c (probability, risk); default = the paper's (0.520614, 0.479386).
+    /// Constant weights ω_c (probability, risk); default the paper's [0.520614, 0.479386].
+    #[serde(default)]
     pub constant_weights: ConstantWeights,
-    /// K: maximal path length (edges) in the propagation sum, 1–8.
-    #[schema(minimum = 1, maximum = 8, example = 3)]
+    /// K: maximal path length (edges) in the propagation sum, 1–8. Default 3.
+    #[serde(default = "default_path_cap")]
+    #[schema(minimum = 1, maximum = 8, example = 3, default = 3)]
     pub path_cap: u32,
-    /// Simple paths (`exact`) or walks.
+    /// Simple paths (`exact`, default) or walks.
+    #[serde(default)]
     pub path_method: PathMethod,
-    /// Hierarchy level mode.
+    /// Hierarchy level mode (default `paper`).
+    #[serde(default)]
     pub levels: LevelsMode,
-    /// Edge betweenness definition.
+    /// Edge betweenness definition (default `all_simple_paths`).
+    #[serde(default)]
     pub betweenness: BetweennessMode,
-    /// Enumeration budget (number of simple paths) on graphs with cycles, 1e3–1e8.
-    #[schema(minimum = 1000.0, maximum = 100_000_000.0, example = 2_000_000.0)]
+    /// Enumeration budget (number of simple paths) on graphs with cycles, 1e3–1e8. Default 2e6.
+    #[serde(default = "default_max_simple_paths")]
+    #[schema(
+        minimum = 1000.0,
+        maximum = 100_000_000.0,
+        example = 2_000_000.0,
+        default = 2_000_000.0
+    )]
     pub max_simple_paths: f64,
+}
+
+fn default_q_in() -> f64 {
+    0.25
+}
+fn default_o_out() -> f64 {
+    0.75
+}
+fn default_path_cap() -> u32 {
+    3
+}
+fn default_max_simple_paths() -> f64 {
+    2e6
 }
 
 impl Default for Options {
     fn default() -> Self {
         Self {
-            q_in: 0.25,
-            o_out: 0.75,
+            q_in: default_q_in(),
+            o_out: default_o_out(),
             constant_weights: ConstantWeights::default(),
-            path_cap: 3,
+            path_cap: default_path_cap(),
             path_method: PathMethod::Exact,
             levels: LevelsMode::Paper,
             betweenness: BetweennessMode::AllSimplePaths,
-            max_simple_paths: 2e6,
+            max_simple_paths: default_max_simple_paths(),
         }
     }
 }
@@ -238,9 +282,11 @@ pub struct ComponentImportanceResponse {
     pub meta: Meta,
     /// Time-independent structure (`outputs.matrices`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub matrices: Option<Matrices>,
     /// Standard centralities (`outputs.centralities`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub centralities: Option<Centralities>,
 }
 
@@ -274,6 +320,7 @@ pub struct TimeResult {
     pub weights_risk: Option<Vec<f64>>,
     /// Relative truncation bound of the K-capped sums (`outputs.indices`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub tail_bound: Option<TailBound>,
     /// F_i(t) used [–] (`outputs.reliability`).
     #[serde(rename = "F", default, skip_serializing_if = "Option::is_none")]
@@ -286,6 +333,7 @@ pub struct TimeResult {
     pub ri_per_h: Option<Vec<f64>>,
     /// Kendall τ_b of each centrality against CI at this time (`outputs.centralities`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub kendall_tau_b: Option<KendallTau>,
 }
 
