@@ -36,17 +36,30 @@
 //! # Validity and accuracy
 //! * Input range: 2–2000 components, ≥ 1 edge, 1–1000 times > 0 h, β ∈ [0.05, 20], K ∈ 1..8.
 //!   Hours and 1/h are kept inside: fp² is not invariant to the unit of RI (spec §6 H4).
-//! * Reproduces the spec's reference implementation to ≤ 1e-12 relative on the paper graph
-//!   (VC1–VC6), paper Tables 1 and 2 exactly / to their printed digits, and Tables 7–9 within the
-//!   documented deviations of the paper (fp² 5.5e-7, fp¹ 1.7e-3, CI 8.2e-4, identical ranks; see
-//!   `tests/paper_component_importance.rs`).
+//! * Paper graph (`tests/paper_component_importance.rs`): Table 1 betweenness exact, Table 2 T
+//!   and Eqs. 21–22 to their 6 printed decimals, RI of Table 6 to its printed digits (M aside,
+//!   §3.11-5); the spec's reference values (VC1–VC6, 9 printed decimals) to 1e-9 relative or
+//!   5e-10 absolute; paper Tables 7–9 within the documented deviations of the paper (fp² 5.5e-7,
+//!   fp¹ 9.3e-4 / 1.7e-3, CI 4.4e-4 / 8.2e-4 at 500 / 2000 h, identical ranks).
+//! * Exact algorithms agree with each other to rounding (closed form vs DFS, DAG counting vs
+//!   enumeration, Brandes vs the pair-by-pair definition: ≤ 1e-12 relative in the property
+//!   tests, 1e-15 typical).
 //! * The K cap is exact when K ≥ the longest path of a DAG (`meta.longest_path_edges`);
 //!   otherwise the relative truncation against the K = ∞ walk sum is bounded by ρ^K/(1−ρ)
-//!   (`tail_bound`), null with a `TRUNCATION_BOUND_VOID` warning when ρ ≥ 1.
+//!   (`tail_bound`), null with a `TRUNCATION_BOUND_VOID` warning when ρ ≥ 1. Measured on random
+//!   DAGs at the default K = 3: normalized indices within 3.6e-9 of K = ∞ (n = 10), 2e-11
+//!   (n ≥ 30), identical rankings (`benches/RESULTS.md`).
+//! * Cost (2-core machine, CPU time): paper request 0.035 ms; n = 1000, out-degree 4, K = 3:
+//!   8.5 ms on a DAG, 45 ms on a cyclic graph with shortest-path betweenness.
 //! * Outside the range: invalid input is rejected with every offending field; cyclic graphs too
 //!   large to enumerate fail with a message naming the alternative; a hazard rate beyond f64
-//!   fails with `HAZARD_RATE_OVERFLOW`. A result is never NaN: a final check refuses to return
-//!   non-finite or inconsistent values (`NUMERICAL_FAILURE`).
+//!   fails with `HAZARD_RATE_OVERFLOW`; path counts beyond f64 on DAGs are recounted in log
+//!   space. A result is never NaN: a final check refuses to return non-finite or inconsistent
+//!   values (`NUMERICAL_FAILURE`).
+
+// Doc comments give units in brackets ([h], [1/h], [ms]) as the style guide asks; they are
+// units, not intra-doc links.
+#![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod centrality;
 pub mod compute;

@@ -2,7 +2,7 @@
 //!
 //! Given edge values p_e = P_ij = x_i·HE_ij (CSR edge order), every function returns per-length
 //! row sums `s[L−1][i]` = Σ over paths (or walks) of exactly L edges starting at i of Π p along
-//! the path, for L = 1..=K. The index is fp_raw_i = Σ_L s[L−1][i]. Keeping the lengths apart
+//! the path, for L = 1..=K. The index is `fp_raw_i = Σ_L s[L−1][i]`. Keeping the lengths apart
 //! lets [`log_index`] scale x by its maximum c (P = c·P̃, so a length-L term scales as c^L) and
 //! combine the lengths in log space: the result neither overflows (risk rates at t → 0 with
 //! β < 1, spec §6 H1) nor underflows (F ≈ 1e-300, H2).
