@@ -3,7 +3,7 @@
 //! decodes, runs the module's `run` on the compute pool, and responds.
 //!
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
-//! [`run_calc`], and register it in [`api_router`] with one `.routes(routes!(...))` line.
+//! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
 pub mod cam_law;
 pub mod json;
