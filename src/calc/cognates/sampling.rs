@@ -108,3 +108,39 @@ pub fn fixed_sweeps(mech: &FourBar, branch: Sign) -> Vec<Sweep> {
 pub fn circuit_sweeps(mech: &FourBar) -> Vec<Sweep> {
     mech.input_range().circuits().into_iter().map(Sweep::Circuit).collect()
 }
+
+/// Distance from `q` to the segment `a–b`.
+#[must_use]
+pub fn point_segment_distance(q: C64, a: C64, b: C64) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_sqr();
+    let t = if len2 > 0.0 { (((q - a).re * ab.re + (q - a).im * ab.im) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (q - (a + ab * t)).norm()
+}
+
+/// Chord error of `circuits`-mode sampling with `n` samples per circuit (spec §8): the largest
+/// distance between the true curve and the chord of two consecutive samples, the truth evaluated at
+/// `sub` sub-samples per chord in the natural parameter `u`. Samples where the mechanism is singular
+/// are skipped. Cost: `n·(sub + 1)` position solves per circuit.
+#[must_use]
+pub fn chord_error(mech: &FourBar, n: usize, spacing: Spacing, sub: usize) -> f64 {
+    let mut worst = 0.0_f64;
+    for circuit in mech.input_range().circuits() {
+        for j in 0..n {
+            let (u0, u1) = (sample_u(j, n), sample_u(j + 1, n));
+            let (Some(p0), Some(p1)) = (curve_point(mech, &circuit, u0, spacing), curve_point(mech, &circuit, u1, spacing))
+            else {
+                continue;
+            };
+            for s in 1..sub {
+                // s < sub ≤ a few hundred: exact in f64.
+                #[allow(clippy::cast_precision_loss, reason = "small integers")]
+                let u = u0 + (u1 - u0) * (s as f64 / sub as f64);
+                if let Some(q) = curve_point(mech, &circuit, u, spacing) {
+                    worst = worst.max(point_segment_distance(q, p0, p1));
+                }
+            }
+        }
+    }
+    worst
+}

@@ -145,10 +145,7 @@ pub fn segments<'a>(curves: impl Iterator<Item = (&'a [C64], bool)>) -> Vec<Segm
 }
 
 fn point_segment_distance(q: C64, (a, b): Segment) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_sqr();
-    let t = if len2 > 0.0 { (((q - a).re * ab.re + (q - a).im * ab.im) / len2).clamp(0.0, 1.0) } else { 0.0 };
-    (q - (a + ab * t)).norm()
+    super::sampling::point_segment_distance(q, a, b)
 }
 
 /// Uniform-grid index of segments for nearest-segment queries.
