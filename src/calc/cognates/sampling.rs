@@ -21,10 +21,21 @@ pub fn circuit_param(circuit: &Circuit, u: f64, spacing: Spacing) -> (f64, Sign)
         Circuit::Limited { lo, hi } => {
             let branch = if u <= PI { Sign::Plus } else { Sign::Minus };
             let phi = match spacing {
-                Spacing::Auto => 0.5 * (lo + hi) - 0.5 * (hi - lo) * u.cos(),
+                // (lo+hi)/2 − ((hi−lo)/2)·cos u, written from the nearer end so that u = 0 and u = π
+                // land exactly on the toggles lo and hi.
+                Spacing::Auto => {
+                    let c = u.cos();
+                    if c >= 0.0 { lo + (hi - lo) * (0.5 * (1.0 - c)) } else { hi - (hi - lo) * (0.5 * (1.0 + c)) }
+                }
                 Spacing::Uniform => {
                     let t = u / PI;
-                    if t <= 1.0 { lo + (hi - lo) * t } else { hi - (hi - lo) * (t - 1.0) }
+                    if t <= 0.5 {
+                        lo + (hi - lo) * t
+                    } else if t <= 1.5 {
+                        hi - (hi - lo) * (t - 1.0).abs()
+                    } else {
+                        lo + (hi - lo) * (2.0 - t)
+                    }
                 }
             };
             (phi.clamp(lo, hi), branch)
