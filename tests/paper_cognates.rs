@@ -5,6 +5,11 @@
 //! printed digit); the same quantities are also checked at 1e-12 against an independent closed-form
 //! computation in this file; paper (Table 1) values at the spec's 0.006 with its documented errata.
 
+#![allow(
+    clippy::suboptimal_flops,
+    reason = "test arithmetic follows the spec's formulas; mul_add gains nothing here"
+)]
+
 use approx::assert_abs_diff_eq;
 use mechcalc::calc::cognates::geometry::{C64, FourBar, Sign, Solve};
 use mechcalc::calc::cognates::input::CognatesInput;
@@ -50,7 +55,10 @@ fn pt(p: [f64; 2]) -> C64 {
 /// Per-coordinate comparison (printed values are rounded coordinate by coordinate).
 fn assert_pt(got: [f64; 2], want: [f64; 2], tol: f64, what: &str) {
     let d = (got[0] - want[0]).abs().max((got[1] - want[1]).abs());
-    assert!(d <= tol, "{what}: got {got:?}, want {want:?}, |Δ| = {d:e} > {tol:e}");
+    assert!(
+        d <= tol,
+        "{what}: got {got:?}, want {want:?}, |Δ| = {d:e} > {tol:e}"
+    );
 }
 
 /// The mechanism of a response entry as a public-API four-bar (for independent re-solves).
@@ -94,8 +102,16 @@ fn table1_third_pivot_and_similarity_spec_6_1() {
     // |AC|, |BC| = the cognates' ground lengths.
     assert_abs_diff_eq!(r.mechanisms[1].links.ground, 2.318699, epsilon = PRINTED_6);
     assert_abs_diff_eq!(r.mechanisms[2].links.ground, 3.931707, epsilon = PRINTED_6);
-    assert_abs_diff_eq!(pt(r.c).norm(), r.mechanisms[1].links.ground, epsilon = EXACT);
-    assert_abs_diff_eq!((pt(r.c) - C64::new(3.1, 0.0)).norm(), r.mechanisms[2].links.ground, epsilon = EXACT);
+    assert_abs_diff_eq!(
+        pt(r.c).norm(),
+        r.mechanisms[1].links.ground,
+        epsilon = EXACT
+    );
+    assert_abs_diff_eq!(
+        (pt(r.c) - C64::new(3.1, 0.0)).norm(),
+        r.mechanisms[2].links.ground,
+        epsilon = EXACT
+    );
 }
 
 #[test]
@@ -116,23 +132,74 @@ fn table1_cognate_links_physical_roles_spec_6_1() {
     // Spec §6.1 rows "cog1 crank / coupler / rocker", "crank-joint-to-P / rocker-joint-to-P".
     let cases = [
         ("cog1 crank", c1.links.crank, 0.920000, 0.92),
-        ("cog1 coupler", c1.links.coupler, 0.845203, 0.92 / 1.23 * 1.13),
+        (
+            "cog1 coupler",
+            c1.links.coupler,
+            0.845203,
+            0.92 / 1.23 * 1.13,
+        ),
         ("cog1 rocker", c1.links.rocker, 0.777886, 0.92 / 1.23 * 1.04),
-        ("cog1 crank_joint_to_P", c1.links.crank_joint_to_p, 1.130000, 1.13),
-        ("cog1 rocker_joint_to_P", c1.links.rocker_joint_to_p, 1.433171, 1.56 / 1.23 * 1.13),
+        (
+            "cog1 crank_joint_to_P",
+            c1.links.crank_joint_to_p,
+            1.130000,
+            1.13,
+        ),
+        (
+            "cog1 rocker_joint_to_P",
+            c1.links.rocker_joint_to_p,
+            1.433171,
+            1.56 / 1.23 * 1.13,
+        ),
         ("cog2 crank", c2.links.crank, 1.433171, 1.56 / 1.23 * 1.13),
-        ("cog2 coupler", c2.links.coupler, 1.319024, 1.56 / 1.23 * 1.04),
+        (
+            "cog2 coupler",
+            c2.links.coupler,
+            1.319024,
+            1.56 / 1.23 * 1.04,
+        ),
         ("cog2 rocker", c2.links.rocker, 1.560000, 1.56),
-        ("cog2 crank_joint_to_P", c2.links.crank_joint_to_p, 0.777886, 0.92 / 1.23 * 1.04),
-        ("cog2 rocker_joint_to_P", c2.links.rocker_joint_to_p, 1.040000, 1.04),
+        (
+            "cog2 crank_joint_to_P",
+            c2.links.crank_joint_to_p,
+            0.777886,
+            0.92 / 1.23 * 1.04,
+        ),
+        (
+            "cog2 rocker_joint_to_P",
+            c2.links.rocker_joint_to_p,
+            1.040000,
+            1.04,
+        ),
     ];
     for (what, got, printed, exact) in cases {
-        assert!((got - printed).abs() <= PRINTED_6, "{what}: {got} vs printed {printed}");
-        assert!((got - exact).abs() <= EXACT, "{what}: {got} vs closed form {exact}");
+        assert!(
+            (got - printed).abs() <= PRINTED_6,
+            "{what}: {got} vs printed {printed}"
+        );
+        assert!(
+            (got - exact).abs() <= EXACT,
+            "{what}: {got} vs closed form {exact}"
+        );
     }
-    assert_eq!((o.links.coupler_side, c1.links.coupler_side, c2.links.coupler_side), (1, -1, -1));
-    assert_abs_diff_eq!(c1.links.coupler_angle_at_crank_joint_deg, 91.881337, epsilon = PRINTED_6);
-    assert_abs_diff_eq!(c2.links.coupler_angle_at_crank_joint_deg, 52.002399, epsilon = PRINTED_6);
+    assert_eq!(
+        (
+            o.links.coupler_side,
+            c1.links.coupler_side,
+            c2.links.coupler_side
+        ),
+        (1, -1, -1)
+    );
+    assert_abs_diff_eq!(
+        c1.links.coupler_angle_at_crank_joint_deg,
+        91.881337,
+        epsilon = PRINTED_6
+    );
+    assert_abs_diff_eq!(
+        c2.links.coupler_angle_at_crank_joint_deg,
+        52.002399,
+        epsilon = PRINTED_6
+    );
 }
 
 /// Table 1 of the paper lists the cognates' b, d, e in similarity order (spec §4.12-1); its values are
@@ -154,12 +221,23 @@ fn table1_paper_values_similar_sides_spec_4_12() {
         ("cog2 e", c2.similar_sides.e, 1.32),
     ];
     for (what, got, printed) in paper {
-        assert!((got - printed).abs() <= 0.006, "{what}: {got} vs paper {printed}");
+        assert!(
+            (got - printed).abs() <= 0.006,
+            "{what}: {got} vs paper {printed}"
+        );
     }
     // Similarity order (Eq. 47): b_i : d_i : e_i = b : d : e.
     for m in [c1, c2] {
-        assert_abs_diff_eq!(m.similar_sides.d / m.similar_sides.b, 0.92 / 1.23, epsilon = EXACT);
-        assert_abs_diff_eq!(m.similar_sides.e / m.similar_sides.b, 1.56 / 1.23, epsilon = EXACT);
+        assert_abs_diff_eq!(
+            m.similar_sides.d / m.similar_sides.b,
+            0.92 / 1.23,
+            epsilon = EXACT
+        );
+        assert_abs_diff_eq!(
+            m.similar_sides.e / m.similar_sides.b,
+            1.56 / 1.23,
+            epsilon = EXACT
+        );
     }
 }
 
@@ -172,7 +250,12 @@ fn table1_unrounded_reading_reproduces_paper_spec_4_12_11() {
         "ground": {"B": [3.096, 0]}, "crank": 1.1305, "coupler": 1.2335, "rocker": 1.0435,
         "coupler_point": {"d": 0.9205, "e": 1.556, "side": 1}
     }));
-    assert_pt(r.c, [-0.053204, 2.309779], PRINTED_6, "C (unrounded reading)");
+    assert_pt(
+        r.c,
+        [-0.053204, 2.309779],
+        PRINTED_6,
+        "C (unrounded reading)",
+    );
     let (c1, c2) = (&r.mechanisms[1], &r.mechanisms[2]);
     assert_abs_diff_eq!(c1.links.crank, 0.9205, epsilon = EXACT);
     assert_abs_diff_eq!(c1.links.coupler, 0.843636, epsilon = PRINTED_6);
@@ -181,7 +264,11 @@ fn table1_unrounded_reading_reproduces_paper_spec_4_12_11() {
     assert_abs_diff_eq!(c2.links.coupler, 1.316324, epsilon = PRINTED_6);
     assert_abs_diff_eq!(c2.links.rocker, 1.556, epsilon = EXACT);
     let rounds_to = |x: f64, printed: f64| (x - printed).abs() <= 0.005;
-    assert!(rounds_to(r.c[0], -0.05) && rounds_to(r.c[1], 2.31), "C {:?}", r.c);
+    assert!(
+        rounds_to(r.c[0], -0.05) && rounds_to(r.c[1], 2.31),
+        "C {:?}",
+        r.c
+    );
     for (got, printed) in [
         (c1.links.crank, 0.92),
         (c1.similar_sides.b, 1.13),
@@ -205,8 +292,16 @@ fn table1_grashof_and_ranges_spec_6_1() {
     let half_ranges = [35.070931, 32.746715, 35.070931];
     let ground_angles = [0.0, 91.881337, -36.116264];
     for (i, m) in r.mechanisms.iter().enumerate() {
-        assert_eq!(m.grashof.class, GrashofClassOut::NonGrashof, "mechanism {i}");
-        assert_eq!(m.grashof.kind, LinkageTypeOut::TripleRocker, "mechanism {i}");
+        assert_eq!(
+            m.grashof.class,
+            GrashofClassOut::NonGrashof,
+            "mechanism {i}"
+        );
+        assert_eq!(
+            m.grashof.kind,
+            LinkageTypeOut::TripleRocker,
+            "mechanism {i}"
+        );
         assert_abs_diff_eq!(m.grashof.margin, margins[i], epsilon = PRINTED_6);
         assert!(!m.input_range.full_rotation);
         assert_eq!(m.input_range.n_circuits, 1);
@@ -218,8 +313,18 @@ fn table1_grashof_and_ranges_spec_6_1() {
     // Spec §9: absolute intervals of the cognates.
     let abs1 = r.mechanisms[1].input_range.intervals_abs_deg[0];
     let abs2 = r.mechanisms[2].input_range.intervals_abs_deg[0];
-    assert_pt(abs1, [59.134621, 124.628052], PRINTED_6 * 2.0, "cog1 abs interval");
-    assert_pt(abs2, [-71.187196, -1.045333], PRINTED_6 * 2.0, "cog2 abs interval");
+    assert_pt(
+        abs1,
+        [59.134621, 124.628052],
+        PRINTED_6 * 2.0,
+        "cog1 abs interval",
+    );
+    assert_pt(
+        abs2,
+        [-71.187196, -1.045333],
+        PRINTED_6 * 2.0,
+        "cog2 abs interval",
+    );
     // Toggles of the original at ±35.070931°.
     let t = &r.mechanisms[0].input_range.toggle_angles_abs_deg;
     assert_eq!(t.len(), 2);
@@ -236,12 +341,24 @@ fn table1_snapshot_branch_plus_spec_6_1() {
     assert_pt(j0.crank_joint, [0.978609, 0.565000], PRINTED_6, "D");
     assert_pt(j0.rocker_joint, [2.208246, 0.535140], PRINTED_6, "E");
     assert_pt(j0.p, [0.970736, 1.484966], PRINTED_6, "P");
-    assert_abs_diff_eq!(s0.transmission_angle_deg.unwrap_or(f64::NAN), 29.58, epsilon = 0.005);
+    assert_abs_diff_eq!(
+        s0.transmission_angle_deg.unwrap_or(f64::NAN),
+        29.58,
+        epsilon = 0.005
+    );
     let s1 = r.mechanisms[1].snapshot.as_ref().expect("snapshot");
     let s2 = r.mechanisms[2].snapshot.as_ref().expect("snapshot");
-    assert_abs_diff_eq!(s1.input_angle_deg.unwrap_or(f64::NAN), 90.490280, epsilon = PRINTED_6);
+    assert_abs_diff_eq!(
+        s1.input_angle_deg.unwrap_or(f64::NAN),
+        90.490280,
+        epsilon = PRINTED_6
+    );
     assert_eq!(s1.branch, Some(1));
-    assert_abs_diff_eq!(s2.input_angle_deg.unwrap_or(f64::NAN), -6.116264, epsilon = PRINTED_6);
+    assert_abs_diff_eq!(
+        s2.input_angle_deg.unwrap_or(f64::NAN),
+        -6.116264,
+        epsilon = PRINTED_6
+    );
     assert_eq!(s2.branch, Some(-1));
     // Spec §9 joints of the cognates.
     let j1 = s1.joints.as_ref().expect("joints");
@@ -254,7 +371,9 @@ fn table1_snapshot_branch_plus_spec_6_1() {
     for (m, s) in [(&r.mechanisms[1], s1), (&r.mechanisms[2], s2)] {
         let fb = fourbar(m);
         let theta = s.input_angle_deg.unwrap_or(f64::NAN).to_radians();
-        let Solve::Pose(q) = fb.solve(theta, sign(s.branch.unwrap_or(1)), false) else { panic!("re-solve assembles") };
+        let Solve::Pose(q) = fb.solve(theta, sign(s.branch.unwrap_or(1)), false) else {
+            panic!("re-solve assembles")
+        };
         assert_pt([q.p.re, q.p.im], j0.p, 1e-14, "re-solved P_i vs P");
     }
 }
@@ -275,7 +394,9 @@ fn table1_snapshot_branch_minus_spec_6_1() {
     for (m, s) in [(&r.mechanisms[1], s1), (&r.mechanisms[2], s2)] {
         let fb = fourbar(m);
         let theta = s.input_angle_deg.unwrap_or(f64::NAN).to_radians();
-        let Solve::Pose(q) = fb.solve(theta, sign(s.branch.unwrap_or(1)), false) else { panic!("re-solve assembles") };
+        let Solve::Pose(q) = fb.solve(theta, sign(s.branch.unwrap_or(1)), false) else {
+            panic!("re-solve assembles")
+        };
         assert_pt([q.p.re, q.p.im], j0.p, 1e-15 * 4.0, "re-solved P_i vs P");
     }
 }
@@ -289,7 +410,11 @@ fn table1_mirrored_side_spec_6_1() {
     assert_pt(r.c, [-0.076122, -2.317449], PRINTED_6, "C mirrored");
     assert_abs_diff_eq!(r.mechanisms[1].links.coupler, 0.845203, epsilon = PRINTED_6);
     assert_abs_diff_eq!(r.mechanisms[2].links.crank, 1.433171, epsilon = PRINTED_6);
-    let j0 = r.mechanisms[0].snapshot.as_ref().and_then(|s| s.joints.as_ref()).expect("joints");
+    let j0 = r.mechanisms[0]
+        .snapshot
+        .as_ref()
+        .and_then(|s| s.joints.as_ref())
+        .expect("joints");
     assert_pt(j0.p, [0.926092, -0.353500], PRINTED_6, "P mirrored");
     assert_eq!(r.mechanisms[0].links.coupler_side, -1);
     assert_eq!(r.mechanisms[1].links.coupler_side, 1);
@@ -298,17 +423,24 @@ fn table1_mirrored_side_spec_6_1() {
 /// Arc length of a closed polyline.
 fn closed_length(points: &[[f64; 2]]) -> f64 {
     let n = points.len();
-    (0..n).map(|i| (pt(points[(i + 1) % n]) - pt(points[i])).norm()).sum()
+    (0..n)
+        .map(|i| (pt(points[(i + 1) % n]) - pt(points[i])).norm())
+        .sum()
 }
 
 /// Arc length of an open polyline.
 fn open_length(points: &[[f64; 2]]) -> f64 {
-    points.windows(2).map(|w| (pt(w[1]) - pt(w[0])).norm()).sum()
+    points
+        .windows(2)
+        .map(|w| (pt(w[1]) - pt(w[0])).norm())
+        .sum()
 }
 
 #[test]
 fn table1_curve_one_circuit_length_spec_6_1() {
-    let r = run_ok(table1(json!({"options": {"curves": true, "points_per_circuit": 100000}})));
+    let r = run_ok(table1(
+        json!({"options": {"curves": true, "points_per_circuit": 100000}}),
+    ));
     for m in &r.mechanisms {
         let curves = m.curves.as_ref().expect("curves");
         assert_eq!(curves.len(), 1);
@@ -335,20 +467,37 @@ fn table1_fixed_branch_coverage_spec_4_8() {
         assert!(!c[0].closed);
         open_length(&c[0].points) / total
     };
-    assert!((frac(0) - 0.46).abs() <= 0.005 + 1e-4, "original covers {}", frac(0));
-    assert!((frac(1) - 0.53).abs() <= 0.005 + 1e-4, "cognate 1 covers {}", frac(1));
+    assert!(
+        (frac(0) - 0.46).abs() <= 0.005 + 1e-4,
+        "original covers {}",
+        frac(0)
+    );
+    assert!(
+        (frac(1) - 0.53).abs() <= 0.005 + 1e-4,
+        "cognate 1 covers {}",
+        frac(1)
+    );
 }
 
 #[test]
 fn table1_geared_fivebars_on_dyad_circles_spec_4_10() {
-    let r = run_ok(table1(json!({"input_angle_deg": 30.0, "options": {"geared_fivebars": true}})));
+    let r = run_ok(table1(
+        json!({"input_angle_deg": 30.0, "options": {"geared_fivebars": true}}),
+    ));
     let fbs = r.geared_fivebars.as_ref().expect("five-bars");
     assert_eq!(fbs.len(), 3);
     let names: Vec<_> = fbs.iter().map(|f| f.pivot_names.clone()).collect();
-    assert_eq!(names, [["A", "C"], ["B", "C"], ["A", "B"]].map(|p| p.map(str::to_string)));
+    assert_eq!(
+        names,
+        [["A", "C"], ["B", "C"], ["A", "B"]].map(|p| p.map(str::to_string))
+    );
     // Table of §4.10: crank lengths and dyads.
     let (a, b, c, d, e) = (1.13, 1.23, 1.04, 0.92, 1.56);
-    let want = [(a, e / b * a, d, d / b * c), (c, d / b * c, e, e / b * a), (d, e, a, c)];
+    let want = [
+        (a, e / b * a, d, d / b * c),
+        (c, d / b * c, e, e / b * a),
+        (d, e, a, c),
+    ];
     for (f, (c1, c2, d1, d2)) in fbs.iter().zip(want) {
         assert_abs_diff_eq!(f.crank1, c1, epsilon = EXACT);
         assert_abs_diff_eq!(f.crank2, c2, epsilon = EXACT);
@@ -356,12 +505,23 @@ fn table1_geared_fivebars_on_dyad_circles_spec_4_10() {
         assert_abs_diff_eq!(f.dyad2, d2, epsilon = EXACT);
         let s = f.snapshot.as_ref().expect("snapshot");
         // Spec: P lies on both dyad circles to 4e-14·L.
-        assert!(s.dyad_residual <= 4e-14 * 3.1, "dyad residual {}", s.dyad_residual);
+        assert!(
+            s.dyad_residual <= 4e-14 * 3.1,
+            "dyad residual {}",
+            s.dyad_residual
+        );
         let phase = (s.crank2_angle_deg - s.crank1_angle_deg - f.phase_deg).rem_euclid(360.0);
-        assert!(phase.min(360.0 - phase) < 1e-9, "gearing phase off by {phase}");
+        assert!(
+            phase.min(360.0 - phase) < 1e-9,
+            "gearing phase off by {phase}"
+        );
     }
     let k = closed_form_k(b, d, e, 1.0);
-    assert_abs_diff_eq!(fbs[0].phase_deg, (C64::new(1.0, 0.0) - k).arg().to_degrees(), epsilon = 1e-9);
+    assert_abs_diff_eq!(
+        fbs[0].phase_deg,
+        (C64::new(1.0, 0.0) - k).arg().to_degrees(),
+        epsilon = 1e-9
+    );
     assert_abs_diff_eq!(fbs[1].phase_deg, k.arg().to_degrees(), epsilon = 1e-9);
 }
 
@@ -425,21 +585,47 @@ fn case(l: f64, a: f64, b: f64, c: f64, d: f64, e: f64, extra: Value) -> Value {
 }
 
 fn links(m: &MechanismOut) -> [f64; 4] {
-    [m.links.ground, m.links.crank, m.links.coupler, m.links.rocker]
+    [
+        m.links.ground,
+        m.links.crank,
+        m.links.coupler,
+        m.links.rocker,
+    ]
 }
 
 fn assert_links(m: &MechanismOut, want: [f64; 4], tol: f64) {
     for (g, w) in links(m).iter().zip(want) {
-        assert!((g - w).abs() <= tol, "{:?}: links {:?} vs {want:?}", m.id, links(m));
+        assert!(
+            (g - w).abs() <= tol,
+            "{:?}: links {:?} vs {want:?}",
+            m.id,
+            links(m)
+        );
     }
 }
 
 #[test]
 fn crank_rocker_case_spec_6_2() {
-    let r = run_ok(case(4.0, 1.0, 3.5, 3.0, 2.0, 2.5, json!({"input_angle_deg": 60.0})));
+    let r = run_ok(case(
+        4.0,
+        1.0,
+        3.5,
+        3.0,
+        2.0,
+        2.5,
+        json!({"input_angle_deg": 60.0}),
+    ));
     assert_pt(r.c, [1.632653, 1.599667], PRINTED_6, "C");
-    assert_links(&r.mechanisms[1], [2.285714, 2.0, 0.571429, 1.714286], PRINTED_6);
-    assert_links(&r.mechanisms[2], [2.857143, 0.714286, 2.142857, 2.5], PRINTED_6);
+    assert_links(
+        &r.mechanisms[1],
+        [2.285714, 2.0, 0.571429, 1.714286],
+        PRINTED_6,
+    );
+    assert_links(
+        &r.mechanisms[2],
+        [2.857143, 0.714286, 2.142857, 2.5],
+        PRINTED_6,
+    );
     assert_eq!(r.mechanisms[0].grashof.kind, LinkageTypeOut::CrankRocker);
     assert_eq!(r.mechanisms[1].grashof.kind, LinkageTypeOut::DoubleRocker);
     assert_eq!(r.mechanisms[2].grashof.kind, LinkageTypeOut::CrankRocker);
@@ -452,11 +638,37 @@ fn crank_rocker_case_spec_6_2() {
     for m in &r.mechanisms {
         assert_eq!(m.input_range.n_circuits, 2, "{:?}", m.id);
     }
-    let p_plus = r.mechanisms[0].snapshot.as_ref().and_then(|s| s.joints.as_ref()).expect("joints").p;
+    let p_plus = r.mechanisms[0]
+        .snapshot
+        .as_ref()
+        .and_then(|s| s.joints.as_ref())
+        .expect("joints")
+        .p;
     assert_pt(p_plus, [0.832228, 2.838238], PRINTED_6, "P(t1=+1)");
-    assert_abs_diff_eq!(r.mechanisms[2].snapshot.as_ref().and_then(|s| s.input_angle_deg).unwrap_or(f64::NAN), 25.9523, epsilon = 5e-5);
-    let r2 = run_ok(case(4.0, 1.0, 3.5, 3.0, 2.0, 2.5, json!({"input_angle_deg": 60.0, "branch": -1})));
-    let p_minus = r2.mechanisms[0].snapshot.as_ref().and_then(|s| s.joints.as_ref()).expect("joints").p;
+    assert_abs_diff_eq!(
+        r.mechanisms[2]
+            .snapshot
+            .as_ref()
+            .and_then(|s| s.input_angle_deg)
+            .unwrap_or(f64::NAN),
+        25.9523,
+        epsilon = 5e-5
+    );
+    let r2 = run_ok(case(
+        4.0,
+        1.0,
+        3.5,
+        3.0,
+        2.0,
+        2.5,
+        json!({"input_angle_deg": 60.0, "branch": -1}),
+    ));
+    let p_minus = r2.mechanisms[0]
+        .snapshot
+        .as_ref()
+        .and_then(|s| s.joints.as_ref())
+        .expect("joints")
+        .p;
     assert_pt(p_minus, [2.386408, 0.201598], PRINTED_6, "P(t1=−1)");
 }
 
@@ -486,7 +698,15 @@ fn double_crank_case_spec_6_2() {
 
 #[test]
 fn rocker_crank_not_assemblable_snapshot_spec_6_2() {
-    let r = run_ok(case(4.0, 3.5, 3.0, 1.0, 2.0, 2.5, json!({"input_angle_deg": 80.0})));
+    let r = run_ok(case(
+        4.0,
+        3.5,
+        3.0,
+        1.0,
+        2.0,
+        2.5,
+        json!({"input_angle_deg": 80.0}),
+    ));
     let s = r.mechanisms[0].snapshot.as_ref().expect("snapshot");
     assert_eq!(s.status, SnapshotStatus::NotAssemblable);
     assert!(s.joints.is_none());
@@ -496,7 +716,10 @@ fn rocker_crank_not_assemblable_snapshot_spec_6_2() {
     assert_eq!(r.mechanisms[1].grashof.kind, LinkageTypeOut::RockerCrank);
     assert_eq!(r.mechanisms[2].grashof.kind, LinkageTypeOut::DoubleRocker);
     for m in &r.mechanisms[1..] {
-        assert_eq!(m.snapshot.as_ref().map(|s| s.status), Some(SnapshotStatus::NotAssemblable));
+        assert_eq!(
+            m.snapshot.as_ref().map(|s| s.status),
+            Some(SnapshotStatus::NotAssemblable)
+        );
     }
 }
 
@@ -517,7 +740,12 @@ fn tilted_ground_case_spec_6_2() {
         }
         let r = run_ok(v);
         assert_pt(r.c, [1.700071, 0.410388], PRINTED_6, "C");
-        let p = r.mechanisms[0].snapshot.as_ref().and_then(|s| s.joints.as_ref()).expect("joints").p;
+        let p = r.mechanisms[0]
+            .snapshot
+            .as_ref()
+            .and_then(|s| s.joints.as_ref())
+            .expect("joints")
+            .p;
         assert_pt(p, [0.534518, 0.838318], PRINTED_6, "P(t1=+1)");
         assert_abs_diff_eq!(r.similarity.k[0], 0.4, epsilon = EXACT);
         assert_abs_diff_eq!(r.similarity.k[1], 0.7, epsilon = EXACT);
@@ -543,8 +771,14 @@ fn coupler_point_forms_agree_spec_3() {
     }
     // joints mode: the Table-1 snapshot drawn as joints.
     let snap = run_ok(table1(json!({"input_angle_deg": 30.0})));
-    let j = snap.mechanisms[0].snapshot.as_ref().and_then(|s| s.joints.as_ref()).expect("joints");
-    let r = run_ok(json!({"joints": {"A": [0, 0], "B": [3.1, 0], "D": j.crank_joint, "E": j.rocker_joint, "P": j.p}}));
+    let j = snap.mechanisms[0]
+        .snapshot
+        .as_ref()
+        .and_then(|s| s.joints.as_ref())
+        .expect("joints");
+    let r = run_ok(
+        json!({"joints": {"A": [0, 0], "B": [3.1, 0], "D": j.crank_joint, "E": j.rocker_joint, "P": j.p}}),
+    );
     assert_pt(r.c, snap.c, 1e-12, "C from joints");
     let s = r.mechanisms[0].snapshot.as_ref().expect("snapshot");
     assert_eq!(s.branch, Some(1));
@@ -562,8 +796,18 @@ fn angle_reference_ground_spec_3() {
     };
     let g = run_ok(v("global", 100.0));
     let r = run_ok(v("ground", 75.0));
-    let pg = g.mechanisms[0].snapshot.as_ref().and_then(|s| s.joints.as_ref()).expect("joints").p;
-    let pr = r.mechanisms[0].snapshot.as_ref().and_then(|s| s.joints.as_ref()).expect("joints").p;
+    let pg = g.mechanisms[0]
+        .snapshot
+        .as_ref()
+        .and_then(|s| s.joints.as_ref())
+        .expect("joints")
+        .p;
+    let pr = r.mechanisms[0]
+        .snapshot
+        .as_ref()
+        .and_then(|s| s.joints.as_ref())
+        .expect("joints")
+        .p;
     assert_pt(pg, pr, 1e-12, "same pose");
 }
 
@@ -592,8 +836,17 @@ fn chord_error_table_spec_8() {
         let cos = chord_error(&paper, n, Spacing::Auto, 16) * sp;
         let uni = chord_error(&paper, n, Spacing::Uniform, 16) * sp;
         let crank_rocker = chord_error(&cr, n, Spacing::Auto, 16) * sc;
-        assert!(cos <= 1.5 * cos_ref, "N={n} paper cosine {cos:e} vs {cos_ref:e}");
-        assert!(uni <= 1.5 * uni_ref, "N={n} paper uniform {uni:e} vs {uni_ref:e}");
-        assert!(crank_rocker <= 1.5 * cr_ref, "N={n} crank-rocker {crank_rocker:e} vs {cr_ref:e}");
+        assert!(
+            cos <= 1.5 * cos_ref,
+            "N={n} paper cosine {cos:e} vs {cos_ref:e}"
+        );
+        assert!(
+            uni <= 1.5 * uni_ref,
+            "N={n} paper uniform {uni:e} vs {uni_ref:e}"
+        );
+        assert!(
+            crank_rocker <= 1.5 * cr_ref,
+            "N={n} crank-rocker {crank_rocker:e} vs {cr_ref:e}"
+        );
     }
 }

@@ -4,9 +4,16 @@
 //! Every request must end in a typed failure or a response whose numbers are all finite.
 //! `STRESS_CASES=…` scales the random sweeps (default 400).
 
+#![allow(
+    clippy::suboptimal_flops,
+    reason = "test arithmetic follows the spec's formulas; mul_add gains nothing here"
+)]
+
 use std::time::Duration;
 
-use mechcalc::calc::cognates::wire::{CognatesResponse, GrashofClassOut, MechanismId, SnapshotStatus, SpecialOut, WarningCode};
+use mechcalc::calc::cognates::wire::{
+    CognatesResponse, GrashofClassOut, MechanismId, SnapshotStatus, SpecialOut, WarningCode,
+};
 use mechcalc::calc::cognates::{CognatesRequest, run};
 use mechcalc::calc::{CalcFailure, ProblemClass};
 use mechcalc::numerics::Budget;
@@ -15,7 +22,10 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
 fn stress_cases() -> usize {
-    std::env::var("STRESS_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(400)
+    std::env::var("STRESS_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(400)
 }
 
 const ALL_OPTIONS: &str = r#"{"curves": true, "points_per_circuit": 32, "verify": ["sync", "implicit", "hausdorff"],
@@ -44,10 +54,19 @@ const NULLABLE: [&str; 10] = [
 fn assert_all_finite(v: &Value, path: &str) {
     match v {
         Value::Null => panic!("null (NaN/∞ or missing value) at {path}"),
-        Value::Number(n) => assert!(n.as_f64().is_some_and(f64::is_finite), "non-finite at {path}"),
-        Value::Array(a) => a.iter().enumerate().for_each(|(i, x)| assert_all_finite(x, &format!("{path}/{i}"))),
+        Value::Number(n) => assert!(
+            n.as_f64().is_some_and(f64::is_finite),
+            "non-finite at {path}"
+        ),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| assert_all_finite(x, &format!("{path}/{i}"))),
         Value::Object(o) => {
-            let assembled = o.get("status").and_then(Value::as_str).is_some_and(|s| s == "ok" || s == "toggle");
+            let assembled = o
+                .get("status")
+                .and_then(Value::as_str)
+                .is_some_and(|s| s == "ok" || s == "toggle");
             for (k, x) in o {
                 if x.is_null() && NULLABLE.contains(&k.as_str()) && !(assembled && k != "special") {
                     continue;
@@ -139,14 +158,33 @@ fn random_linkages_six_orders_of_magnitude() {
             }
         }
     }
-    assert!(n_ok > stress_cases() / 4, "only {n_ok} successes, {n_fail} failures");
+    assert!(
+        n_ok > stress_cases() / 4,
+        "only {n_ok} successes, {n_fail} failures"
+    );
 }
 
 #[test]
 fn extreme_aspect_ratio_warns_and_stays_finite() {
-    for (l, a, b, c) in [(1.0, 1e-6, 1.0, 0.5), (1e6, 1.0, 1e6, 1e6), (1.0, 1.0, 1.0, 1e-7), (3e5, 2e5, 1e-2, 1e5 + 1.0)] {
-        match attempt(lk(l, a, b, c, json!({"u": b * 0.3, "v": b * 0.4}), json!({"input_angle_deg": 10.0, "options": all_options()}))) {
-            Ok(r) => assert!(has_warning(&r, WarningCode::ExtremeAspectRatio), "{:?}", r.warnings),
+    for (l, a, b, c) in [
+        (1.0, 1e-6, 1.0, 0.5),
+        (1e6, 1.0, 1e6, 1e6),
+        (1.0, 1.0, 1.0, 1e-7),
+        (3e5, 2e5, 1e-2, 1e5 + 1.0),
+    ] {
+        match attempt(lk(
+            l,
+            a,
+            b,
+            c,
+            json!({"u": b * 0.3, "v": b * 0.4}),
+            json!({"input_angle_deg": 10.0, "options": all_options()}),
+        )) {
+            Ok(r) => assert!(
+                has_warning(&r, WarningCode::ExtremeAspectRatio),
+                "{:?}",
+                r.warnings
+            ),
             Err(e) => assert_eq!(e.code, "NOT_ASSEMBLABLE"),
         }
     }
@@ -161,8 +199,16 @@ fn absolute_scale_extremes() {
             "coupler_point": {"d": 0.92 * s, "e": 1.56 * s, "side": 1},
             "input_angle_deg": 30.0, "options": all_options()
         }));
-        assert!((r.c[0] / s - (5.0 - 0.076122)).abs() < 1e-6, "C at scale {s:e}: {:?}", r.c);
-        let sync = r.verification.as_ref().and_then(|v| v.sync.as_ref()).expect("sync");
+        assert!(
+            (r.c[0] / s - (5.0 - 0.076122)).abs() < 1e-6,
+            "C at scale {s:e}: {:?}",
+            r.c
+        );
+        let sync = r
+            .verification
+            .as_ref()
+            .and_then(|v| v.sync.as_ref())
+            .expect("sync");
         assert!(sync.passed, "{sync:?}");
     }
 }
@@ -174,9 +220,30 @@ fn absolute_scale_extremes() {
 #[test]
 fn near_toggle_snapshots() {
     let cases = [
-        lk(3.1, 1.13, 1.23, 1.04, json!({"d": 0.92, "e": 1.56, "side": 1}), json!({})),
-        lk(4.0, 3.5, 3.0, 1.0, json!({"d": 2.0, "e": 2.5, "side": 1}), json!({})),
-        lk(4.0, 3.0, 1.0, 3.5, json!({"d": 0.8, "e": 0.6, "side": -1}), json!({})),
+        lk(
+            3.1,
+            1.13,
+            1.23,
+            1.04,
+            json!({"d": 0.92, "e": 1.56, "side": 1}),
+            json!({}),
+        ),
+        lk(
+            4.0,
+            3.5,
+            3.0,
+            1.0,
+            json!({"d": 2.0, "e": 2.5, "side": 1}),
+            json!({}),
+        ),
+        lk(
+            4.0,
+            3.0,
+            1.0,
+            3.5,
+            json!({"d": 0.8, "e": 0.6, "side": -1}),
+            json!({}),
+        ),
     ];
     for base in cases {
         let r0 = ok(base.clone());
@@ -197,7 +264,9 @@ fn near_toggle_snapshots() {
                         let s = r.mechanisms[0].snapshot.as_ref().expect("snapshot");
                         assert!(matches!(
                             s.status,
-                            SnapshotStatus::Ok | SnapshotStatus::Toggle | SnapshotStatus::NotAssemblable
+                            SnapshotStatus::Ok
+                                | SnapshotStatus::Toggle
+                                | SnapshotStatus::NotAssemblable
                         ));
                         if s.status == SnapshotStatus::Toggle {
                             assert!(has_warning(&r, WarningCode::SnapshotAtToggle));
@@ -206,8 +275,15 @@ fn near_toggle_snapshots() {
                             // Assembled a hair inside the range: the pose map still holds.
                             let j0 = s.joints.as_ref().expect("joints");
                             for m in &r.mechanisms[1..] {
-                                let jm = m.snapshot.as_ref().and_then(|x| x.joints.as_ref()).expect("joints");
-                                assert!((jm.p[0] - j0.p[0]).abs() < 1e-12 && (jm.p[1] - j0.p[1]).abs() < 1e-12);
+                                let jm = m
+                                    .snapshot
+                                    .as_ref()
+                                    .and_then(|x| x.joints.as_ref())
+                                    .expect("joints");
+                                assert!(
+                                    (jm.p[0] - j0.p[0]).abs() < 1e-12
+                                        && (jm.p[1] - j0.p[1]).abs() < 1e-12
+                                );
                             }
                         }
                     }
@@ -220,9 +296,18 @@ fn near_toggle_snapshots() {
 #[test]
 fn joints_at_toggle_warns() {
     // E on the segment D–B: the drawn configuration is a toggle (cross product exactly 0).
-    let r = ok(json!({"joints": {"A": [0, 0], "B": [4, 0], "D": [1, 1], "E": [2.5, 0.5], "P": [1.5, 1.5]}}));
-    assert!(has_warning(&r, WarningCode::SnapshotAtToggle), "{:?}", r.warnings);
-    assert_eq!(r.mechanisms[0].snapshot.as_ref().and_then(|s| s.branch), Some(1));
+    let r = ok(
+        json!({"joints": {"A": [0, 0], "B": [4, 0], "D": [1, 1], "E": [2.5, 0.5], "P": [1.5, 1.5]}}),
+    );
+    assert!(
+        has_warning(&r, WarningCode::SnapshotAtToggle),
+        "{:?}",
+        r.warnings
+    );
+    assert_eq!(
+        r.mechanisms[0].snapshot.as_ref().and_then(|s| s.branch),
+        Some(1)
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -232,14 +317,37 @@ fn joints_at_toggle_warns() {
 #[test]
 fn change_point_warns_with_folded_angles() {
     // s + l = p + q: 1 + 4 = 2 + 3 (crank + ground = coupler + rocker: folds at φ = 180°).
-    for (l, a, b, c) in [(4.0, 1.0, 2.0, 3.0), (4.0, 1.0, 3.0, 2.0), (3.0, 2.0, 4.0, 1.0), (2.0, 1.0, 4.0, 3.0)] {
+    for (l, a, b, c) in [
+        (4.0, 1.0, 2.0, 3.0),
+        (4.0, 1.0, 3.0, 2.0),
+        (3.0, 2.0, 4.0, 1.0),
+        (2.0, 1.0, 4.0, 3.0),
+    ] {
         for eps in [0.0, 1e-15, -1e-15, 1e-11, -1e-11] {
-            let r = ok(lk(l, a + eps, b, c, json!({"u": 0.3 * b, "v": 0.5 * b}), json!({"input_angle_deg": 179.0, "options": all_options()})));
+            let r = ok(lk(
+                l,
+                a + eps,
+                b,
+                c,
+                json!({"u": 0.3 * b, "v": 0.5 * b}),
+                json!({"input_angle_deg": 179.0, "options": all_options()}),
+            ));
             for m in &r.mechanisms {
-                assert_eq!(m.grashof.class, GrashofClassOut::ChangePoint, "{l} {a} {b} {c} eps {eps}");
+                assert_eq!(
+                    m.grashof.class,
+                    GrashofClassOut::ChangePoint,
+                    "{l} {a} {b} {c} eps {eps}"
+                );
             }
-            let w = r.warnings.iter().find(|w| w.code == WarningCode::ChangePoint).expect("change_point warning");
-            assert!(w.angles_deg.as_ref().is_some_and(|a| !a.is_empty()), "{w:?}");
+            let w = r
+                .warnings
+                .iter()
+                .find(|w| w.code == WarningCode::ChangePoint)
+                .expect("change_point warning");
+            assert!(
+                w.angles_deg.as_ref().is_some_and(|a| !a.is_empty()),
+                "{w:?}"
+            );
         }
     }
 }
@@ -247,8 +355,19 @@ fn change_point_warns_with_folded_angles() {
 #[test]
 fn grashof_rtol_zero_and_max() {
     for rtol in [0.0, 1e-3] {
-        let r = ok(lk(4.0, 1.0 + 1e-5, 2.0, 3.0, json!({"u": 0.6, "v": 1.0}), json!({"options": {"grashof_rtol": rtol}})));
-        let want = if rtol > 0.0 { GrashofClassOut::ChangePoint } else { GrashofClassOut::NonGrashof };
+        let r = ok(lk(
+            4.0,
+            1.0 + 1e-5,
+            2.0,
+            3.0,
+            json!({"u": 0.6, "v": 1.0}),
+            json!({"options": {"grashof_rtol": rtol}}),
+        ));
+        let want = if rtol > 0.0 {
+            GrashofClassOut::ChangePoint
+        } else {
+            GrashofClassOut::NonGrashof
+        };
         assert_eq!(r.mechanisms[0].grashof.class, want);
     }
 }
@@ -257,16 +376,41 @@ fn grashof_rtol_zero_and_max() {
 fn parallelogram_original_locks_cognate_one() {
     // a = c, b = l: cognate 1 is a deltoid with crank = ground (spec §7).
     for side in [1.0, -1.0] {
-        let r = ok(lk(3.0, 1.0, 3.0, 1.0, json!({"u": 1.2, "v": side * 0.8}), json!({"input_angle_deg": 40.0, "options": all_options()})));
+        let r = ok(lk(
+            3.0,
+            1.0,
+            3.0,
+            1.0,
+            json!({"u": 1.2, "v": side * 0.8}),
+            json!({"input_angle_deg": 40.0, "options": all_options()}),
+        ));
         let sp: Vec<_> = r.mechanisms.iter().map(|m| m.grashof.special).collect();
-        assert_eq!(sp, [Some(SpecialOut::Parallelogram), Some(SpecialOut::Deltoid), Some(SpecialOut::Deltoid)]);
+        assert_eq!(
+            sp,
+            [
+                Some(SpecialOut::Parallelogram),
+                Some(SpecialOut::Deltoid),
+                Some(SpecialOut::Deltoid)
+            ]
+        );
         assert!(has_warning(&r, WarningCode::Parallelogram));
-        let locked = r.warnings.iter().find(|w| w.code == WarningCode::InputLockedSegment).expect("locked warning");
+        let locked = r
+            .warnings
+            .iter()
+            .find(|w| w.code == WarningCode::InputLockedSegment)
+            .expect("locked warning");
         assert_eq!(locked.mechanism, Some(MechanismId::Cognate1));
-        let sync = r.verification.as_ref().and_then(|v| v.sync.as_ref()).expect("sync");
+        let sync = r
+            .verification
+            .as_ref()
+            .and_then(|v| v.sync.as_ref())
+            .expect("sync");
         assert!(sync.n_skipped_locked > 0, "{sync:?}");
         assert!(sync.max_constraint_residual < 1e-12 * 3.0, "{sync:?}");
-        assert!(sync.max_dev < 1e-6 * 3.0, "locked samples must be skipped: {sync:?}");
+        assert!(
+            sync.max_dev < 1e-6 * 3.0,
+            "locked samples must be skipped: {sync:?}"
+        );
         // In the snapshot (parallelogram mode) cognate 1's crank tip sits on C.
         let s1 = r.mechanisms[1].snapshot.as_ref().expect("snapshot");
         assert_eq!(s1.status, SnapshotStatus::Singular);
@@ -276,37 +420,99 @@ fn parallelogram_original_locks_cognate_one() {
 #[test]
 fn deltoid_original_singular_at_zero() {
     // a = l, b = c: D reaches B at φ = 0.
-    let base = lk(2.0, 2.0, 1.5, 1.5, json!({"u": 0.5, "v": 0.7}), json!({"options": all_options()}));
+    let base = lk(
+        2.0,
+        2.0,
+        1.5,
+        1.5,
+        json!({"u": 0.5, "v": 0.7}),
+        json!({"options": all_options()}),
+    );
     let mut v = base.clone();
     v["input_angle_deg"] = json!(0.0);
     let r = ok(v);
     assert_eq!(r.mechanisms[0].grashof.special, Some(SpecialOut::Deltoid));
-    assert_eq!(r.mechanisms[0].snapshot.as_ref().map(|s| s.status), Some(SnapshotStatus::Singular));
+    assert_eq!(
+        r.mechanisms[0].snapshot.as_ref().map(|s| s.status),
+        Some(SnapshotStatus::Singular)
+    );
     assert!(has_warning(&r, WarningCode::Deltoid));
-    assert!(r.warnings.iter().any(|w| w.code == WarningCode::InputLockedSegment && w.mechanism == Some(MechanismId::Original)));
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w.code == WarningCode::InputLockedSegment
+                && w.mechanism == Some(MechanismId::Original))
+    );
     // The φ = 0 samples (one per circuit) are excluded from the original's curves.
-    let excluded: usize = r.mechanisms[0].curves.as_ref().expect("curves").iter().map(|c| c.n_singular_excluded).sum();
+    let excluded: usize = r.mechanisms[0]
+        .curves
+        .as_ref()
+        .expect("curves")
+        .iter()
+        .map(|c| c.n_singular_excluded)
+        .sum();
     assert!(excluded >= 1, "singular samples excluded: {excluded}");
     // Specials map as spec §7: deltoid crank=ground → (parallelogram, deltoid).
-    assert_eq!(r.mechanisms[1].grashof.special, Some(SpecialOut::Parallelogram));
+    assert_eq!(
+        r.mechanisms[1].grashof.special,
+        Some(SpecialOut::Parallelogram)
+    );
     assert_eq!(r.mechanisms[2].grashof.special, Some(SpecialOut::Deltoid));
     // Deltoid crank = coupler (a = b, c = l) → (deltoid, parallelogram).
-    let r2 = ok(lk(2.0, 1.5, 1.5, 2.0, json!({"u": 0.5, "v": 0.7}), json!({"input_angle_deg": 30.0, "options": all_options()})));
+    let r2 = ok(lk(
+        2.0,
+        1.5,
+        1.5,
+        2.0,
+        json!({"u": 0.5, "v": 0.7}),
+        json!({"input_angle_deg": 30.0, "options": all_options()}),
+    ));
     let sp: Vec<_> = r2.mechanisms.iter().map(|m| m.grashof.special).collect();
-    assert_eq!(sp, [Some(SpecialOut::Deltoid), Some(SpecialOut::Deltoid), Some(SpecialOut::Parallelogram)]);
+    assert_eq!(
+        sp,
+        [
+            Some(SpecialOut::Deltoid),
+            Some(SpecialOut::Deltoid),
+            Some(SpecialOut::Parallelogram)
+        ]
+    );
     // Rhombus.
-    let r3 = ok(lk(1.0, 1.0, 1.0, 1.0, json!({"u": 0.5, "v": 0.7}), json!({"input_angle_deg": 0.0, "options": all_options()})));
+    let r3 = ok(lk(
+        1.0,
+        1.0,
+        1.0,
+        1.0,
+        json!({"u": 0.5, "v": 0.7}),
+        json!({"input_angle_deg": 0.0, "options": all_options()}),
+    ));
     assert_eq!(r3.mechanisms[0].grashof.special, Some(SpecialOut::Rhombus));
 }
 
 #[test]
 fn crank_tip_near_output_pivot() {
     // a = l with b ≠ c: s → 0 is never assemblable; the snapshot at φ = 0 must say so cleanly.
-    let r = ok(lk(2.0, 2.0, 1.0, 1.5, json!({"u": 0.5, "v": 0.7}), json!({"input_angle_deg": 0.0, "options": all_options()})));
+    let r = ok(lk(
+        2.0,
+        2.0,
+        1.0,
+        1.5,
+        json!({"u": 0.5, "v": 0.7}),
+        json!({"input_angle_deg": 0.0, "options": all_options()}),
+    ));
     let s = r.mechanisms[0].snapshot.as_ref().expect("snapshot");
-    assert!(matches!(s.status, SnapshotStatus::NotAssemblable | SnapshotStatus::Singular));
+    assert!(matches!(
+        s.status,
+        SnapshotStatus::NotAssemblable | SnapshotStatus::Singular
+    ));
     for eps in [1e-15, 1e-12, 1e-9] {
-        let _ = ok(lk(2.0, 2.0 - eps, 1.5, 1.5, json!({"u": 0.5, "v": 0.7}), json!({"input_angle_deg": 0.0, "options": all_options()})));
+        let _ = ok(lk(
+            2.0,
+            2.0 - eps,
+            1.5,
+            1.5,
+            json!({"u": 0.5, "v": 0.7}),
+            json!({"input_angle_deg": 0.0, "options": all_options()}),
+        ));
     }
 }
 
@@ -321,13 +527,34 @@ fn coupler_point_on_or_near_a_joint() {
         assert_eq!(e.code, "COUPLER_POINT_AT_JOINT", "{e}");
         assert_eq!(e.errors[0].pointer, "/coupler_point");
     }
-    for (u, v, who) in [(1e-4, 1e-4, MechanismId::Cognate1), (3.5 - 1e-4, 1e-4, MechanismId::Cognate2)] {
-        let r = ok(lk(4.0, 1.0, 3.5, 3.0, json!({"u": u, "v": v}), json!({"input_angle_deg": 20.0, "options": all_options()})));
-        let w = r.warnings.iter().find(|w| w.code == WarningCode::NearDegenerateCognate).expect("warning");
+    for (u, v, who) in [
+        (1e-4, 1e-4, MechanismId::Cognate1),
+        (3.5 - 1e-4, 1e-4, MechanismId::Cognate2),
+    ] {
+        let r = ok(lk(
+            4.0,
+            1.0,
+            3.5,
+            3.0,
+            json!({"u": u, "v": v}),
+            json!({"input_angle_deg": 20.0, "options": all_options()}),
+        ));
+        let w = r
+            .warnings
+            .iter()
+            .find(|w| w.code == WarningCode::NearDegenerateCognate)
+            .expect("warning");
         assert_eq!(w.mechanism, Some(who));
     }
     for (u, v) in [(1e-8, 0.0), (3.5 * (1.0 - 1e-8), 1e-9), (1e-6, -1e-6)] {
-        let _ = ok(lk(4.0, 1.0, 3.5, 3.0, json!({"u": u, "v": v}), json!({"input_angle_deg": 20.0, "options": all_options()})));
+        let _ = ok(lk(
+            4.0,
+            1.0,
+            3.5,
+            3.0,
+            json!({"u": u, "v": v}),
+            json!({"input_angle_deg": 20.0, "options": all_options()}),
+        ));
     }
 }
 
@@ -343,15 +570,30 @@ fn collinear_and_near_degenerate_coupler_triangles() {
                 // Largest excess of one side over the sum of the other two, as the server sees it.
                 let excess = (d2 - (b + e)).max(e - (b + d2)).max(b - (d2 + e));
                 let slack = 1e-12 * b.max(d2).max(e);
-                match attempt(lk(4.0, 1.0, b, 3.0, json!({"d": d2, "e": e, "side": side}), json!({"input_angle_deg": 33.0, "options": all_options()}))) {
+                match attempt(lk(
+                    4.0,
+                    1.0,
+                    b,
+                    3.0,
+                    json!({"d": d2, "e": e, "side": side}),
+                    json!({"input_angle_deg": 33.0, "options": all_options()}),
+                )) {
                     Ok(r) => {
                         assert!(excess <= slack, "accepted beyond the slack: {d2} {e}");
                         // Degenerate or within the slack: clamped onto the line DE. A triangle one
                         // ulp inside is a genuine (thin) triangle: P sits ~sqrt(ε)·b off the line.
                         if excess >= 0.0 {
-                            assert!(has_warning(&r, WarningCode::CollinearCouplerTriangle), "{d2} {e}: {:?}", r.warnings);
+                            assert!(
+                                has_warning(&r, WarningCode::CollinearCouplerTriangle),
+                                "{d2} {e}: {:?}",
+                                r.warnings
+                            );
                         }
-                        let sync = r.verification.as_ref().and_then(|v| v.sync.as_ref()).expect("sync");
+                        let sync = r
+                            .verification
+                            .as_ref()
+                            .and_then(|v| v.sync.as_ref())
+                            .expect("sync");
                         assert!(sync.passed, "{sync:?}");
                     }
                     Err(err) => {
@@ -364,7 +606,14 @@ fn collinear_and_near_degenerate_coupler_triangles() {
     }
     // θ3 = 90° ± tiny: C_x ill-conditioned but finite.
     for dv in [0.0, 1e-15, 1e-9] {
-        let _ = ok(lk(3.1, 1.13, 1.23, 1.04, json!({"u": dv, "v": 0.92}), json!({"input_angle_deg": 30.0, "options": all_options()})));
+        let _ = ok(lk(
+            3.1,
+            1.13,
+            1.23,
+            1.04,
+            json!({"u": dv, "v": 0.92}),
+            json!({"input_angle_deg": 30.0, "options": all_options()}),
+        ));
     }
 }
 
@@ -376,10 +625,24 @@ fn random_near_degenerate_triangles() {
         let d = b * rng.random_range(0.01..0.99);
         let gap = [0.0, 1e-15, 1e-12, 1e-9, -1e-15, -1e-12][rng.random_range(0..6)];
         let e = (b - d) * (1.0 + gap);
-        let (l, a, c) = (b * rng.random_range(0.5..2.0), b * rng.random_range(0.1..1.0), b * rng.random_range(0.5..2.0));
-        let req = lk(l, a, b, c, json!({"d": d, "e": e, "side": 1}), json!({"input_angle_deg": rng.random_range(-180.0..180.0), "options": all_options()}));
+        let (l, a, c) = (
+            b * rng.random_range(0.5..2.0),
+            b * rng.random_range(0.1..1.0),
+            b * rng.random_range(0.5..2.0),
+        );
+        let req = lk(
+            l,
+            a,
+            b,
+            c,
+            json!({"d": d, "e": e, "side": 1}),
+            json!({"input_angle_deg": rng.random_range(-180.0..180.0), "options": all_options()}),
+        );
         if let Err(err) = attempt(req) {
-            assert!(["NOT_ASSEMBLABLE", "COUPLER_TRIANGLE_INVALID"].contains(&err.code), "{err}");
+            assert!(
+                ["NOT_ASSEMBLABLE", "COUPLER_TRIANGLE_INVALID"].contains(&err.code),
+                "{err}"
+            );
         }
     }
 }
@@ -396,33 +659,86 @@ fn rejections_carry_codes_and_pointers() {
     assert_eq!(e.class, ProblemClass::InvalidInput);
     let ptrs: Vec<_> = e.errors.iter().map(|i| i.pointer.as_str()).collect();
     assert_eq!(ptrs, ["/crank", "/rocker"]);
-    let e = fail(lk(3.1, 1.13, 1.23, 1.04, json!({"d": -0.1, "e": 1.56}), json!({})));
-    assert_eq!((e.code, e.errors[0].pointer.as_str()), ("NON_POSITIVE_LENGTH", "/coupler_point/d"));
+    let e = fail(lk(
+        3.1,
+        1.13,
+        1.23,
+        1.04,
+        json!({"d": -0.1, "e": 1.56}),
+        json!({}),
+    ));
+    assert_eq!(
+        (e.code, e.errors[0].pointer.as_str()),
+        ("NON_POSITIVE_LENGTH", "/coupler_point/d")
+    );
     let e = fail(lk(0.0, 1.13, 1.23, 1.04, cp.clone(), json!({})));
-    assert_eq!((e.code, e.errors[0].pointer.as_str()), ("COINCIDENT_PIVOTS", "/ground/B"));
+    assert_eq!(
+        (e.code, e.errors[0].pointer.as_str()),
+        ("COINCIDENT_PIVOTS", "/ground/B")
+    );
     let e = fail(lk(1e-13, 1.13, 1.23, 1.04, cp.clone(), json!({})));
     assert_eq!(e.code, "COINCIDENT_PIVOTS");
-    let e = fail(lk(3.1, 1.13, 1.23, 1.04, json!({"d": 0.2, "e": 1.56}), json!({})));
-    assert_eq!((e.code, e.errors[0].pointer.as_str()), ("COUPLER_TRIANGLE_INVALID", "/coupler_point"));
+    let e = fail(lk(
+        3.1,
+        1.13,
+        1.23,
+        1.04,
+        json!({"d": 0.2, "e": 1.56}),
+        json!({}),
+    ));
+    assert_eq!(
+        (e.code, e.errors[0].pointer.as_str()),
+        ("COUPLER_TRIANGLE_INVALID", "/coupler_point")
+    );
     let e = fail(lk(10.0, 1.0, 2.0, 3.0, cp.clone(), json!({})));
-    assert_eq!((e.code, e.class), ("NOT_ASSEMBLABLE", ProblemClass::Infeasible));
+    assert_eq!(
+        (e.code, e.class),
+        ("NOT_ASSEMBLABLE", ProblemClass::Infeasible)
+    );
     // Longest = sum of the others: a rigid, single configuration.
-    let e = fail(lk(6.0, 1.0, 2.0, 3.0, json!({"u": 0.5, "v": 0.5}), json!({})));
+    let e = fail(lk(
+        6.0,
+        1.0,
+        2.0,
+        3.0,
+        json!({"u": 0.5, "v": 0.5}),
+        json!({}),
+    ));
     assert_eq!(e.code, "NOT_ASSEMBLABLE");
-    let e = fail(lk(3.1, 1.13, 1.23, 1.04, cp.clone(), json!({"options": {"points_per_circuit": 8, "grashof_rtol": 0.1}})));
+    let e = fail(lk(
+        3.1,
+        1.13,
+        1.23,
+        1.04,
+        cp.clone(),
+        json!({"options": {"points_per_circuit": 8, "grashof_rtol": 0.1}}),
+    ));
     let ptrs: Vec<_> = e.errors.iter().map(|i| i.pointer.as_str()).collect();
-    assert_eq!(ptrs, ["/options/points_per_circuit", "/options/grashof_rtol"]);
+    assert_eq!(
+        ptrs,
+        ["/options/points_per_circuit", "/options/grashof_rtol"]
+    );
     // Missing fields and mixed modes.
     let e = fail(json!({"crank": 1.0}));
     assert_eq!(e.errors.len(), 4, "{e}");
-    let e = fail(json!({"joints": {"A": [0, 0], "B": [3, 0], "D": [1, 0], "E": [2, 1], "P": [1, 1]}, "crank": 1.0, "branch": 1}));
+    let e = fail(
+        json!({"joints": {"A": [0, 0], "B": [3, 0], "D": [1, 0], "E": [2, 1], "P": [1, 1]}, "crank": 1.0, "branch": 1}),
+    );
     let ptrs: Vec<_> = e.errors.iter().map(|i| i.pointer.as_str()).collect();
     assert_eq!(ptrs, ["/crank", "/branch"]);
-    let e = fail(json!({"joints": {"A": [0, 0], "B": [0, 0], "D": [1, 0], "E": [2, 1], "P": [1, 1]}}));
-    assert_eq!((e.code, e.errors[0].pointer.as_str()), ("COINCIDENT_PIVOTS", "/joints/B"));
-    let e = fail(json!({"ground": {"B": [1e200, 0]}, "crank": 1.0, "coupler": 1.0, "rocker": 1.0, "coupler_point": {"u": 0.5, "v": 0.5}}));
+    let e =
+        fail(json!({"joints": {"A": [0, 0], "B": [0, 0], "D": [1, 0], "E": [2, 1], "P": [1, 1]}}));
+    assert_eq!(
+        (e.code, e.errors[0].pointer.as_str()),
+        ("COINCIDENT_PIVOTS", "/joints/B")
+    );
+    let e = fail(
+        json!({"ground": {"B": [1e200, 0]}, "crank": 1.0, "coupler": 1.0, "rocker": 1.0, "coupler_point": {"u": 0.5, "v": 0.5}}),
+    );
     assert_eq!(e.errors[0].pointer, "/ground/B/0");
-    let e = fail(json!({"ground": {"B": [3, 0], "length": 3.0}, "crank": 1.0, "coupler": 1.0, "rocker": 1.0, "coupler_point": {"u": 0.5, "v": 0.5}}));
+    let e = fail(
+        json!({"ground": {"B": [3, 0], "length": 3.0}, "crank": 1.0, "coupler": 1.0, "rocker": 1.0, "coupler_point": {"u": 0.5, "v": 0.5}}),
+    );
     assert_eq!(e.errors[0].pointer, "/ground/length");
 }
 
@@ -441,7 +757,10 @@ fn decode_errors_for_malformed_shapes() {
         json!({"options": {"points_per_circuit": -5}}),
     ];
     for v in bad {
-        assert!(serde_json::from_value::<CognatesRequest>(v.clone()).is_err(), "should not decode: {v}");
+        assert!(
+            serde_json::from_value::<CognatesRequest>(v.clone()).is_err(),
+            "should not decode: {v}"
+        );
     }
 }
 
@@ -449,11 +768,21 @@ fn decode_errors_for_malformed_shapes() {
 fn too_many_points_and_deadline() {
     // Grashof double rocker: verification samples 3 × 2 circuits × 1e5 = 6e5 points, fixed-branch
     // curves another (2 + 1 + 2) intervals × 1e5 = 5e5: above the 1e6 cap.
-    let base = lk(4.0, 3.0, 1.0, 3.5, json!({"d": 0.8, "e": 0.6, "side": 1}), json!({}));
+    let base = lk(
+        4.0,
+        3.0,
+        1.0,
+        3.5,
+        json!({"d": 0.8, "e": 0.6, "side": 1}),
+        json!({}),
+    );
     let mut v = base.clone();
     v["options"] = json!({"curves": true, "points_per_circuit": 100000, "curve_mode": "fixed_branch", "verify": ["sync"]});
     let e = fail(v);
-    assert_eq!((e.code, e.class), ("TOO_MANY_POINTS", ProblemClass::TooLarge));
+    assert_eq!(
+        (e.code, e.class),
+        ("TOO_MANY_POINTS", ProblemClass::TooLarge)
+    );
     assert_eq!(e.errors[0].pointer, "/options/points_per_circuit");
     // An exhausted budget stops sampling with a typed failure.
     let mut v = base;
@@ -465,12 +794,33 @@ fn too_many_points_and_deadline() {
 
 #[test]
 fn huge_angles_and_fixed_branch_without_snapshot() {
-    let r = ok(lk(3.1, 1.13, 1.23, 1.04, json!({"d": 0.92, "e": 1.56}), json!({"input_angle_deg": 1e15, "options": all_options()})));
+    let r = ok(lk(
+        3.1,
+        1.13,
+        1.23,
+        1.04,
+        json!({"d": 0.92, "e": 1.56}),
+        json!({"input_angle_deg": 1e15, "options": all_options()}),
+    ));
     assert!(r.mechanisms[0].snapshot.is_some());
     let mut opts = all_options();
     opts["curve_mode"] = json!("fixed_branch");
-    let r = ok(lk(3.1, 1.13, 1.23, 1.04, json!({"d": 0.92, "e": 1.56}), json!({"options": opts.clone()})));
+    let r = ok(lk(
+        3.1,
+        1.13,
+        1.23,
+        1.04,
+        json!({"d": 0.92, "e": 1.56}),
+        json!({"options": opts.clone()}),
+    ));
     assert!(has_warning(&r, WarningCode::FixedBranchDefaultBranches));
-    let r = ok(lk(3.1, 1.13, 1.23, 1.04, json!({"d": 0.92, "e": 1.56}), json!({"input_angle_deg": 100.0, "options": opts})));
+    let r = ok(lk(
+        3.1,
+        1.13,
+        1.23,
+        1.04,
+        json!({"d": 0.92, "e": 1.56}),
+        json!({"input_angle_deg": 100.0, "options": opts}),
+    ));
     assert!(has_warning(&r, WarningCode::FixedBranchDefaultBranches));
 }

@@ -6,8 +6,8 @@ use crate::numerics::Budget;
 
 use super::error::CognatesError;
 use super::geometry::{
-    ASSEMBLY_SLACK_REL, C64, Family, FourBar, Grashof, GrashofClass, InputRange, SINGULAR_REL, Sign, Solve, Special,
-    TOGGLE_REL, cognate1_branch, cognates, map_pose, wrap_pi,
+    ASSEMBLY_SLACK_REL, C64, Family, FourBar, Grashof, GrashofClass, InputRange, SINGULAR_REL,
+    Sign, Solve, Special, TOGGLE_REL, cognate1_branch, cognates, map_pose, wrap_pi,
 };
 use super::input::{CognatesInput, SnapshotSpec};
 use super::sampling::{Sweep, circuit_sweeps, fixed_sweeps};
@@ -159,7 +159,11 @@ pub struct CognatesOutput {
     pub points_total: usize,
 }
 
-const IDS: [MechanismId; 3] = [MechanismId::Original, MechanismId::Cognate1, MechanismId::Cognate2];
+const IDS: [MechanismId; 3] = [
+    MechanismId::Original,
+    MechanismId::Cognate1,
+    MechanismId::Cognate2,
+];
 const NAMES: [&str; 3] = ["original", "cognate 1", "cognate 2"];
 
 /// Runs the computation (pure, deterministic; checks the budget while sampling).
@@ -199,14 +203,20 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
 
     // Work plan and point cap.
     let n = opts.points_per_circuit;
-    let need_circuits = (opts.curves && opts.curve_mode == CurveMode::Circuits) || opts.any_verify() || opts.metrics;
+    let need_circuits = (opts.curves && opts.curve_mode == CurveMode::Circuits)
+        || opts.any_verify()
+        || opts.metrics;
     let need_fixed = opts.curves && opts.curve_mode == CurveMode::FixedBranch;
     let n_u64 = u64::try_from(n).unwrap_or(u64::MAX);
     let circuits: u64 = mechs.iter().map(|m| m.range.circuits().len() as u64).sum();
     let intervals: u64 = mechs.iter().map(|m| m.range.intervals().len() as u64).sum();
-    let requested = n_u64.saturating_mul(u64::from(need_circuits) * circuits + u64::from(need_fixed) * intervals);
+    let requested = n_u64
+        .saturating_mul(u64::from(need_circuits) * circuits + u64::from(need_fixed) * intervals);
     if requested > MAX_POINTS_TOTAL {
-        return Err(CognatesError::TooManyPoints { requested, cap: MAX_POINTS_TOTAL });
+        return Err(CognatesError::TooManyPoints {
+            requested,
+            cap: MAX_POINTS_TOTAL,
+        });
     }
 
     let mut counter = 0_u64;
@@ -216,7 +226,16 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
         for (idx, m) in mechs.iter_mut().enumerate() {
             let sweeps = circuit_sweeps(&m.mech);
             let sync_here = if idx == 0 { sync.as_mut() } else { None };
-            let (curves, metrics) = trace(&family, idx, &sweeps, n, opts.spacing, sync_here, budget, &mut counter)?;
+            let (curves, metrics) = trace(
+                &family,
+                idx,
+                &sweeps,
+                n,
+                opts.spacing,
+                sync_here,
+                budget,
+                &mut counter,
+            )?;
             if opts.metrics && metrics.n > 0 {
                 m.metrics = Some(metrics);
             }
@@ -224,14 +243,25 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
         }
     }
     let implicit = opts.verify_implicit.then(|| {
-        implicit_check(&family, circuit_curves.iter().skip(1).flatten().flat_map(|c| c.points.iter()))
+        implicit_check(
+            &family,
+            circuit_curves
+                .iter()
+                .skip(1)
+                .flatten()
+                .flat_map(|c| c.points.iter()),
+        )
     });
     let hausdorff_out = opts.verify_hausdorff.then(|| {
         let segs: Vec<_> = circuit_curves
             .iter()
             .map(|cs| segments(cs.iter().map(|c| (c.points.as_slice(), c.closed))))
             .collect();
-        (hausdorff(&segs[0], &segs[1]), hausdorff(&segs[0], &segs[2]), n)
+        (
+            hausdorff(&segs[0], &segs[1]),
+            hausdorff(&segs[0], &segs[2]),
+            n,
+        )
     });
     if opts.curves {
         if opts.curve_mode == CurveMode::Circuits {
@@ -251,26 +281,67 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
             }
             for (idx, m) in mechs.iter_mut().enumerate() {
                 let sweeps = fixed_sweeps(&m.mech, branches[idx]);
-                let (curves, _) = trace(&family, idx, &sweeps, n, opts.spacing, None, budget, &mut counter)?;
+                let (curves, _) = trace(
+                    &family,
+                    idx,
+                    &sweeps,
+                    n,
+                    opts.spacing,
+                    None,
+                    budget,
+                    &mut counter,
+                )?;
                 m.curves = Some(curves);
             }
         }
     }
-    let points_total = mechs.iter().flat_map(|m| m.curves.iter().flatten()).map(|c| c.points.len()).sum();
-    let fivebars = opts.geared_fivebars.then(|| geared_fivebars(&family, mechs[0].snapshot.as_ref()));
+    let points_total = mechs
+        .iter()
+        .flat_map(|m| m.curves.iter().flatten())
+        .map(|c| c.points.len())
+        .sum();
+    let fivebars = opts
+        .geared_fivebars
+        .then(|| geared_fivebars(&family, mechs[0].snapshot.as_ref()));
     collect_warnings(input, &family, &mechs, &mut warnings);
-    Ok(CognatesOutput { family, mechs, sync, implicit, hausdorff: hausdorff_out, fivebars, warnings, points_total })
+    Ok(CognatesOutput {
+        family,
+        mechs,
+        sync,
+        implicit,
+        hausdorff: hausdorff_out,
+        fivebars,
+        warnings,
+        points_total,
+    })
 }
 
 fn not_assemblable(m: &FourBar, scale: f64) -> CognatesError {
-    let links = [("ground", m.ground), ("crank", m.crank), ("coupler", m.coupler), ("rocker", m.rocker)];
-    let (name, longest) = links.iter().copied().fold(("ground", 0.0), |acc, l| if l.1 > acc.1 { l } else { acc });
+    let links = [
+        ("ground", m.ground),
+        ("crank", m.crank),
+        ("coupler", m.coupler),
+        ("rocker", m.rocker),
+    ];
+    let (name, longest) = links
+        .iter()
+        .copied()
+        .fold(("ground", 0.0), |acc, l| if l.1 > acc.1 { l } else { acc });
     let sum: f64 = links.iter().map(|l| l.1).sum();
-    CognatesError::NotAssemblable { longest_name: name, longest: longest * scale, others: (sum - longest) * scale }
+    CognatesError::NotAssemblable {
+        longest_name: name,
+        longest: longest * scale,
+        others: (sum - longest) * scale,
+    }
 }
 
 fn warning(code: WarningCode, message: String, mechanism: Option<MechanismId>) -> Warning {
-    Warning { code, message, mechanism, angles_deg: None }
+    Warning {
+        code,
+        message,
+        mechanism,
+        angles_deg: None,
+    }
 }
 
 /// Snapshot of all three mechanisms for the original's input `spec` (spec §4.4, §4.6).
@@ -279,7 +350,13 @@ fn snapshots(family: &Family, spec: SnapshotSpec) -> [SnapshotResult; 3] {
     let one = C64::new(1.0, 0.0);
     let t1 = spec.branch;
     let theta2_cog2 = wrap_pi(spec.theta + (one - orig.k).arg());
-    let undetermined = |status, theta, branch| SnapshotResult { status, theta, branch, joints: None, mu: None };
+    let undetermined = |status, theta, branch| SnapshotResult {
+        status,
+        theta,
+        branch,
+        joints: None,
+        mu: None,
+    };
     match orig.solve(spec.theta, t1, false) {
         Solve::Pose(pose) => {
             let maps = map_pose(family, &pose);
@@ -300,7 +377,11 @@ fn snapshots(family: &Family, spec: SnapshotSpec) -> [SnapshotResult; 3] {
                     1 => cognate1_branch(orig, &pose).unwrap_or(Sign::Plus),
                     _ => t1.flip(),
                 };
-                let theta = if i == 0 { spec.theta } else { (di - m.input_pivot).arg() };
+                let theta = if i == 0 {
+                    spec.theta
+                } else {
+                    (di - m.input_pivot).arg()
+                };
                 *slot = SnapshotResult {
                     status,
                     theta: Some(theta),
@@ -314,7 +395,11 @@ fn snapshots(family: &Family, spec: SnapshotSpec) -> [SnapshotResult; 3] {
         Solve::NotAssemblable { .. } => [
             undetermined(SnapStatus::NotAssemblable, Some(spec.theta), Some(t1)),
             undetermined(SnapStatus::NotAssemblable, None, None),
-            undetermined(SnapStatus::NotAssemblable, Some(theta2_cog2), Some(t1.flip())),
+            undetermined(
+                SnapStatus::NotAssemblable,
+                Some(theta2_cog2),
+                Some(t1.flip()),
+            ),
         ],
         Solve::Singular { .. } => [
             undetermined(SnapStatus::Singular, Some(spec.theta), Some(t1)),
@@ -327,10 +412,14 @@ fn snapshots(family: &Family, spec: SnapshotSpec) -> [SnapshotResult; 3] {
 /// Branches for `fixed_branch` curves; `true` when defaults had to be used.
 fn fixed_branches(mechs: &[MechOutput], spec: Option<SnapshotSpec>) -> ([Sign; 3], bool) {
     let t1 = spec.map_or(Sign::Plus, |s| s.branch);
-    let assembled =
-        mechs[0].snapshot.is_some_and(|s| matches!(s.status, SnapStatus::Ok | SnapStatus::Toggle) && s.joints.is_some());
+    let assembled = mechs[0].snapshot.is_some_and(|s| {
+        matches!(s.status, SnapStatus::Ok | SnapStatus::Toggle) && s.joints.is_some()
+    });
     if assembled {
-        let b1 = mechs[1].snapshot.and_then(|s| s.branch).unwrap_or(Sign::Plus);
+        let b1 = mechs[1]
+            .snapshot
+            .and_then(|s| s.branch)
+            .unwrap_or(Sign::Plus);
         ([t1, b1, t1.flip()], false)
     } else {
         ([t1, Sign::Plus, t1.flip()], true)
@@ -338,7 +427,10 @@ fn fixed_branches(mechs: &[MechOutput], spec: Option<SnapshotSpec>) -> ([Sign; 3
 }
 
 /// Samples one mechanism over `sweeps`: curves, metrics and (for the original) the `sync` check.
-#[allow(clippy::too_many_arguments, reason = "internal helper; the arguments are the sampling plan")]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "internal helper; the arguments are the sampling plan"
+)]
 fn trace(
     family: &Family,
     idx: usize,
@@ -364,7 +456,10 @@ fn trace(
         for j in 0..n {
             *counter += 1;
             if (*counter).is_multiple_of(BUDGET_CHECK_EVERY) && budget.check(*counter).is_some() {
-                return Err(CognatesError::Deadline { stage: "curve sampling", samples: *counter });
+                return Err(CognatesError::Deadline {
+                    stage: "curve sampling",
+                    samples: *counter,
+                });
             }
             let (phi, t) = sweep.sample(j, n, spacing);
             let theta = phi + gamma;
@@ -392,13 +487,23 @@ fn trace(
     Ok((curves, metrics))
 }
 
+/// One row of the §4.10 table: pivot names, pivots, crank origins, crank lengths, phase, dyads.
+type FiveBarRow = (
+    [&'static str; 2],
+    [C64; 2],
+    [&'static str; 2],
+    [f64; 2],
+    f64,
+    [f64; 2],
+);
+
 /// The three 1:1 geared five-bars (spec §4.10).
 fn geared_fivebars(family: &Family, snap: Option<&SnapshotResult>) -> Vec<FiveBar> {
     let [orig, cog1, cog2] = &family.mechs;
     let one = C64::new(1.0, 0.0);
     let k = orig.k;
     let (a, b, c) = (orig.input_pivot, orig.output_pivot, family.c);
-    let specs: [([&'static str; 2], [C64; 2], [&'static str; 2], [f64; 2], f64, [f64; 2]); 3] = [
+    let specs: [FiveBarRow; 3] = [
         (
             ["A", "C"],
             [a, c],
@@ -429,7 +534,13 @@ fn geared_fivebars(family: &Family, snap: Option<&SnapshotResult>) -> Vec<FiveBa
             return None;
         }
         let (d, e, p) = s.joints?;
-        let pose = super::geometry::Pose { d, e, p, h: 0.0, s: 0.0 };
+        let pose = super::geometry::Pose {
+            d,
+            e,
+            p,
+            h: 0.0,
+            s: 0.0,
+        };
         let [_, (d1, e1), (d2, e2)] = map_pose(family, &pose);
         Some([[d, d2], [e, e1], [d1, e2]])
     });
@@ -441,21 +552,41 @@ fn geared_fivebars(family: &Family, snap: Option<&SnapshotResult>) -> Vec<FiveBa
             let snapshot = tips.zip(p).map(|(t, p)| {
                 let [t1, t2] = t[i];
                 let angles = [(t1 - pivots[0]).arg(), (t2 - pivots[1]).arg()];
-                let residual = ((p - t1).norm() - dyads[0]).abs().max(((p - t2).norm() - dyads[1]).abs());
+                let residual = ((p - t1).norm() - dyads[0])
+                    .abs()
+                    .max(((p - t2).norm() - dyads[1]).abs());
                 (angles, [t1, t2], p, residual)
             });
-            FiveBar { names, pivots, from, cranks, phase: wrap_pi(phase), dyads, snapshot }
+            FiveBar {
+                names,
+                pivots,
+                from,
+                cranks,
+                phase: wrap_pi(phase),
+                dyads,
+                snapshot,
+            }
         })
         .collect()
 }
 
-fn collect_warnings(input: &CognatesInput, family: &Family, mechs: &[MechOutput], out: &mut Vec<Warning>) {
+fn collect_warnings(
+    input: &CognatesInput,
+    family: &Family,
+    mechs: &[MechOutput],
+    out: &mut Vec<Warning>,
+) {
     let rtol = input.options.grashof_rtol;
     for (i, m) in mechs.iter().enumerate() {
         let id = Some(IDS[i]);
         let name = NAMES[i];
         if m.grashof.class == GrashofClass::ChangePoint {
-            let folded: Vec<f64> = m.mech.folded_angles(rtol).into_iter().map(f64::to_degrees).collect();
+            let folded: Vec<f64> = m
+                .mech
+                .folded_angles(rtol)
+                .into_iter()
+                .map(f64::to_degrees)
+                .collect();
             out.push(Warning {
                 code: WarningCode::ChangePoint,
                 message: format!(
@@ -490,7 +621,10 @@ fn collect_warnings(input: &CognatesInput, family: &Family, mechs: &[MechOutput]
             )),
             None => {}
         }
-        if matches!(m.grashof.special, Some(Special::DeltoidCrankGround | Special::Rhombus)) {
+        if matches!(
+            m.grashof.special,
+            Some(Special::DeltoidCrankGround | Special::Rhombus)
+        ) {
             let gamma = m.mech.ground_angle();
             out.push(Warning {
                 code: WarningCode::InputLockedSegment,
@@ -533,7 +667,9 @@ fn collect_warnings(input: &CognatesInput, family: &Family, mechs: &[MechOutput]
             Some(MechanismId::Cognate2),
         ));
     }
-    let at_toggle = mechs[0].snapshot.is_some_and(|s| s.status == SnapStatus::Toggle);
+    let at_toggle = mechs[0]
+        .snapshot
+        .is_some_and(|s| s.status == SnapStatus::Toggle);
     if input.joints_at_toggle || at_toggle {
         out.push(warning(
             WarningCode::SnapshotAtToggle,
@@ -543,7 +679,12 @@ fn collect_warnings(input: &CognatesInput, family: &Family, mechs: &[MechOutput]
             Some(MechanismId::Original),
         ));
     }
-    let (lo, hi) = family.mechs.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), m| (lo.min(m.min_length()), hi.max(m.scale())));
+    let (lo, hi) = family
+        .mechs
+        .iter()
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), m| {
+            (lo.min(m.min_length()), hi.max(m.scale()))
+        });
     if hi > EXTREME_ASPECT * lo {
         out.push(warning(
             WarningCode::ExtremeAspectRatio,

@@ -24,7 +24,9 @@ pub enum CognatesError {
         others: f64,
     },
     /// The requested curves exceed the server's point cap.
-    #[error("too many curve points: {requested} (3 mechanisms × circuits × points_per_circuit) exceed the cap {cap}")]
+    #[error(
+        "too many curve points: {requested} (3 mechanisms × circuits × points_per_circuit) exceed the cap {cap}"
+    )]
     TooManyPoints {
         /// Points the request would produce.
         requested: u64,
@@ -54,7 +56,9 @@ impl From<CognatesError> for CalcFailure {
                 "/options/points_per_circuit",
                 detail,
             ),
-            CognatesError::Deadline { .. } => CalcFailure::general(ProblemClass::TooLarge, "DEADLINE_EXCEEDED", detail),
+            CognatesError::Deadline { .. } => {
+                CalcFailure::general(ProblemClass::TooLarge, "DEADLINE_EXCEEDED", detail)
+            }
         }
     }
 }

@@ -285,7 +285,10 @@ impl InputRange {
         if self.full_rotation() {
             Vec::new()
         } else {
-            self.intervals().into_iter().flat_map(|(lo, hi)| [wrap_pi(lo), wrap_pi(hi)]).collect()
+            self.intervals()
+                .into_iter()
+                .flat_map(|(lo, hi)| [wrap_pi(lo), wrap_pi(hi)])
+                .collect()
         }
     }
 
@@ -295,7 +298,10 @@ impl InputRange {
         if self.full_rotation() {
             vec![Circuit::Full(Sign::Plus), Circuit::Full(Sign::Minus)]
         } else {
-            self.intervals().into_iter().map(|(lo, hi)| Circuit::Limited { lo, hi }).collect()
+            self.intervals()
+                .into_iter()
+                .map(|(lo, hi)| Circuit::Limited { lo, hi })
+                .collect()
         }
     }
 
@@ -400,7 +406,11 @@ impl FourBar {
                 LinkRole::Coupler => "RRR3",
                 LinkRole::Output => "RRR4",
             };
-            (GrashofClass::NonGrashof, LinkageType::TripleRocker, Some(code))
+            (
+                GrashofClass::NonGrashof,
+                LinkageType::TripleRocker,
+                Some(code),
+            )
         };
         let eq = |x: f64, y: f64| (x - y).abs() <= tol;
         let (g, a, b, c) = (self.ground, self.crank, self.coupler, self.rocker);
@@ -418,7 +428,17 @@ impl FourBar {
         } else {
             None
         };
-        Grashof { class, kind, barker, special, margin, s_plus_l, p_plus_q, shortest, longest }
+        Grashof {
+            class,
+            kind,
+            barker,
+            special,
+            margin,
+            s_plus_l,
+            p_plus_q,
+            shortest,
+            longest,
+        }
     }
 
     /// Whether some input angle assembles the linkage with a motion range of non-zero width: the
@@ -436,7 +456,10 @@ impl FourBar {
     #[must_use]
     pub fn input_range(&self) -> InputRange {
         let (g, a, b, c) = (self.ground, self.crank, self.coupler, self.rocker);
-        InputRange { phi_min: included_angle(a, g, (b - c).abs()), phi_max: included_angle(a, g, b + c) }
+        InputRange {
+            phi_min: included_angle(a, g, (b - c).abs()),
+            phi_max: included_angle(a, g, b + c),
+        }
     }
 
     /// Crank tip at absolute input angle `theta` [rad].
@@ -498,7 +521,11 @@ impl FourBar {
     pub fn dyad_height(&self, d: C64, e: C64) -> (f64, f64) {
         let w = self.output_pivot - d;
         let s = w.norm();
-        if s > 0.0 { (cross(w, e - d).abs() / s, s) } else { ((e - d).norm(), 0.0) }
+        if s > 0.0 {
+            (cross(w, e - d).abs() / s, s)
+        } else {
+            ((e - d).norm(), 0.0)
+        }
     }
 
     /// Input angles (absolute, rad) at which the linkage folds flat (all joints on the ground line),
@@ -558,7 +585,10 @@ pub fn cognates(orig: &FourBar) -> Family {
         rocker: n1k * orig.coupler,
         k: k / (k - one),
     };
-    Family { c, mechs: [*orig, cog1, cog2] }
+    Family {
+        c,
+        mechs: [*orig, cog1, cog2],
+    }
 }
 
 /// The same configuration in all three mechanisms (spec §4.6): crank and rocker tips
@@ -593,19 +623,39 @@ struct Dual {
 
 impl Dual {
     fn c(v: f64) -> Self {
-        Self { v, dx: 0.0, dy: 0.0 }
+        Self {
+            v,
+            dx: 0.0,
+            dy: 0.0,
+        }
     }
     fn add(self, o: Self) -> Self {
-        Self { v: self.v + o.v, dx: self.dx + o.dx, dy: self.dy + o.dy }
+        Self {
+            v: self.v + o.v,
+            dx: self.dx + o.dx,
+            dy: self.dy + o.dy,
+        }
     }
     fn sub(self, o: Self) -> Self {
-        Self { v: self.v - o.v, dx: self.dx - o.dx, dy: self.dy - o.dy }
+        Self {
+            v: self.v - o.v,
+            dx: self.dx - o.dx,
+            dy: self.dy - o.dy,
+        }
     }
     fn mul(self, o: Self) -> Self {
-        Self { v: self.v * o.v, dx: self.dx * o.v + self.v * o.dx, dy: self.dy * o.v + self.v * o.dy }
+        Self {
+            v: self.v * o.v,
+            dx: self.dx * o.v + self.v * o.dx,
+            dy: self.dy * o.v + self.v * o.dy,
+        }
     }
     fn scale(self, s: f64) -> Self {
-        Self { v: self.v * s, dx: self.dx * s, dy: self.dy * s }
+        Self {
+            v: self.v * s,
+            dx: self.dx * s,
+            dy: self.dy * s,
+        }
     }
 }
 
@@ -619,15 +669,33 @@ pub fn sextic(mech: &FourBar, p: C64) -> (f64, f64) {
     let (a, c) = (mech.crank, mech.rocker);
     let wa = p - mech.input_pivot;
     let wb = p - mech.output_pivot;
-    let wax = Dual { v: wa.re, dx: 1.0, dy: 0.0 };
-    let way = Dual { v: wa.im, dx: 0.0, dy: 1.0 };
-    let wbx = Dual { v: wb.re, dx: 1.0, dy: 0.0 };
-    let wby = Dual { v: wb.im, dx: 0.0, dy: 1.0 };
+    let wax = Dual {
+        v: wa.re,
+        dx: 1.0,
+        dy: 0.0,
+    };
+    let way = Dual {
+        v: wa.im,
+        dx: 0.0,
+        dy: 1.0,
+    };
+    let wbx = Dual {
+        v: wb.re,
+        dx: 1.0,
+        dy: 0.0,
+    };
+    let wby = Dual {
+        v: wb.im,
+        dx: 0.0,
+        dy: 1.0,
+    };
     // z = conj(w_B)·m: Re z = wbx·m.re + wby·m.im, Im z = wbx·m.im − wby·m.re.
     let re_z = wbx.scale(m.re).add(wby.scale(m.im));
     let im_z = wbx.scale(m.im).sub(wby.scale(m.re));
     let r1 = Dual::c(a * a - d * d).sub(wax.mul(wax)).sub(way.mul(way));
-    let r2 = Dual::c(c * c - m.norm_sqr()).sub(wbx.mul(wbx)).sub(wby.mul(wby));
+    let r2 = Dual::c(c * c - m.norm_sqr())
+        .sub(wbx.mul(wbx))
+        .sub(wby.mul(wby));
     let a11 = wax.scale(2.0 * d);
     let a12 = way.scale(2.0 * d);
     let a21 = re_z.scale(2.0);
@@ -661,15 +729,22 @@ mod tests {
     #[test]
     fn sextic_vanishes_on_the_curve_and_gradient_matches_finite_differences() {
         let m = paper();
-        let Solve::Pose(pose) = m.solve(30f64.to_radians(), Sign::Plus, false) else { panic!("assembles") };
+        let Solve::Pose(pose) = m.solve(30f64.to_radians(), Sign::Plus, false) else {
+            panic!("assembles")
+        };
         let (f, g) = sextic(&m, pose.p);
         assert!(f.abs() / g < 1e-13, "F = {f}, |grad| = {g}");
         let q = C64::new(0.3, 0.7);
         let (f0, g0) = sextic(&m, q);
         let hstep = 1e-6;
-        let fx = (sextic(&m, q + C64::new(hstep, 0.0)).0 - sextic(&m, q - C64::new(hstep, 0.0)).0) / (2.0 * hstep);
-        let fy = (sextic(&m, q + C64::new(0.0, hstep)).0 - sextic(&m, q - C64::new(0.0, hstep)).0) / (2.0 * hstep);
-        assert!((fx.hypot(fy) - g0).abs() < 1e-6 * g0.max(1.0), "{fx} {fy} {g0} {f0}");
+        let fx = (sextic(&m, q + C64::new(hstep, 0.0)).0 - sextic(&m, q - C64::new(hstep, 0.0)).0)
+            / (2.0 * hstep);
+        let fy = (sextic(&m, q + C64::new(0.0, hstep)).0 - sextic(&m, q - C64::new(0.0, hstep)).0)
+            / (2.0 * hstep);
+        assert!(
+            (fx.hypot(fy) - g0).abs() < 1e-6 * g0.max(1.0),
+            "{fx} {fy} {g0} {f0}"
+        );
     }
 
     #[test]

@@ -12,7 +12,9 @@
 use crate::calc::{CalcFailure, FieldIssue, ProblemClass};
 
 use super::geometry::{C64, FourBar, Sign, cis, cross};
-use super::wire::{AngleReference, CognatesRequest, CouplerPoint, CurveMode, Spacing, VerifyKind, WireSign};
+use super::wire::{
+    AngleReference, CognatesRequest, CouplerPoint, CurveMode, Spacing, VerifyKind, WireSign,
+};
 
 /// Largest magnitude accepted for any coordinate or length: keeps `|B − A|` and every product of
 /// two lengths finite (1e100² = 1e200 < f64::MAX), far beyond any physical unit choice.
@@ -108,7 +110,13 @@ struct Issues {
 
 impl Issues {
     fn push(&mut self, code: &'static str, pointer: impl Into<String>, detail: impl Into<String>) {
-        self.list.push((code, FieldIssue { pointer: pointer.into(), detail: detail.into() }));
+        self.list.push((
+            code,
+            FieldIssue {
+                pointer: pointer.into(),
+                detail: detail.into(),
+            },
+        ));
     }
 
     fn is_clean(&self) -> bool {
@@ -118,10 +126,18 @@ impl Issues {
     /// A positive, finite, bounded length.
     fn length(&mut self, pointer: &str, name: &str, x: f64) -> bool {
         if !x.is_finite() || x <= 0.0 {
-            self.push("NON_POSITIVE_LENGTH", pointer, format!("{name} must be a finite length > 0, got {x}"));
+            self.push(
+                "NON_POSITIVE_LENGTH",
+                pointer,
+                format!("{name} must be a finite length > 0, got {x}"),
+            );
             false
         } else if x > MAX_MAGNITUDE {
-            self.push("INVALID_INPUT", pointer, format!("{name} must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"));
+            self.push(
+                "INVALID_INPUT",
+                pointer,
+                format!("{name} must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"),
+            );
             false
         } else {
             true
@@ -131,10 +147,18 @@ impl Issues {
     /// A non-negative, finite, bounded length.
     fn non_negative(&mut self, pointer: &str, name: &str, x: f64) -> bool {
         if !x.is_finite() || x < 0.0 {
-            self.push("NON_POSITIVE_LENGTH", pointer, format!("{name} must be a finite length ≥ 0, got {x}"));
+            self.push(
+                "NON_POSITIVE_LENGTH",
+                pointer,
+                format!("{name} must be a finite length ≥ 0, got {x}"),
+            );
             false
         } else if x > MAX_MAGNITUDE {
-            self.push("INVALID_INPUT", pointer, format!("{name} must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"));
+            self.push(
+                "INVALID_INPUT",
+                pointer,
+                format!("{name} must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"),
+            );
             false
         } else {
             true
@@ -144,10 +168,18 @@ impl Issues {
     /// A finite, bounded coordinate or signed length.
     fn coord(&mut self, pointer: &str, name: &str, x: f64) -> bool {
         if !x.is_finite() {
-            self.push("NON_POSITIVE_LENGTH", pointer, format!("{name} must be a finite number, got {x}"));
+            self.push(
+                "NON_POSITIVE_LENGTH",
+                pointer,
+                format!("{name} must be a finite number, got {x}"),
+            );
             false
         } else if x.abs() > MAX_MAGNITUDE {
-            self.push("INVALID_INPUT", pointer, format!("|{name}| must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"));
+            self.push(
+                "INVALID_INPUT",
+                pointer,
+                format!("|{name}| must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"),
+            );
             false
         } else {
             true
@@ -164,7 +196,11 @@ impl Issues {
         if x.is_finite() {
             true
         } else {
-            self.push("NON_POSITIVE_LENGTH", pointer, format!("{name} must be a finite angle, got {x}"));
+            self.push(
+                "NON_POSITIVE_LENGTH",
+                pointer,
+                format!("{name} must be a finite angle, got {x}"),
+            );
             false
         }
     }
@@ -172,11 +208,22 @@ impl Issues {
     /// `Ok` when clean; else one failure with every issue so far, coded by the first.
     fn finish(&mut self) -> Result<(), CalcFailure> {
         let list = std::mem::take(&mut self.list);
-        let Some((code, first)) = list.first() else { return Ok(()) };
+        let Some((code, first)) = list.first() else {
+            return Ok(());
+        };
         let code = *code;
         let n = list.len();
-        let detail = if n == 1 { format!("{} {}", first.pointer, first.detail) } else { format!("{n} fields failed validation") };
-        Err(CalcFailure { class: ProblemClass::InvalidInput, code, detail, errors: list.into_iter().map(|(_, i)| i).collect() })
+        let detail = if n == 1 {
+            format!("{} {}", first.pointer, first.detail)
+        } else {
+            format!("{n} fields failed validation")
+        };
+        Err(CalcFailure {
+            class: ProblemClass::InvalidInput,
+            code,
+            detail,
+            errors: list.into_iter().map(|(_, i)| i).collect(),
+        })
     }
 }
 
@@ -201,7 +248,10 @@ fn sign_of(w: WireSign) -> Sign {
 /// A power of two within a factor √2 of `x > 0`: dividing by it is exact.
 fn power_of_two_near(x: f64) -> f64 {
     // x is finite, positive and ≤ ~1e101 here, so log2 is in (−1100, 340) and the cast cannot wrap.
-    #[allow(clippy::cast_possible_truncation, reason = "bounded: see the comment above")]
+    #[allow(
+        clippy::cast_possible_truncation,
+        reason = "bounded: see the comment above"
+    )]
     let e = x.log2().round() as i32;
     2f64.powi(e)
 }
@@ -222,14 +272,20 @@ fn validate_options(req: &CognatesRequest, issues: &mut Issues) -> Options {
         issues.push(
             "INVALID_INPUT",
             "/options/points_per_circuit",
-            format!("points_per_circuit must be in [{lo}, {hi}], got {}", o.points_per_circuit),
+            format!(
+                "points_per_circuit must be in [{lo}, {hi}], got {}",
+                o.points_per_circuit
+            ),
         );
     }
     if !(o.grashof_rtol.is_finite() && (0.0..=MAX_GRASHOF_RTOL).contains(&o.grashof_rtol)) {
         issues.push(
             "INVALID_INPUT",
             "/options/grashof_rtol",
-            format!("grashof_rtol must be in [0, {MAX_GRASHOF_RTOL}], got {}", o.grashof_rtol),
+            format!(
+                "grashof_rtol must be in [0, {MAX_GRASHOF_RTOL}], got {}",
+                o.grashof_rtol
+            ),
         );
     }
     Options {
@@ -260,8 +316,14 @@ impl TryFrom<CognatesRequest> for CognatesInput {
     }
 }
 
-fn joints_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -> Result<CognatesInput, CalcFailure> {
-    let Some(j) = req.joints else { unreachable!("joints_mode is called with joints present") };
+fn joints_mode(
+    req: &CognatesRequest,
+    options: Options,
+    mut issues: Issues,
+) -> Result<CognatesInput, CalcFailure> {
+    let Some(j) = req.joints else {
+        unreachable!("joints_mode is called with joints present")
+    };
     let conflicts = [
         ("/ground", req.ground.is_some()),
         ("/crank", req.crank.is_some()),
@@ -273,12 +335,18 @@ fn joints_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -> R
     ];
     for (ptr, present) in conflicts {
         if present {
-            issues.push("INVALID_INPUT", ptr, "must be omitted with `joints` (read from the drawn configuration)");
+            issues.push(
+                "INVALID_INPUT",
+                ptr,
+                "must be omitted with `joints` (read from the drawn configuration)",
+            );
         }
     }
     let ok = [("A", j.a), ("B", j.b), ("D", j.d), ("E", j.e), ("P", j.p)]
         .into_iter()
-        .fold(true, |acc, (n, p)| issues.point(&format!("/joints/{n}"), n, p) && acc);
+        .fold(true, |acc, (n, p)| {
+            issues.point(&format!("/joints/{n}"), n, p) && acc
+        });
     if !ok || !issues.is_clean() {
         issues.finish()?;
     }
@@ -287,17 +355,34 @@ fn joints_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -> R
     let crank = (d - a).norm();
     let coupler = (e - d).norm();
     let rocker = (e - b).norm();
-    let big_l = l.max(crank).max(coupler).max(rocker).max((p - d).norm()).max((p - e).norm());
+    let big_l = l
+        .max(crank)
+        .max(coupler)
+        .max(rocker)
+        .max((p - d).norm())
+        .max((p - e).norm());
     if !(big_l.is_finite() && big_l > 0.0) {
         issues.push("NON_POSITIVE_LENGTH", "/joints", "all joints coincide");
         issues.finish()?;
     }
     if l <= COINCIDENT_REL * big_l {
-        issues.push("COINCIDENT_PIVOTS", "/joints/B", format!("B coincides with A: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"));
+        issues.push(
+            "COINCIDENT_PIVOTS",
+            "/joints/B",
+            format!("B coincides with A: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"),
+        );
     }
-    for (ptr, name, len) in [("/joints/D", "crank |D − A|", crank), ("/joints/E", "coupler |E − D|", coupler), ("/joints/E", "rocker |E − B|", rocker)] {
+    for (ptr, name, len) in [
+        ("/joints/D", "crank |D − A|", crank),
+        ("/joints/E", "coupler |E − D|", coupler),
+        ("/joints/E", "rocker |E − B|", rocker),
+    ] {
         if len <= LENGTH_FLOOR_REL * big_l {
-            issues.push("NON_POSITIVE_LENGTH", ptr, format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"));
+            issues.push(
+                "NON_POSITIVE_LENGTH",
+                ptr,
+                format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"),
+            );
         }
     }
     if !issues.is_clean() {
@@ -328,40 +413,71 @@ fn joints_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -> R
         mech,
         side: Sign::of(k.im).unwrap_or(Sign::Plus),
         collinear,
-        snapshot: Some(SnapshotSpec { theta: (d - a).arg(), branch: t.unwrap_or(Sign::Plus) }),
+        snapshot: Some(SnapshotSpec {
+            theta: (d - a).arg(),
+            branch: t.unwrap_or(Sign::Plus),
+        }),
         joints_at_toggle: t.is_none(),
         options,
     })
 }
 
 fn check_at_joint(issues: &mut Issues, ptr: &str, k: C64, one: C64) {
-    if !(k.norm() > AT_JOINT_TOL) {
-        issues.push("COUPLER_POINT_AT_JOINT", ptr, format!("P coincides with the crank joint D: |k| = {:e} ≤ 1e-9", k.norm()));
-    } else if !((one - k).norm() > AT_JOINT_TOL) {
+    if k.norm() <= AT_JOINT_TOL {
         issues.push(
             "COUPLER_POINT_AT_JOINT",
             ptr,
-            format!("P coincides with the rocker joint E: |1 − k| = {:e} ≤ 1e-9", (one - k).norm()),
+            format!(
+                "P coincides with the crank joint D: |k| = {:e} ≤ 1e-9",
+                k.norm()
+            ),
+        );
+    } else if (one - k).norm() <= AT_JOINT_TOL {
+        issues.push(
+            "COUPLER_POINT_AT_JOINT",
+            ptr,
+            format!(
+                "P coincides with the rocker joint E: |1 − k| = {:e} ≤ 1e-9",
+                (one - k).norm()
+            ),
         );
     }
 }
 
-fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -> Result<CognatesInput, CalcFailure> {
+fn dimension_mode(
+    req: &CognatesRequest,
+    options: Options,
+    mut issues: Issues,
+) -> Result<CognatesInput, CalcFailure> {
     // --- field checks ---
     let mut ground_ok = false;
     let mut a_raw = [0.0, 0.0];
     let mut b_raw = [0.0, 0.0];
     match &req.ground {
-        None => issues.push("INVALID_INPUT", "/ground", "ground is required (or give `joints`)"),
+        None => issues.push(
+            "INVALID_INPUT",
+            "/ground",
+            "ground is required (or give `joints`)",
+        ),
         Some(g) => {
             a_raw = g.a.unwrap_or([0.0, 0.0]);
             let a_ok = issues.point("/ground/A", "A", a_raw);
             match (g.b, g.length) {
-                (Some(_), Some(_)) => issues.push("INVALID_INPUT", "/ground/length", "give either B or length, not both"),
-                (None, None) => issues.push("INVALID_INPUT", "/ground/B", "B (or length) is required"),
+                (Some(_), Some(_)) => issues.push(
+                    "INVALID_INPUT",
+                    "/ground/length",
+                    "give either B or length, not both",
+                ),
+                (None, None) => {
+                    issues.push("INVALID_INPUT", "/ground/B", "B (or length) is required")
+                }
                 (Some(b), None) => {
                     if g.angle_deg.is_some() {
-                        issues.push("INVALID_INPUT", "/ground/angle_deg", "angle_deg goes with length, not with B");
+                        issues.push(
+                            "INVALID_INPUT",
+                            "/ground/angle_deg",
+                            "angle_deg goes with length, not with B",
+                        );
                     }
                     b_raw = b;
                     ground_ok = issues.point("/ground/B", "B", b) && a_ok;
@@ -381,14 +497,21 @@ fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -
     }
     let mut lens = [0.0; 3];
     let mut lens_ok = true;
-    for (i, (ptr, name, v)) in
-        [("/crank", "crank a", req.crank), ("/coupler", "coupler b", req.coupler), ("/rocker", "rocker c", req.rocker)]
-            .into_iter()
-            .enumerate()
+    for (i, (ptr, name, v)) in [
+        ("/crank", "crank a", req.crank),
+        ("/coupler", "coupler b", req.coupler),
+        ("/rocker", "rocker c", req.rocker),
+    ]
+    .into_iter()
+    .enumerate()
     {
         match v {
             None => {
-                issues.push("INVALID_INPUT", ptr, format!("{name} is required (or give `joints`)"));
+                issues.push(
+                    "INVALID_INPUT",
+                    ptr,
+                    format!("{name} is required (or give `joints`)"),
+                );
                 lens_ok = false;
             }
             Some(x) => {
@@ -399,7 +522,11 @@ fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -
     }
     let cp_ok = match req.coupler_point {
         None => {
-            issues.push("INVALID_INPUT", "/coupler_point", "coupler_point is required (or give `joints`)");
+            issues.push(
+                "INVALID_INPUT",
+                "/coupler_point",
+                "coupler_point is required (or give `joints`)",
+            );
             false
         }
         Some(CouplerPoint::Triangle { d, e, .. }) => {
@@ -421,7 +548,9 @@ fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -
     if !(ground_ok && lens_ok && cp_ok && issues.is_clean()) {
         issues.finish()?;
     }
-    let Some(cp) = req.coupler_point else { unreachable!("checked above") };
+    let Some(cp) = req.coupler_point else {
+        unreachable!("checked above")
+    };
     let [crank, coupler, rocker] = lens;
     let a = c64(a_raw);
     let b = c64(b_raw);
@@ -431,9 +560,13 @@ fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -
     let coupler_data = match cp {
         CouplerPoint::Triangle { d, e, side } => {
             let slack = TRIANGLE_SLACK_REL * coupler.max(d).max(e);
-            let violated = [(d, coupler + e, "d > b + e"), (e, coupler + d, "e > b + d"), (coupler, d + e, "b > d + e")]
-                .into_iter()
-                .find(|(x, s, _)| *x > *s + slack);
+            let violated = [
+                (d, coupler + e, "d > b + e"),
+                (e, coupler + d, "e > b + d"),
+                (coupler, d + e, "b > d + e"),
+            ]
+            .into_iter()
+            .find(|(x, s, _)| *x > *s + slack);
             if let Some((_, _, what)) = violated {
                 issues.push(
                     "COUPLER_TRIANGLE_INVALID",
@@ -449,16 +582,31 @@ fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -
                 let re = (dn * dn + (bn - en) * (bn + en)) / (2.0 * bn * bn);
                 let heron = (dn + bn + en) * (-dn + bn + en) * (dn - bn + en) * (dn + bn - en);
                 let im = t.value() * heron.max(0.0).sqrt() / (2.0 * bn * bn);
-                Some(CouplerData { k: C64::new(re, im), d, e, side: Some(t) })
+                Some(CouplerData {
+                    k: C64::new(re, im),
+                    d,
+                    e,
+                    side: Some(t),
+                })
             }
         }
         CouplerPoint::Frame { u, v } => {
             let k = C64::new(u, v) / coupler;
-            Some(CouplerData { k, d: u.hypot(v), e: (coupler - u).hypot(v), side: None })
+            Some(CouplerData {
+                k,
+                d: u.hypot(v),
+                e: (coupler - u).hypot(v),
+                side: None,
+            })
         }
         CouplerPoint::Polar { p, alpha_deg } => {
             let z = cis(deg_to_rad(alpha_deg)) * p;
-            Some(CouplerData { k: z / coupler, d: p, e: (C64::new(coupler, 0.0) - z).norm(), side: None })
+            Some(CouplerData {
+                k: z / coupler,
+                d: p,
+                e: (C64::new(coupler, 0.0) - z).norm(),
+                side: None,
+            })
         }
     };
     let l = (b - a).norm();
@@ -467,20 +615,34 @@ fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -
     if l <= COINCIDENT_REL * big_l {
         issues.push(
             "COINCIDENT_PIVOTS",
-            if req.ground.as_ref().is_some_and(|g| g.length.is_some()) { "/ground/length" } else { "/ground/B" },
+            if req.ground.as_ref().is_some_and(|g| g.length.is_some()) {
+                "/ground/length"
+            } else {
+                "/ground/B"
+            },
             format!("ground pivots coincide: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"),
         );
     }
-    for (ptr, name, len) in [("/crank", "crank a", crank), ("/coupler", "coupler b", coupler), ("/rocker", "rocker c", rocker)] {
+    for (ptr, name, len) in [
+        ("/crank", "crank a", crank),
+        ("/coupler", "coupler b", coupler),
+        ("/rocker", "rocker c", rocker),
+    ] {
         if len < LENGTH_FLOOR_REL * big_l {
-            issues.push("NON_POSITIVE_LENGTH", ptr, format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"));
+            issues.push(
+                "NON_POSITIVE_LENGTH",
+                ptr,
+                format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"),
+            );
         }
     }
     if let Some(cd) = &coupler_data {
         check_at_joint(&mut issues, "/coupler_point", cd.k, one);
     }
     issues.finish()?;
-    let Some(cd) = coupler_data else { unreachable!("issues would have been reported") };
+    let Some(cd) = coupler_data else {
+        unreachable!("issues would have been reported")
+    };
 
     // --- normalised frame ---
     let scale = power_of_two_near(big_l);
@@ -495,14 +657,19 @@ fn dimension_mode(req: &CognatesRequest, options: Options, mut issues: Issues) -
         k: cd.k,
     };
     let collinear = cd.k.im.abs() * coupler <= COLLINEAR_REL * coupler.max(cd.d).max(cd.e);
-    let side = cd.side.unwrap_or_else(|| Sign::of(cd.k.im).unwrap_or(Sign::Plus));
+    let side = cd
+        .side
+        .unwrap_or_else(|| Sign::of(cd.k.im).unwrap_or(Sign::Plus));
     let snapshot = req.input_angle_deg.map(|deg| {
         let rel = deg_to_rad(deg);
         let theta = match req.angle_reference {
             AngleReference::Global => rel,
             AngleReference::Ground => rel + mech.ground_angle(),
         };
-        SnapshotSpec { theta: super::geometry::wrap_pi(theta), branch: req.branch.map_or(Sign::Plus, sign_of) }
+        SnapshotSpec {
+            theta: super::geometry::wrap_pi(theta),
+            branch: req.branch.map_or(Sign::Plus, sign_of),
+        }
     });
     Ok(CognatesInput {
         origin: a,

@@ -69,10 +69,10 @@ pub use wire::{CognatesRequest, CognatesResponse};
 use compute::{Curve, FiveBar, MechOutput, Metrics, SnapStatus, SnapshotResult};
 use geometry::{C64, GrashofClass, LinkRole, LinkageType, Special, wrap_pi};
 use wire::{
-    CurveOut, FiveBarSnapshot, Footprint, GearedFiveBar, GrashofClassOut, GrashofOut, HausdorffCheck, ImplicitCheck,
-    InputRangeOut, JointsOut, LinkRoleOut, LinkageTypeOut, Links, MechanismId, MechanismOut, Meta, MetricsOut,
-    OriginalLink, RotationMap, SimilarSides, Similarity, SnapshotOut, SnapshotStatus, SpecialOut, SyncCheck, TurnsWith,
-    Verification,
+    CurveOut, FiveBarSnapshot, Footprint, GearedFiveBar, GrashofClassOut, GrashofOut,
+    HausdorffCheck, ImplicitCheck, InputRangeOut, JointsOut, LinkRoleOut, LinkageTypeOut, Links,
+    MechanismId, MechanismOut, Meta, MetricsOut, OriginalLink, RotationMap, SimilarSides,
+    Similarity, SnapshotOut, SnapshotStatus, SpecialOut, SyncCheck, TurnsWith, Verification,
 };
 
 /// Entry point of `POST /v1/cognates`: validate, compute, build the wire response.
@@ -92,15 +92,26 @@ pub fn run(req: CognatesRequest, budget: &Budget) -> Result<CognatesResponse, Ca
 /// Converts the normalised output to the caller's units.
 #[must_use]
 pub fn to_wire(input: &CognatesInput, out: &CognatesOutput) -> CognatesResponse {
-    let fr = Frame { origin: input.origin, scale: input.scale };
+    let fr = Frame {
+        origin: input.origin,
+        scale: input.scale,
+    };
     let family = &out.family;
     let orig = &family.mechs[0];
     let k = orig.k;
     let one = C64::new(1.0, 0.0);
     let c_pt = fr.pt(family.c);
     // Pivots echoed exactly where they are the caller's A and B.
-    let pivots = [(input.a_raw, input.b_raw), (input.a_raw, c_pt), (c_pt, input.b_raw)];
-    let ids = [MechanismId::Original, MechanismId::Cognate1, MechanismId::Cognate2];
+    let pivots = [
+        (input.a_raw, input.b_raw),
+        (input.a_raw, c_pt),
+        (c_pt, input.b_raw),
+    ];
+    let ids = [
+        MechanismId::Original,
+        MechanismId::Cognate1,
+        MechanismId::Cognate2,
+    ];
     let mechanisms = out
         .mechs
         .iter()
@@ -131,7 +142,11 @@ pub fn to_wire(input: &CognatesInput, out: &CognatesOutput) -> CognatesResponse 
         n_points: n,
     });
     let verification =
-        (sync.is_some() || implicit.is_some() || hausdorff.is_some()).then_some(Verification { sync, implicit, hausdorff });
+        (sync.is_some() || implicit.is_some() || hausdorff.is_some()).then_some(Verification {
+            sync,
+            implicit,
+            hausdorff,
+        });
     CognatesResponse {
         c: c_pt,
         similarity: Similarity {
@@ -142,9 +157,15 @@ pub fn to_wire(input: &CognatesInput, out: &CognatesOutput) -> CognatesResponse 
         },
         mechanisms,
         verification,
-        geared_fivebars: out.fivebars.as_ref().map(|f| f.iter().map(|b| fivebar_out(&fr, b)).collect()),
+        geared_fivebars: out
+            .fivebars
+            .as_ref()
+            .map(|f| f.iter().map(|b| fivebar_out(&fr, b)).collect()),
         warnings: out.warnings.clone(),
-        meta: Meta { points_total: out.points_total, compute_us: 0 },
+        meta: Meta {
+            points_total: out.points_total,
+            compute_us: 0,
+        },
     }
 }
 
@@ -190,15 +211,33 @@ fn mechanism_out(
     let intervals = m.range.intervals();
     let rotation_map = match i {
         1 => Some(RotationMap {
-            crank: TurnsWith { turns_with: OriginalLink::Coupler, offset_deg: deg(k_orig.arg()) },
-            coupler: TurnsWith { turns_with: OriginalLink::Crank, offset_deg: deg(k_orig.arg()) },
-            rocker: TurnsWith { turns_with: OriginalLink::Rocker, offset_deg: deg(k_orig.arg()) },
+            crank: TurnsWith {
+                turns_with: OriginalLink::Coupler,
+                offset_deg: deg(k_orig.arg()),
+            },
+            coupler: TurnsWith {
+                turns_with: OriginalLink::Crank,
+                offset_deg: deg(k_orig.arg()),
+            },
+            rocker: TurnsWith {
+                turns_with: OriginalLink::Rocker,
+                offset_deg: deg(k_orig.arg()),
+            },
             same_timing_as_original: false,
         }),
         2 => Some(RotationMap {
-            crank: TurnsWith { turns_with: OriginalLink::Crank, offset_deg: deg((one - k_orig).arg()) },
-            coupler: TurnsWith { turns_with: OriginalLink::Rocker, offset_deg: deg((k_orig - one).arg()) },
-            rocker: TurnsWith { turns_with: OriginalLink::Coupler, offset_deg: deg((k_orig - one).arg()) },
+            crank: TurnsWith {
+                turns_with: OriginalLink::Crank,
+                offset_deg: deg((one - k_orig).arg()),
+            },
+            coupler: TurnsWith {
+                turns_with: OriginalLink::Rocker,
+                offset_deg: deg((k_orig - one).arg()),
+            },
+            rocker: TurnsWith {
+                turns_with: OriginalLink::Coupler,
+                offset_deg: deg((k_orig - one).arg()),
+            },
             same_timing_as_original: true,
         }),
         _ => None,
@@ -219,10 +258,17 @@ fn mechanism_out(
             coupler_angle_at_crank_joint_deg: mech.k.arg().abs().to_degrees(),
             k: [mech.k.re, mech.k.im],
         },
-        similar_sides: SimilarSides { b: fr.len(similar.0), d: fr.len(similar.1), e: fr.len(similar.2) },
+        similar_sides: SimilarSides {
+            b: fr.len(similar.0),
+            d: fr.len(similar.1),
+            e: fr.len(similar.2),
+        },
         grashof: grashof_out(fr, &m.grashof),
         input_range: InputRangeOut {
-            intervals_rel_deg: intervals.iter().map(|(lo, hi)| [lo.to_degrees(), hi.to_degrees()]).collect(),
+            intervals_rel_deg: intervals
+                .iter()
+                .map(|(lo, hi)| [lo.to_degrees(), hi.to_degrees()])
+                .collect(),
             intervals_abs_deg: intervals
                 .iter()
                 .map(|(lo, hi)| {
@@ -231,12 +277,23 @@ fn mechanism_out(
                 })
                 .collect(),
             full_rotation: m.range.full_rotation(),
-            toggle_angles_abs_deg: m.range.toggles().into_iter().map(|t| deg(t + gamma)).collect(),
+            toggle_angles_abs_deg: m
+                .range
+                .toggles()
+                .into_iter()
+                .map(|t| deg(t + gamma))
+                .collect(),
             n_circuits: m.range.circuits().len(),
         },
         rotation_map,
-        snapshot: m.snapshot.as_ref().map(|s| snapshot_out(fr, s, gamma, (pin, pout))),
-        curves: m.curves.as_ref().map(|cs| cs.iter().map(|c| curve_out(fr, c)).collect()),
+        snapshot: m
+            .snapshot
+            .as_ref()
+            .map(|s| snapshot_out(fr, s, gamma, (pin, pout))),
+        curves: m
+            .curves
+            .as_ref()
+            .map(|cs| cs.iter().map(|c| curve_out(fr, c)).collect()),
         metrics: m.metrics.as_ref().map(|x| metrics_out(fr, i, m, x)),
     }
 }
@@ -276,7 +333,12 @@ fn grashof_out(fr: &Frame, g: &geometry::Grashof) -> GrashofOut {
     }
 }
 
-fn snapshot_out(fr: &Frame, s: &SnapshotResult, gamma: f64, (pin, pout): ([f64; 2], [f64; 2])) -> SnapshotOut {
+fn snapshot_out(
+    fr: &Frame,
+    s: &SnapshotResult,
+    gamma: f64,
+    (pin, pout): ([f64; 2], [f64; 2]),
+) -> SnapshotOut {
     SnapshotOut {
         status: match s.status {
             SnapStatus::Ok => SnapshotStatus::Ok,
@@ -315,8 +377,18 @@ fn metrics_out(fr: &Frame, i: usize, m: &MechOutput, x: &Metrics) -> MetricsOut 
     MetricsOut {
         link_length_sum: fr.len(mech.ground + mech.crank + mech.coupler + mech.rocker),
         ground_span: fr.len(mech.ground),
-        coupler_max_side: fr.len(mech.coupler.max(mech.crank_joint_to_p()).max(mech.rocker_joint_to_p())),
-        footprint: Footprint { min: lo, max: hi, width: w, height: h, area: w * h },
+        coupler_max_side: fr.len(
+            mech.coupler
+                .max(mech.crank_joint_to_p())
+                .max(mech.rocker_joint_to_p()),
+        ),
+        footprint: Footprint {
+            min: lo,
+            max: hi,
+            width: w,
+            height: h,
+            area: w * h,
+        },
         transmission_angle_min_deg: x.mu_min.to_degrees(),
         transmission_angle_max_deg: x.mu_max.to_degrees(),
         full_rotation: m.range.full_rotation(),
@@ -335,13 +407,15 @@ fn fivebar_out(fr: &Frame, b: &FiveBar) -> GearedFiveBar {
         phase_deg: b.phase.to_degrees(),
         dyad1: fr.len(b.dyads[0]),
         dyad2: fr.len(b.dyads[1]),
-        snapshot: b.snapshot.map(|(angles, tips, p, residual)| FiveBarSnapshot {
-            crank1_angle_deg: deg(angles[0]),
-            crank2_angle_deg: deg(angles[1]),
-            crank1_tip: fr.pt(tips[0]),
-            crank2_tip: fr.pt(tips[1]),
-            p: fr.pt(p),
-            dyad_residual: fr.len(residual),
-        }),
+        snapshot: b
+            .snapshot
+            .map(|(angles, tips, p, residual)| FiveBarSnapshot {
+                crank1_angle_deg: deg(angles[0]),
+                crank2_angle_deg: deg(angles[1]),
+                crank1_tip: fr.pt(tips[0]),
+                crank2_tip: fr.pt(tips[1]),
+                p: fr.pt(p),
+                dyad_residual: fr.len(residual),
+            }),
     }
 }

@@ -25,7 +25,11 @@ pub fn circuit_param(circuit: &Circuit, u: f64, spacing: Spacing) -> (f64, Sign)
                 // land exactly on the toggles lo and hi.
                 Spacing::Auto => {
                     let c = u.cos();
-                    if c >= 0.0 { lo + (hi - lo) * (0.5 * (1.0 - c)) } else { hi - (hi - lo) * (0.5 * (1.0 + c)) }
+                    if c >= 0.0 {
+                        lo + (hi - lo) * (0.5 * (1.0 - c))
+                    } else {
+                        hi - (hi - lo) * (0.5 * (1.0 + c))
+                    }
                 }
                 Spacing::Uniform => {
                     let t = u / PI;
@@ -47,7 +51,10 @@ pub fn circuit_param(circuit: &Circuit, u: f64, spacing: Spacing) -> (f64, Sign)
 #[must_use]
 pub fn sample_u(j: usize, n: usize) -> f64 {
     // j < n ≤ 100 000 here: both convert to f64 exactly.
-    #[allow(clippy::cast_precision_loss, reason = "j and n are ≤ 1e5, exact in f64")]
+    #[allow(
+        clippy::cast_precision_loss,
+        reason = "j and n are ≤ 1e5, exact in f64"
+    )]
     let t = j as f64 / n as f64;
     2.0 * PI * t
 }
@@ -87,10 +94,22 @@ impl Sweep {
     pub fn sample(&self, j: usize, n: usize, spacing: Spacing) -> (f64, Sign) {
         match self {
             Self::Circuit(c) => circuit_param(c, sample_u(j, n), spacing),
-            Self::Fixed { lo, hi, branch, closed } => {
+            Self::Fixed {
+                lo,
+                hi,
+                branch,
+                closed,
+            } => {
                 // j < n ≤ 100 000: exact in f64.
-                #[allow(clippy::cast_precision_loss, reason = "j and n are ≤ 1e5, exact in f64")]
-                let t = if *closed { j as f64 / n as f64 } else { j as f64 / (n.max(2) - 1) as f64 };
+                #[allow(
+                    clippy::cast_precision_loss,
+                    reason = "j and n are ≤ 1e5, exact in f64"
+                )]
+                let t = if *closed {
+                    j as f64 / n as f64
+                } else {
+                    j as f64 / (n.max(2) - 1) as f64
+                };
                 (lo + (hi - lo) * t, *branch)
             }
         }
@@ -111,13 +130,26 @@ impl Sweep {
 pub fn fixed_sweeps(mech: &FourBar, branch: Sign) -> Vec<Sweep> {
     let range = mech.input_range();
     let full = range.full_rotation();
-    range.intervals().into_iter().map(|(lo, hi)| Sweep::Fixed { lo, hi, branch, closed: full }).collect()
+    range
+        .intervals()
+        .into_iter()
+        .map(|(lo, hi)| Sweep::Fixed {
+            lo,
+            hi,
+            branch,
+            closed: full,
+        })
+        .collect()
 }
 
 /// The sweeps of a mechanism in `circuits` mode.
 #[must_use]
 pub fn circuit_sweeps(mech: &FourBar) -> Vec<Sweep> {
-    mech.input_range().circuits().into_iter().map(Sweep::Circuit).collect()
+    mech.input_range()
+        .circuits()
+        .into_iter()
+        .map(Sweep::Circuit)
+        .collect()
 }
 
 /// Distance from `q` to the segment `a–b`.
@@ -125,7 +157,11 @@ pub fn circuit_sweeps(mech: &FourBar) -> Vec<Sweep> {
 pub fn point_segment_distance(q: C64, a: C64, b: C64) -> f64 {
     let ab = b - a;
     let len2 = ab.norm_sqr();
-    let t = if len2 > 0.0 { (((q - a).re * ab.re + (q - a).im * ab.im) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if len2 > 0.0 {
+        (((q - a).re * ab.re + (q - a).im * ab.im) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     (q - (a + ab * t)).norm()
 }
 
@@ -139,8 +175,10 @@ pub fn chord_error(mech: &FourBar, n: usize, spacing: Spacing, sub: usize) -> f6
     for circuit in mech.input_range().circuits() {
         for j in 0..n {
             let (u0, u1) = (sample_u(j, n), sample_u(j + 1, n));
-            let (Some(p0), Some(p1)) = (curve_point(mech, &circuit, u0, spacing), curve_point(mech, &circuit, u1, spacing))
-            else {
+            let (Some(p0), Some(p1)) = (
+                curve_point(mech, &circuit, u0, spacing),
+                curve_point(mech, &circuit, u1, spacing),
+            ) else {
                 continue;
             };
             for s in 1..sub {

@@ -2,7 +2,9 @@
 //! residuals, independent re-solve), `implicit` (the original's coupler-curve sextic) and `hausdorff`
 //! (polyline distance with a uniform-grid index).
 
-use super::geometry::{C64, Family, Pose, SINGULAR_REL, Sign, Solve, TOGGLE_REL, cognate1_branch, map_pose, sextic};
+use super::geometry::{
+    C64, Family, Pose, SINGULAR_REL, Sign, Solve, TOGGLE_REL, cognate1_branch, map_pose, sextic,
+};
 
 /// Cognate dyad height `h_i/b_i` below which a sample counts as near a toggle (spec §4.9).
 pub const NEAR_TOGGLE_REL: f64 = 1e-6;
@@ -43,9 +45,7 @@ impl SyncAcc {
         let mut near = false;
         let mut locked = false;
         let mut dev_sample = 0.0_f64;
-        for i in 1..3 {
-            let m = &family.mechs[i];
-            let (di, ei) = maps[i];
+        for (i, (m, &(di, ei))) in family.mechs.iter().zip(maps.iter()).enumerate().skip(1) {
             let residual = ((di - m.input_pivot).norm() - m.crank)
                 .abs()
                 .max(((ei - di).norm() - m.coupler).abs())
@@ -61,7 +61,11 @@ impl SyncAcc {
                 continue;
             }
             let theta = (di - m.input_pivot).arg();
-            let branch = if i == 2 { Some(t1.flip()) } else { cognate1_branch(orig, pose) };
+            let branch = if i == 2 {
+                Some(t1.flip())
+            } else {
+                cognate1_branch(orig, pose)
+            };
             let resolve = |t: Sign| match m.solve(theta, t, true) {
                 Solve::Pose(q) => Some((q.p - pose.p).norm()),
                 Solve::NotAssemblable { .. } | Solve::Singular { .. } => None,
@@ -104,7 +108,10 @@ pub struct ImplicitResult {
 
 /// Distance estimates of `points` from the coupler curve of the family's original (spec §4.9).
 #[must_use]
-pub fn implicit_check<'a>(family: &Family, points: impl Iterator<Item = &'a C64>) -> ImplicitResult {
+pub fn implicit_check<'a>(
+    family: &Family,
+    points: impl Iterator<Item = &'a C64>,
+) -> ImplicitResult {
     let orig = &family.mechs[0];
     let vals: Vec<(f64, f64)> = points.map(|p| sextic(orig, *p)).collect();
     if vals.is_empty() {
@@ -114,7 +121,10 @@ pub fn implicit_check<'a>(family: &Family, points: impl Iterator<Item = &'a C64>
     let mid = grads.len() / 2;
     let (_, median, _) = grads.select_nth_unstable_by(mid, f64::total_cmp);
     let floor = DOUBLE_POINT_REL * *median;
-    let mut out = ImplicitResult { n_points: vals.len(), ..ImplicitResult::default() };
+    let mut out = ImplicitResult {
+        n_points: vals.len(),
+        ..ImplicitResult::default()
+    };
     for (f, g) in vals {
         if g < floor || g <= 0.0 {
             out.n_skipped += 1;
@@ -160,7 +170,10 @@ struct SegmentGrid<'a> {
 
 impl<'a> SegmentGrid<'a> {
     fn new(segs: &'a [Segment]) -> Self {
-        let (mut lo, mut hi) = (C64::new(f64::INFINITY, f64::INFINITY), C64::new(f64::NEG_INFINITY, f64::NEG_INFINITY));
+        let (mut lo, mut hi) = (
+            C64::new(f64::INFINITY, f64::INFINITY),
+            C64::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        );
         for (a, b) in segs {
             for p in [a, b] {
                 lo = C64::new(lo.re.min(p.re), lo.im.min(p.im));
@@ -169,18 +182,32 @@ impl<'a> SegmentGrid<'a> {
         }
         let extent = (hi.re - lo.re).max(hi.im - lo.im);
         // About one cell per segment along the longer side's square: sqrt(n) cells per side.
-        #[allow(clippy::cast_precision_loss, reason = "segment counts are ≤ ~1e6, exact in f64")]
+        #[allow(
+            clippy::cast_precision_loss,
+            reason = "segment counts are ≤ ~1e6, exact in f64"
+        )]
         let per_side = (segs.len() as f64).sqrt().max(1.0);
         let cell = if extent > 0.0 { extent / per_side } else { 1.0 };
         let count = |w: f64| -> usize {
             // w/cell ≤ per_side ≤ 1e3 + 1: the cast is exact and cannot wrap.
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "bounded, non-negative")]
+            #[allow(
+                clippy::cast_possible_truncation,
+                clippy::cast_sign_loss,
+                reason = "bounded, non-negative"
+            )]
             let n = (w / cell).floor() as usize;
             n + 1
         };
         let nx = count(hi.re - lo.re);
         let ny = count(hi.im - lo.im);
-        let mut grid = Self { segs, min: lo, cell, nx, ny, cells: vec![Vec::new(); nx * ny] };
+        let mut grid = Self {
+            segs,
+            min: lo,
+            cell,
+            nx,
+            ny,
+            cells: vec![Vec::new(); nx * ny],
+        };
         for (idx, (a, b)) in segs.iter().enumerate() {
             let (ix0, iy0) = grid.cell_of(C64::new(a.re.min(b.re), a.im.min(b.im)));
             let (ix1, iy1) = grid.cell_of(C64::new(a.re.max(b.re), a.im.max(b.im)));
@@ -201,12 +228,20 @@ impl<'a> SegmentGrid<'a> {
                 0
             } else {
                 // Clamped to n − 1 before the cast: cannot wrap.
-                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss, reason = "clamped")]
+                #[allow(
+                    clippy::cast_possible_truncation,
+                    clippy::cast_sign_loss,
+                    clippy::cast_precision_loss,
+                    reason = "clamped"
+                )]
                 let i = x.min((n - 1) as f64) as usize;
                 i
             }
         };
-        (f(p.re - self.min.re, self.nx), f(p.im - self.min.im, self.ny))
+        (
+            f(p.re - self.min.re, self.nx),
+            f(p.im - self.min.im, self.ny),
+        )
     }
 
     fn nearest(&self, q: C64) -> f64 {
@@ -243,7 +278,10 @@ impl<'a> SegmentGrid<'a> {
 
 /// Directed Hausdorff distance: largest distance from a vertex of `from` to the segments `to`.
 fn directed(from: &[Segment], grid: &SegmentGrid<'_>) -> f64 {
-    from.iter().flat_map(|(a, b)| [*a, *b]).map(|p| grid.nearest(p)).fold(0.0, f64::max)
+    from.iter()
+        .flat_map(|(a, b)| [*a, *b])
+        .map(|p| grid.nearest(p))
+        .fold(0.0, f64::max)
 }
 
 /// Symmetric Hausdorff distance between two polyline sets (vertex to segment); `None` when either
@@ -265,7 +303,12 @@ mod tests {
     #[test]
     fn hausdorff_of_shifted_square() {
         let sq = |o: f64| {
-            let p = [C64::new(o, 0.0), C64::new(1.0 + o, 0.0), C64::new(1.0 + o, 1.0), C64::new(o, 1.0)];
+            let p = [
+                C64::new(o, 0.0),
+                C64::new(1.0 + o, 0.0),
+                C64::new(1.0 + o, 1.0),
+                C64::new(o, 1.0),
+            ];
             segments(std::iter::once((&p[..], true)))
         };
         let a = sq(0.0);

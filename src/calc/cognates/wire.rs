@@ -4,8 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
-use utoipa::openapi::schema::{ObjectBuilder, Schema, SchemaType, Type};
 use utoipa::openapi::RefOr;
+use utoipa::openapi::schema::{ObjectBuilder, Schema, SchemaType, Type};
 
 /// A point `[x, y]` in the caller's length unit.
 pub type Point = [f64; 2];
@@ -180,7 +180,9 @@ impl TryFrom<CouplerPointRaw> for CouplerPoint {
                 "give exactly one coupler-point form: {{d, e, side}}, {{u, v}} or {{p, alpha_deg}} (got {forms})"
             ));
         }
-        let need = |x: Option<f64>, name: &str, form: &str| x.ok_or_else(|| format!("form {form} needs `{name}`"));
+        let need = |x: Option<f64>, name: &str, form: &str| {
+            x.ok_or_else(|| format!("form {form} needs `{name}`"))
+        };
         if tri {
             Ok(Self::Triangle {
                 d: need(r.d, "d", "{d, e, side}")?,
@@ -188,9 +190,15 @@ impl TryFrom<CouplerPointRaw> for CouplerPoint {
                 side: r.side.unwrap_or(WireSign::Plus),
             })
         } else if frame {
-            Ok(Self::Frame { u: need(r.u, "u", "{u, v}")?, v: need(r.v, "v", "{u, v}")? })
+            Ok(Self::Frame {
+                u: need(r.u, "u", "{u, v}")?,
+                v: need(r.v, "v", "{u, v}")?,
+            })
         } else {
-            Ok(Self::Polar { p: need(r.p, "p", "{p, alpha_deg}")?, alpha_deg: need(r.alpha_deg, "alpha_deg", "{p, alpha_deg}")? })
+            Ok(Self::Polar {
+                p: need(r.p, "p", "{p, alpha_deg}")?,
+                alpha_deg: need(r.alpha_deg, "alpha_deg", "{p, alpha_deg}")?,
+            })
         }
     }
 }
@@ -636,7 +644,10 @@ pub struct CurveOut {
     pub n_singular_excluded: usize,
 }
 
-#[allow(clippy::trivially_copy_pass_by_ref, reason = "serde's skip_serializing_if passes a reference")]
+#[allow(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde's skip_serializing_if passes a reference"
+)]
 fn is_zero(n: &usize) -> bool {
     *n == 0
 }
