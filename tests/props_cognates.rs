@@ -25,6 +25,7 @@ fn cases(default: u32) -> ProptestConfig {
         .unwrap_or(default);
     ProptestConfig {
         cases,
+        max_global_rejects: 100 * cases,
         ..ProptestConfig::default()
     }
 }
@@ -282,9 +283,14 @@ proptest! {
     #[test]
     fn timing_and_branch_map(lk in linkage()) {
         prop_assume!(lk.assemblable() && lk.regular_point());
-        let r = lk.run(json!({}));
+        // Put the snapshot inside the feasible range (a random angle is often outside it).
+        let m = lk.input().mech;
+        let (lo, hi) = m.input_range().intervals()[0];
+        let frac = 0.05 + 0.9 * (lk.theta_deg + 180.0) / 360.0;
+        let theta = (m.ground_angle() + lo + frac * (hi - lo)).to_degrees();
+        let r = Lk { theta_deg: theta, ..lk }.run(json!({}));
         let s0 = r.mechanisms[0].snapshot.clone().expect("snapshot");
-        prop_assume!(s0.joints.is_some());
+        prop_assert!(s0.joints.is_some(), "snapshot inside the range must assemble");
         let j0 = s0.joints.clone().expect("joints");
         let k = C64::new(r.similarity.k[0], r.similarity.k[1]);
         let one = C64::new(1.0, 0.0);
@@ -392,7 +398,8 @@ proptest! {
                     prop_assert!(false, "toggle not assemblable");
                     continue;
                 };
-                prop_assert!(p.h <= 1e-7 * l, "h = {:e} at a toggle", p.h);
+                // h² at a computed toggle angle is zero up to rounding ~ε·L², so h ≲ C·sqrt(ε)·L.
+                prop_assert!(p.h <= 1e-6 * l, "h = {:e} at a toggle", p.h);
                 prop_assert!((p.p - q.p).norm() <= 1e-6 * l * (1.0 + m.k.norm()));
             }
         }
@@ -411,7 +418,9 @@ proptest! {
         let e1 = chord_error(&m, 512, Spacing::Auto, 8);
         let e2 = chord_error(&m, 1024, Spacing::Auto, 8);
         prop_assume!(e1 > 1e-12 * m.scale());
+        // Second order: at least ×3 per doubling (×4 asymptotically; more while fine features such
+        // as cusps are still being resolved).
         let ratio = e1 / e2;
-        prop_assert!((3.0..5.5).contains(&ratio), "ratio {ratio} ({e1:e} → {e2:e})");
+        prop_assert!(ratio >= 3.0, "ratio {ratio} ({e1:e} → {e2:e})");
     }
 }
