@@ -207,7 +207,7 @@ fn print_tables() {
     let (paper, sp) = mech(&table1(json!({})));
     let (crm, sc) = mech(&crank_rocker(json!({})));
     let randoms: Vec<(FourBar, f64)> = random_linkages().iter().map(mech).collect();
-    let mut prev: Option<(f64, f64, f64)> = None;
+    let mut seen: Vec<(usize, (f64, f64, f64))> = Vec::new();
     let mut report = Vec::new();
     for n in NS {
         let e_cos = chord_error(&paper, n, Spacing::Auto, 16) * sp;
@@ -220,9 +220,13 @@ fn print_tables() {
             .map(|(m, _)| chord_error(m, n, Spacing::Auto, 16) * nf * nf / m.scale())
             .fold(0.0, f64::max);
         let slope = |p: f64, c: f64| (p / c).log2();
-        let (s1, s2, s3) = prev.map_or((f64::NAN, f64::NAN, f64::NAN), |(a, b, c)| {
-            (slope(a, e_cos), slope(b, e_uni), slope(c, e_cr))
-        });
+        // Slope against N/2 (only for doublings).
+        let (s1, s2, s3) = seen
+            .iter()
+            .find(|(m, _)| 2 * m == n)
+            .map_or((f64::NAN, f64::NAN, f64::NAN), |(_, (a, b, c))| {
+                (slope(*a, e_cos), slope(*b, e_uni), slope(*c, e_cr))
+            });
         let verify = json!({"points_per_circuit": n, "verify": ["sync", "implicit"]});
         let rv = run(req(&table1(verify.clone())), &budget).expect("runs");
         let v = rv.verification.expect("verification");
@@ -260,7 +264,7 @@ fn print_tables() {
             "random_max_e_n2_over_l": rand_norm, "sync_paper_rel": sync_p, "sync_random_rel": sync_r,
             "implicit_paper_rel": imp_p, "implicit_random_rel": imp_r
         }));
-        prev = Some((e_cos, e_uni, e_cr));
+        seen.push((n, (e_cos, e_uni, e_cr)));
     }
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/cognates_accuracy.json");

@@ -35,25 +35,11 @@ fn all_options() -> Value {
     serde_json::from_str(ALL_OPTIONS).expect("valid options")
 }
 
-/// Keys whose value may legitimately be null (optional outputs), checked separately below.
-const NULLABLE: [&str; 10] = [
-    "special",
-    "barker",
-    "input_angle_deg",
-    "input_angle_rel_deg",
-    "branch",
-    "joints",
-    "transmission_angle_deg",
-    "cognate1",
-    "cognate2",
-    "max",
-];
-
-/// Every number in the response is finite: serde_json turns NaN/∞ into `null`, so any `null` outside
-/// the optional fields (and any null in an assembled snapshot) is a defect.
+/// Every number in the response is finite: serde_json turns NaN/∞ into `null`, and absent optional
+/// outputs are omitted (never `null`), so any `null` is a defect.
 fn assert_all_finite(v: &Value, path: &str) {
     match v {
-        Value::Null => panic!("null (NaN/∞ or missing value) at {path}"),
+        Value::Null => panic!("null (NaN/∞ or an unset optional) at {path}"),
         Value::Number(n) => assert!(
             n.as_f64().is_some_and(f64::is_finite),
             "non-finite at {path}"
@@ -62,18 +48,9 @@ fn assert_all_finite(v: &Value, path: &str) {
             .iter()
             .enumerate()
             .for_each(|(i, x)| assert_all_finite(x, &format!("{path}/{i}"))),
-        Value::Object(o) => {
-            let assembled = o
-                .get("status")
-                .and_then(Value::as_str)
-                .is_some_and(|s| s == "ok" || s == "toggle");
-            for (k, x) in o {
-                if x.is_null() && NULLABLE.contains(&k.as_str()) && !(assembled && k != "special") {
-                    continue;
-                }
-                assert_all_finite(x, &format!("{path}/{k}"));
-            }
-        }
+        Value::Object(o) => o
+            .iter()
+            .for_each(|(k, x)| assert_all_finite(x, &format!("{path}/{k}"))),
         Value::Bool(_) | Value::String(_) => {}
     }
 }

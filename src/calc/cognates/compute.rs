@@ -220,7 +220,7 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
     }
 
     let mut counter = 0_u64;
-    let mut sync = opts.verify_sync.then(SyncAcc::default);
+    let mut sync = opts.verify_sync.then(|| SyncAcc::new(&family));
     let mut circuit_curves: Vec<Vec<Curve>> = Vec::new();
     if need_circuits {
         for (idx, m) in mechs.iter_mut().enumerate() {
@@ -230,8 +230,7 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
                 &family,
                 idx,
                 &sweeps,
-                n,
-                opts.spacing,
+                (n, opts.spacing, opts.metrics),
                 sync_here,
                 budget,
                 &mut counter,
@@ -285,8 +284,7 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
                     &family,
                     idx,
                     &sweeps,
-                    n,
-                    opts.spacing,
+                    (n, opts.spacing, false),
                     None,
                     budget,
                     &mut counter,
@@ -426,23 +424,20 @@ fn fixed_branches(mechs: &[MechOutput], spec: Option<SnapshotSpec>) -> ([Sign; 3
     }
 }
 
-/// Samples one mechanism over `sweeps`: curves, metrics and (for the original) the `sync` check.
-#[allow(
-    clippy::too_many_arguments,
-    reason = "internal helper; the arguments are the sampling plan"
-)]
+/// Samples one mechanism over `sweeps` with `(n, spacing, metrics)`: curves, metrics (when asked)
+/// and, for the original, the `sync` check.
 fn trace(
     family: &Family,
     idx: usize,
     sweeps: &[Sweep],
-    n: usize,
-    spacing: super::wire::Spacing,
+    (n, spacing, want_metrics): (usize, super::wire::Spacing, bool),
     mut sync: Option<&mut SyncAcc>,
     budget: &Budget,
     counter: &mut u64,
 ) -> Result<(Vec<Curve>, Metrics), CognatesError> {
     let m = &family.mechs[idx];
     let gamma = m.ground_angle();
+    let s_min = m.singular_tol();
     let mut metrics = Metrics::new(m);
     let mut curves = Vec::with_capacity(sweeps.len());
     for sweep in sweeps {
@@ -463,18 +458,20 @@ fn trace(
             }
             let (phi, t) = sweep.sample(j, n, spacing);
             let theta = phi + gamma;
-            match m.solve(theta, t, true) {
+            match m.solve_tol(theta, t, true, s_min) {
                 Solve::Pose(pose) => {
                     curve.points.push(pose.p);
                     curve.theta.push(wrap_pi(theta));
                     curve.branch.push(t);
-                    metrics.include(pose.d);
-                    metrics.include(pose.e);
-                    metrics.include(pose.p);
-                    let mu = m.transmission_angle(pose.d, pose.e);
-                    metrics.mu_min = metrics.mu_min.min(mu);
-                    metrics.mu_max = metrics.mu_max.max(mu);
-                    metrics.n += 1;
+                    if want_metrics {
+                        metrics.include(pose.d);
+                        metrics.include(pose.e);
+                        metrics.include(pose.p);
+                        let mu = m.transmission_angle(pose.d, pose.e);
+                        metrics.mu_min = metrics.mu_min.min(mu);
+                        metrics.mu_max = metrics.mu_max.max(mu);
+                        metrics.n += 1;
+                    }
                     if let Some(acc) = sync.as_deref_mut() {
                         acc.add(family, &pose, t);
                     }

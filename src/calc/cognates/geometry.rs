@@ -36,6 +36,13 @@ pub fn dot(u: C64, v: C64) -> f64 {
     u.re * v.re + u.im * v.im
 }
 
+/// Modulus `|z|` by `sqrt(x² + y²)`: `hypot` guards against overflow that cannot occur in the
+/// normalised frame (|z| ≲ 1e13 there) and costs 2–3× more in the sampling loops.
+#[must_use]
+pub fn mag(z: C64) -> f64 {
+    z.norm_sqr().sqrt()
+}
+
 /// Unit vector at angle `theta` [rad].
 #[must_use]
 pub fn cis(theta: f64) -> C64 {
@@ -468,21 +475,39 @@ impl FourBar {
         self.input_pivot + cis(theta) * self.crank
     }
 
+    /// Distance `s` at or below which the crank tip counts as sitting on the output pivot
+    /// (`1e-12·L`, spec §4.4 step 2). Hot loops compute it once and call the `*_tol` solvers.
+    #[must_use]
+    pub fn singular_tol(&self) -> f64 {
+        SINGULAR_REL * self.scale()
+    }
+
     /// Closed-form position analysis (spec §4.4) at absolute input angle `theta` [rad] on branch `t`.
     /// With `clamp`, a negative `h²` is set to 0 (for inputs known to lie inside the feasible range,
     /// where only rounding can make it negative); otherwise beyond the slack it is `NotAssemblable`.
     #[must_use]
     pub fn solve(&self, theta: f64, t: Sign, clamp: bool) -> Solve {
-        let d = self.crank_tip(theta);
-        self.solve_dyad(d, t, clamp)
+        self.solve_tol(theta, t, clamp, self.singular_tol())
+    }
+
+    /// [`FourBar::solve`] with a precomputed [`FourBar::singular_tol`].
+    #[must_use]
+    pub fn solve_tol(&self, theta: f64, t: Sign, clamp: bool, s_min: f64) -> Solve {
+        self.solve_dyad_tol(self.crank_tip(theta), t, clamp, s_min)
     }
 
     /// The dyad part of [`FourBar::solve`] for a given crank tip `d`.
     #[must_use]
     pub fn solve_dyad(&self, d: C64, t: Sign, clamp: bool) -> Solve {
+        self.solve_dyad_tol(d, t, clamp, self.singular_tol())
+    }
+
+    /// [`FourBar::solve_dyad`] with a precomputed [`FourBar::singular_tol`].
+    #[must_use]
+    pub fn solve_dyad_tol(&self, d: C64, t: Sign, clamp: bool, s_min: f64) -> Solve {
         let w = self.output_pivot - d;
-        let s = w.norm();
-        if s <= SINGULAR_REL * self.scale() {
+        let s = mag(w);
+        if s <= s_min {
             return Solve::Singular { d };
         }
         let (b, c) = (self.coupler, self.rocker);
@@ -520,11 +545,11 @@ impl FourBar {
     #[must_use]
     pub fn dyad_height(&self, d: C64, e: C64) -> (f64, f64) {
         let w = self.output_pivot - d;
-        let s = w.norm();
+        let s = mag(w);
         if s > 0.0 {
             (cross(w, e - d).abs() / s, s)
         } else {
-            ((e - d).norm(), 0.0)
+            (mag(e - d), 0.0)
         }
     }
 

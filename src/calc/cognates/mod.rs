@@ -43,6 +43,11 @@
 //!   warnings. An input angle outside the feasible range returns `status: not_assemblable`.
 
 #![allow(
+    rustdoc::broken_intra_doc_links,
+    reason = "docs write units as `[length]`, `[deg]`, `[rad]` (the project's field-doc convention, also the \
+              OpenAPI descriptions); rustdoc would read them as links"
+)]
+#![allow(
     clippy::suboptimal_flops,
     reason = "mul_add is a libm call on the generic x86-64 target (no FMA) and would double the cost of a \
               position solve; the formulas follow the spec and their rounding is covered by the tests"

@@ -3,7 +3,7 @@
 //! (polyline distance with a uniform-grid index).
 
 use super::geometry::{
-    C64, Family, Pose, SINGULAR_REL, Sign, Solve, TOGGLE_REL, cognate1_branch, map_pose, sextic,
+    C64, Family, Pose, Sign, Solve, TOGGLE_REL, cognate1_branch, mag, map_pose, sextic,
 };
 
 /// Cognate dyad height `h_i/b_i` below which a sample counts as near a toggle (spec §4.9).
@@ -23,6 +23,8 @@ pub const DOUBLE_POINT_REL: f64 = 1e-6;
 /// Running `sync` statistics (normalised units).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SyncAcc {
+    /// Singular-distance tolerances of the three mechanisms (precomputed).
+    s_min: [f64; 3],
     /// Largest re-solve deviation.
     pub max_dev: f64,
     /// Largest re-solve deviation away from the cognates' toggles.
@@ -38,6 +40,15 @@ pub struct SyncAcc {
 }
 
 impl SyncAcc {
+    /// An empty accumulator for `family`.
+    #[must_use]
+    pub fn new(family: &Family) -> Self {
+        Self {
+            s_min: family.mechs.map(|m| m.singular_tol()),
+            ..Self::default()
+        }
+    }
+
     /// Checks one original configuration `pose` on branch `t1`.
     pub fn add(&mut self, family: &Family, pose: &Pose, t1: Sign) {
         let maps = map_pose(family, pose);
@@ -46,17 +57,17 @@ impl SyncAcc {
         let mut locked = false;
         let mut dev_sample = 0.0_f64;
         for (i, (m, &(di, ei))) in family.mechs.iter().zip(maps.iter()).enumerate().skip(1) {
-            let residual = ((di - m.input_pivot).norm() - m.crank)
+            let residual = (mag(di - m.input_pivot) - m.crank)
                 .abs()
-                .max(((ei - di).norm() - m.coupler).abs())
-                .max(((ei - m.output_pivot).norm() - m.rocker).abs())
-                .max((pose.p - (di + m.k * (ei - di))).norm());
+                .max((mag(ei - di) - m.coupler).abs())
+                .max((mag(ei - m.output_pivot) - m.rocker).abs())
+                .max(mag(pose.p - (di + m.k * (ei - di))));
             self.max_constraint_residual = self.max_constraint_residual.max(residual);
             let (h, s) = m.dyad_height(di, ei);
             if h < NEAR_TOGGLE_REL * m.coupler {
                 near = true;
             }
-            if s <= SINGULAR_REL * m.scale() {
+            if s <= self.s_min[i] {
                 locked = true;
                 continue;
             }
@@ -66,8 +77,9 @@ impl SyncAcc {
             } else {
                 cognate1_branch(orig, pose)
             };
-            let resolve = |t: Sign| match m.solve(theta, t, true) {
-                Solve::Pose(q) => Some((q.p - pose.p).norm()),
+            let s_min = self.s_min[i];
+            let resolve = |t: Sign| match m.solve_tol(theta, t, true, s_min) {
+                Solve::Pose(q) => Some(mag(q.p - pose.p)),
                 Solve::NotAssemblable { .. } | Solve::Singular { .. } => None,
             };
             let dev = match branch {
@@ -158,14 +170,16 @@ fn point_segment_distance(q: C64, (a, b): Segment) -> f64 {
     super::sampling::point_segment_distance(q, a, b)
 }
 
-/// Uniform-grid index of segments for nearest-segment queries.
+/// Uniform-grid index of segments for nearest-segment queries (cells in compressed-row form).
 struct SegmentGrid<'a> {
     segs: &'a [Segment],
     min: C64,
     cell: f64,
     nx: usize,
     ny: usize,
-    cells: Vec<Vec<u32>>,
+    /// `items[start[c]..start[c + 1]]` are the segments overlapping cell `c`.
+    start: Vec<u32>,
+    items: Vec<u32>,
 }
 
 impl<'a> SegmentGrid<'a> {
@@ -174,29 +188,37 @@ impl<'a> SegmentGrid<'a> {
             C64::new(f64::INFINITY, f64::INFINITY),
             C64::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
         );
+        let mut total = 0.0;
         for (a, b) in segs {
+            total += mag(b - a);
             for p in [a, b] {
                 lo = C64::new(lo.re.min(p.re), lo.im.min(p.im));
                 hi = C64::new(hi.re.max(p.re), hi.im.max(p.im));
             }
         }
         let extent = (hi.re - lo.re).max(hi.im - lo.im);
-        // About one cell per segment along the longer side's square: sqrt(n) cells per side.
         #[allow(
             clippy::cast_precision_loss,
             reason = "segment counts are ≤ ~1e6, exact in f64"
         )]
-        let per_side = (segs.len() as f64).sqrt().max(1.0);
-        let cell = if extent > 0.0 { extent / per_side } else { 1.0 };
+        let n = segs.len().max(1) as f64;
+        // About two mean segment lengths per cell (a query then scans a handful of segments), but
+        // never more than ~4n cells.
+        let cell = (2.0 * total / n).max(extent / (2.0 * n.sqrt()));
+        let cell = if cell > 0.0 && cell.is_finite() {
+            cell
+        } else {
+            1.0
+        };
         let count = |w: f64| -> usize {
-            // w/cell ≤ per_side ≤ 1e3 + 1: the cast is exact and cannot wrap.
+            // w/cell ≤ 2·sqrt(n) ≤ ~2e3: the cast is exact and cannot wrap.
             #[allow(
                 clippy::cast_possible_truncation,
                 clippy::cast_sign_loss,
                 reason = "bounded, non-negative"
             )]
-            let n = (w / cell).floor() as usize;
-            n + 1
+            let k = (w / cell).floor() as usize;
+            k + 1
         };
         let nx = count(hi.re - lo.re);
         let ny = count(hi.im - lo.im);
@@ -206,15 +228,41 @@ impl<'a> SegmentGrid<'a> {
             cell,
             nx,
             ny,
-            cells: vec![Vec::new(); nx * ny],
+            start: vec![0; nx * ny + 1],
+            items: Vec::new(),
         };
-        for (idx, (a, b)) in segs.iter().enumerate() {
-            let (ix0, iy0) = grid.cell_of(C64::new(a.re.min(b.re), a.im.min(b.im)));
-            let (ix1, iy1) = grid.cell_of(C64::new(a.re.max(b.re), a.im.max(b.im)));
+        // Two passes: count per cell, then fill.
+        let ranges: Vec<_> = segs
+            .iter()
+            .map(|(a, b)| {
+                let (ix0, iy0) = grid.cell_of(C64::new(a.re.min(b.re), a.im.min(b.im)));
+                let (ix1, iy1) = grid.cell_of(C64::new(a.re.max(b.re), a.im.max(b.im)));
+                (ix0, iy0, ix1, iy1)
+            })
+            .collect();
+        let mut counts = vec![0_u32; nx * ny];
+        for &(ix0, iy0, ix1, iy1) in &ranges {
+            for iy in iy0..=iy1 {
+                for ix in ix0..=ix1 {
+                    counts[iy * nx + ix] += 1;
+                }
+            }
+        }
+        let mut acc = 0_u32;
+        for (c, k) in counts.iter().enumerate() {
+            grid.start[c] = acc;
+            acc += k;
+        }
+        grid.start[nx * ny] = acc;
+        let mut fill = grid.start.clone();
+        grid.items = vec![0; acc as usize];
+        for (idx, &(ix0, iy0, ix1, iy1)) in ranges.iter().enumerate() {
             let id = u32::try_from(idx).unwrap_or(u32::MAX);
             for iy in iy0..=iy1 {
                 for ix in ix0..=ix1 {
-                    grid.cells[iy * nx + ix].push(id);
+                    let c = iy * nx + ix;
+                    grid.items[fill[c] as usize] = id;
+                    fill[c] += 1;
                 }
             }
         }
@@ -259,9 +307,9 @@ impl<'a> SegmentGrid<'a> {
                     if !on_ring {
                         continue;
                     }
-                    for &s in &self.cells[iy * self.nx + ix] {
-                        let d = point_segment_distance(q, self.segs[s as usize]);
-                        best = best.min(d);
+                    let c = iy * self.nx + ix;
+                    for &s in &self.items[self.start[c] as usize..self.start[c + 1] as usize] {
+                        best = best.min(point_segment_distance(q, self.segs[s as usize]));
                     }
                 }
             }

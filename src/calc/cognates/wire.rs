@@ -65,36 +65,40 @@ impl ToSchema for WireSign {}
 pub struct CognatesRequest {
     /// Ground pivots: `{A, B}` or `{A, length, angle_deg}` (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub ground: Option<GroundSpec>,
     /// Crank (input link) length `a` [length], > 0 (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(exclusive_minimum = 0.0, example = 1.13)]
+    #[schema(nullable = false, exclusive_minimum = 0.0, example = 1.13)]
     pub crank: Option<f64>,
     /// Coupler length `b` = |E − D| [length], > 0 (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(exclusive_minimum = 0.0, example = 1.23)]
+    #[schema(nullable = false, exclusive_minimum = 0.0, example = 1.23)]
     pub coupler: Option<f64>,
     /// Rocker (output link) length `c` [length], > 0 (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(exclusive_minimum = 0.0, example = 1.04)]
+    #[schema(nullable = false, exclusive_minimum = 0.0, example = 1.04)]
     pub rocker: Option<f64>,
     /// Coupler point P, exactly one of three forms (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub coupler_point: Option<CouplerPoint>,
     /// One drawn configuration (joints mode; excludes the dimension fields, `input_angle_deg` and
     /// `branch`, which are read from the joints).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub joints: Option<JointsSpec>,
     /// Input angle of the snapshot configuration [deg] (θ2, or φ with `angle_reference: ground`).
     /// Omit for no snapshot.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(example = 30.0)]
+    #[schema(nullable = false, example = 30.0)]
     pub input_angle_deg: Option<f64>,
     /// Reference of `input_angle_deg`: `global` (from +x) or `ground` (from A→B, paper φ).
     #[serde(default)]
     pub angle_reference: AngleReference,
     /// Assembly branch `t1` of the snapshot (1: E left of the directed line D→B). Default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub branch: Option<WireSign>,
     /// Optional outputs and knobs.
     #[serde(default)]
@@ -107,18 +111,19 @@ pub struct CognatesRequest {
 pub struct GroundSpec {
     /// Input pivot A [length], default `[0, 0]`.
     #[serde(rename = "A", default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<[f64; 2]>, example = json!([0.0, 0.0]))]
+    #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([0.0, 0.0]))]
     pub a: Option<Point>,
     /// Output pivot B [length], ≠ A.
     #[serde(rename = "B", default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<[f64; 2]>, example = json!([3.1, 0.0]))]
+    #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([3.1, 0.0]))]
     pub b: Option<Point>,
     /// Ground length `l` = |B − A| [length], > 0 (instead of `B`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(exclusive_minimum = 0.0)]
+    #[schema(nullable = false, exclusive_minimum = 0.0)]
     pub length: Option<f64>,
     /// Direction γ of A→B when `length` is used [deg], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub angle_deg: Option<f64>,
 }
 
@@ -283,9 +288,12 @@ pub struct CognatesOptions {
     /// Samples per closed circuit per mechanism, N.
     #[schema(minimum = 16, maximum = 100_000, example = 360)]
     pub points_per_circuit: u64,
-    /// Sample spacing.
+    /// Sample spacing: `auto` (cosine on limited-range circuits, uniform on full turns) or `uniform`.
+    #[schema(inline)]
     pub spacing: Spacing,
-    /// Curve tracing mode.
+    /// Curve tracing mode: `circuits` (whole curve, branch switching at toggles) or `fixed_branch`
+    /// (paper style: each input over its range on its snapshot branch).
+    #[schema(inline)]
     pub curve_mode: CurveMode,
     /// Verification methods to run.
     pub verify: Vec<VerifyKind>,
@@ -330,9 +338,11 @@ pub struct CognatesResponse {
     pub mechanisms: Vec<MechanismOut>,
     /// Numerical certificate that the curves coincide (when `options.verify` is not empty).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub verification: Option<Verification>,
     /// The three 1:1 geared five-bar equivalents (when `options.geared_fivebars`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub geared_fivebars: Option<Vec<GearedFiveBar>>,
     /// Warnings about fragile or special geometry.
     pub warnings: Vec<Warning>,
@@ -392,15 +402,19 @@ pub struct MechanismOut {
     pub input_range: InputRangeOut,
     /// Which original link each link turns with (cognates only).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub rotation_map: Option<RotationMap>,
     /// The snapshot configuration (when `input_angle_deg` or `joints` is given).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub snapshot: Option<SnapshotOut>,
     /// Sampled coupler curves (when `options.curves`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub curves: Option<Vec<CurveOut>>,
     /// Comparison metrics (when `options.metrics`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub metrics: Option<MetricsOut>,
 }
 
@@ -505,9 +519,13 @@ pub struct GrashofOut {
     /// Type by the shortest link (Grashof) or `triple_rocker` / `change_point`.
     #[serde(rename = "type")]
     pub kind: LinkageTypeOut,
-    /// Barker code: GCCC, GCRR, GRCR, GRRC, RRR1..RRR4 (null for change points).
+    /// Barker code: GCCC, GCRR, GRCR, GRRC, RRR1..RRR4 (absent for change points).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub barker: Option<String>,
-    /// Special shape, or null.
+    /// Special shape (absent when none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub special: Option<SpecialOut>,
     /// Signed margin (s + l) − (p + q) [length]; negative = Grashof.
     pub margin: f64,
@@ -615,15 +633,25 @@ pub struct JointsOut {
 pub struct SnapshotOut {
     /// Status of this mechanism's own input at this pose.
     pub status: SnapshotStatus,
-    /// This mechanism's own input angle, absolute [deg] (null when undetermined).
+    /// This mechanism's own input angle, absolute [deg] (absent when undetermined).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub input_angle_deg: Option<f64>,
     /// The same angle relative to its own ground line [deg].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub input_angle_rel_deg: Option<f64>,
-    /// This mechanism's assembly branch (null when undetermined).
+    /// This mechanism's assembly branch (absent when undetermined).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub branch: Option<i8>,
-    /// Joint positions (null when not assemblable or undetermined).
+    /// Joint positions (absent when not assemblable or undetermined).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub joints: Option<JointsOut>,
     /// Transmission angle folded into [0°, 90°] [deg].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub transmission_angle_deg: Option<f64>,
 }
 
@@ -697,12 +725,15 @@ pub struct Footprint {
 pub struct Verification {
     /// Pose-map check (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub sync: Option<SyncCheck>,
     /// Sextic check (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub implicit: Option<ImplicitCheck>,
     /// Hausdorff distances (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub hausdorff: Option<HausdorffCheck>,
 }
 
@@ -742,11 +773,17 @@ pub struct ImplicitCheck {
 /// `hausdorff`: symmetric Hausdorff distance between the traced polylines (vertex to segment).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct HausdorffCheck {
-    /// Original vs cognate 1 (null when a curve has no points).
+    /// Original vs cognate 1 (absent when a curve has no points).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub cognate1: Option<f64>,
-    /// Original vs cognate 2 (null when a curve has no points).
+    /// Original vs cognate 2 (absent when a curve has no points).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub cognate2: Option<f64>,
     /// The larger of the two.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub max: Option<f64>,
     /// Points per traced curve the distances were measured on (sampling-limited: O(N⁻²)).
     pub n_points: usize,
@@ -774,6 +811,7 @@ pub struct GearedFiveBar {
     pub dyad2: f64,
     /// The five-bar in the snapshot configuration (when the snapshot assembles).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub snapshot: Option<FiveBarSnapshot>,
 }
 
@@ -831,9 +869,11 @@ pub struct Warning {
     pub message: String,
     /// The mechanism concerned, if one.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub mechanism: Option<MechanismId>,
     /// Related input angles (absolute) [deg], e.g. the folded positions of a change point.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub angles_deg: Option<Vec<f64>>,
 }
 
