@@ -198,7 +198,7 @@ fn print_tables() {
     );
 
     println!(
-        "\n### Accuracy vs N (chord error, length unit of the input; slope = log2 e(N/2)/e(N))\n"
+        "\n### Accuracy vs N (chord error, length unit of the input; slope = log2 e(N/2)/e(N), doublings only)\n"
     );
     println!(
         "| N | paper, cosine (auto) | slope | paper, uniform | slope | crank-rocker, auto | slope | 20 random, auto: max e·N²/L | sync max_dev_regular / L (paper; random max) | implicit max_dist / L (paper; random max) |"
