@@ -292,6 +292,35 @@ impl<'a> SegmentGrid<'a> {
         )
     }
 
+    /// Distance from `q` to the nearest cell outside the block of Chebyshev radius `r` around
+    /// `(cx, cy)`; infinite on sides where the block reaches the grid border (no cells beyond).
+    fn reach(&self, q: C64, cx: usize, cy: usize, r: usize) -> f64 {
+        // Cell indices are ≤ ~2e3: exact in f64.
+        #[allow(clippy::cast_precision_loss, reason = "small indices")]
+        let edge = |i: usize| i as f64 * self.cell;
+        let left = if cx > r {
+            q.re - (self.min.re + edge(cx - r))
+        } else {
+            f64::INFINITY
+        };
+        let right = if cx + r + 1 < self.nx {
+            self.min.re + edge(cx + r + 1) - q.re
+        } else {
+            f64::INFINITY
+        };
+        let below = if cy > r {
+            q.im - (self.min.im + edge(cy - r))
+        } else {
+            f64::INFINITY
+        };
+        let above = if cy + r + 1 < self.ny {
+            self.min.im + edge(cy + r + 1) - q.im
+        } else {
+            f64::INFINITY
+        };
+        left.min(right).min(below).min(above)
+    }
+
     fn nearest(&self, q: C64) -> f64 {
         let (cx, cy) = self.cell_of(q);
         let mut best = f64::INFINITY;
@@ -313,10 +342,7 @@ impl<'a> SegmentGrid<'a> {
                     }
                 }
             }
-            // Every cell of ring r + 1 is at least r·cell away from q.
-            #[allow(clippy::cast_precision_loss, reason = "r ≤ ~1e3")]
-            let reach = r as f64 * self.cell;
-            if best <= reach {
+            if best <= self.reach(q, cx, cy, r) {
                 break;
             }
         }
@@ -325,11 +351,17 @@ impl<'a> SegmentGrid<'a> {
 }
 
 /// Directed Hausdorff distance: largest distance from a vertex of `from` to the segments `to`.
+/// Each vertex is queried once (a segment's end is the next one's start along a polyline).
 fn directed(from: &[Segment], grid: &SegmentGrid<'_>) -> f64 {
-    from.iter()
-        .flat_map(|(a, b)| [*a, *b])
-        .map(|p| grid.nearest(p))
-        .fold(0.0, f64::max)
+    let mut worst = 0.0_f64;
+    for (i, (a, b)) in from.iter().enumerate() {
+        worst = worst.max(grid.nearest(*a));
+        let shared = from.get(i + 1).is_some_and(|next| next.0 == *b);
+        if !shared {
+            worst = worst.max(grid.nearest(*b));
+        }
+    }
+    worst
 }
 
 /// Symmetric Hausdorff distance between two polyline sets (vertex to segment); `None` when either
@@ -363,5 +395,34 @@ mod tests {
         let b = sq(0.25);
         assert!((hausdorff(&a, &b).unwrap_or(1.0) - 0.25).abs() < 1e-15);
         assert!(hausdorff(&a, &a).unwrap_or(1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn grid_matches_brute_force() {
+        // Two wiggly closed polylines with uneven spacing; brute-force vertex-to-segment distances.
+        let curve = |phase: f64, n: usize, amp: f64| -> Vec<C64> {
+            (0..n)
+                .map(|j| {
+                    let t = (j as f64 / n as f64).powi(2) * std::f64::consts::TAU;
+                    C64::from_polar(1.0 + amp * (5.0 * t + phase).sin(), t)
+                })
+                .collect()
+        };
+        let (pa, pb) = (curve(0.0, 300, 0.1), curve(0.4, 170, 0.12));
+        let a = segments(std::iter::once((&pa[..], true)));
+        let b = segments(std::iter::once((&pb[..], true)));
+        let brute = |from: &[Segment], to: &[Segment]| {
+            from.iter()
+                .flat_map(|(p, q)| [*p, *q])
+                .map(|v| {
+                    to.iter()
+                        .map(|s| point_segment_distance(v, *s))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .fold(0.0, f64::max)
+        };
+        let want = brute(&a, &b).max(brute(&b, &a));
+        let got = hausdorff(&a, &b).unwrap_or(f64::NAN);
+        assert!((got - want).abs() <= 1e-15, "{got} vs {want}");
     }
 }
