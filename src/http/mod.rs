@@ -6,6 +6,7 @@
 //! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
 pub mod cam_law;
+pub mod cognates;
 pub mod json;
 pub mod meta;
 pub mod pool;
@@ -93,6 +94,7 @@ JSON pointers to the offending fields.",
     tags(
         (name = "service", description = "Health and discovery"),
         (name = "cam-law", description = "Cam motion laws: evaluation and identification"),
+        (name = "linkages", description = "Planar linkages: Roberts–Chebyshev cognates of a four-bar"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -104,6 +106,7 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
         .routes(routes!(cam_law::evaluate))
+        .routes(routes!(cognates::construct))
 }
 
 /// The OpenAPI document of the service, generated from the handlers and wire types.
