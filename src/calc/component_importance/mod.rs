@@ -57,10 +57,6 @@
 //!   space. A result is never NaN: a final check refuses to return non-finite or inconsistent
 //!   values (`NUMERICAL_FAILURE`).
 
-// Doc comments give units in brackets ([h], [1/h], [ms]) as the style guide asks; they are
-// units, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod centrality;
 pub mod compute;
 pub mod error;
