@@ -2,6 +2,8 @@
 //! each module exposes `compute(input, budget) -> Result<Output, Error>` and its wire types.
 
 pub mod cam_law;
+pub mod cognates;
+pub mod component_importance;
 pub mod irefc;
 pub mod problem;
 

@@ -3,9 +3,11 @@
 //! decodes, runs the module's `run` on the compute pool, and responds.
 //!
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
-//! [`run_calc`], and register it in [`api_router`] with one `.routes(routes!(...))` line.
+//! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
 pub mod cam_law;
+pub mod cognates;
+pub mod component_importance;
 pub mod irefc;
 pub mod json;
 pub mod meta;
@@ -94,6 +96,8 @@ JSON pointers to the offending fields.",
     tags(
         (name = "service", description = "Health and discovery"),
         (name = "cam-law", description = "Cam motion laws: evaluation and identification"),
+        (name = "linkages", description = "Planar linkages: Roberts–Chebyshev cognates of a four-bar"),
+        (name = "reliability", description = "Reliability and maintenance: component importance under fault propagation"),
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
     ),
     components(schemas(Problem, ProblemField))
@@ -106,6 +110,8 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
         .routes(routes!(cam_law::evaluate))
+        .routes(routes!(cognates::construct))
+        .routes(routes!(component_importance::rank))
         .routes(routes!(irefc::stress))
         .routes(routes!(irefc::efficiency))
 }

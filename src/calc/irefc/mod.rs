@@ -43,11 +43,6 @@
 //!   gives η ≤ 1 for every μ, f_s ≥ 0; with the paper's μ = 1 mm it predicts η ≈ 0.37, so the paper's
 //!   η = 0.93 depends on its reduced relative speeds.
 
-// Units are written in brackets as in the specs ([m], [N], [deg]); they also reach the OpenAPI
-// descriptions through the doc comments, so they stay unescaped. Real intra-doc links in this module were
-// checked with this lint on: every report was a unit.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod brent;
 pub mod efficiency;
 pub mod error;

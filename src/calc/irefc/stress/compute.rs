@@ -412,7 +412,8 @@ pub fn load_sharing_breakpoints(z2: u32, lo: f64, hi: f64) -> Vec<f64> {
 #[must_use]
 pub fn scan_intervals(p: &StressParams, z2: u32) -> usize {
     if p.refine && p.load_sharing == LoadSharing::PhaseExact {
-        p.n_intervals.max(z2 as usize * PHASE_EXACT_POINTS_PER_SEGMENT)
+        p.n_intervals
+            .max(z2 as usize * PHASE_EXACT_POINTS_PER_SEGMENT)
     } else {
         p.n_intervals
     }
