@@ -231,6 +231,23 @@ impl<'a, M: CurveModel> Ctx<'a, M> {
         Ok(f)
     }
 
+    /// The objective at `g` even when the budget is spent (counted; updates best-so-far). Used
+    /// once per fit for the initial solution, so that every answer has a finite best-so-far.
+    pub fn value_forced(&mut self, g: &[f64; 7]) -> f64 {
+        self.evaluations += 1;
+        let ok = self.model.curve(g, &mut self.curve) && self.curve.iter().all(|v| v.is_finite());
+        let f = if ok {
+            match self.metric {
+                Metric::Euclidean => euclidean(&self.curve, self.data),
+                Metric::Dtw { window } => self.dtw.distance(&self.curve, self.data, window),
+            }
+        } else {
+            f64::INFINITY
+        };
+        self.offer(f, g);
+        f
+    }
+
     /// Residuals `ŷ_k − y_k` into `out` and their Euclidean norm (one counted evaluation). When
     /// the metric is EN this also updates best-so-far. `Ok(None)` for a degenerate candidate.
     ///

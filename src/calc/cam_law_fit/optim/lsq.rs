@@ -39,6 +39,13 @@ struct Problem<'r, 'a, M: CurveModel> {
     local_evals: Cell<u64>,
     cap: u64,
     refused: Cell<Option<StopReason>>,
+    /// Stop as converged once the EN is at or below this (an exact fit cannot improve).
+    target: f64,
+    reached: Cell<bool>,
+    /// Early-snap threshold and the genes exempt from it (see [`Options::early_snap`]).
+    early_snap: Option<(f64, [bool; 7])>,
+    early_hit: Cell<bool>,
+    jac_calls: Cell<u64>,
     /// Residual magnitude substituted for a degenerate candidate (empty pulse): far worse than
     /// any real candidate, so LM rejects the step.
     penalty: f64,
@@ -56,7 +63,7 @@ impl<M: CurveModel> Problem<'_, '_, M> {
         {
             return Some(cr.clone());
         }
-        if self.refused.get().is_some() {
+        if self.refused.get().is_some() || self.reached.get() || self.early_hit.get() {
             return None;
         }
         if self.local_evals.get() >= self.cap {
@@ -76,6 +83,10 @@ impl<M: CurveModel> Problem<'_, '_, M> {
             Ok(Some(en)) => {
                 if en < self.best.get().0 {
                     self.best.set((en, g));
+                }
+                if en <= self.target {
+                    self.reached.set(true);
+                    return None;
                 }
                 DVector::from_column_slice(&scratch)
             }
@@ -104,6 +115,20 @@ impl<M: CurveModel> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_, M> {
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
         let r0 = self.eval_at(&self.x)?;
+        // Early snap: after the first accepted step, stop as soon as a non-exempt free gene's
+        // normalized value falls below the threshold (the caller zeroes it and continues on
+        // fewer genes: an active-set strategy that avoids the slow approach of x² → 0).
+        self.jac_calls.set(self.jac_calls.get() + 1);
+        if let Some((thr, exempt)) = self.early_snap
+            && self.jac_calls.get() > 1
+        {
+            let g = self.genes(&self.x);
+            let sum: f64 = g.iter().sum();
+            if sum > 0.0 && self.free.0.iter().any(|&k| !exempt[k] && g[k] < thr * sum) {
+                self.early_hit.set(true);
+                return None;
+            }
+        }
         let n = self.x.len();
         let mut jac = DMatrix::zeros(r0.len(), n);
         let mut xp = self.x.clone();
@@ -127,16 +152,58 @@ impl<M: CurveModel> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_, M> {
     }
 }
 
+/// Options of one least-squares run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Evaluation cap of the run (Jacobian probes included).
+    pub cap: u64,
+    /// Stop as converged once EN ≤ `target` (0: run to LM's own tolerances).
+    pub target: f64,
+    /// `(threshold, exempt)`: end the run early, with [`End::early_snap`] set, once a free gene
+    /// that is not exempt has a normalized value below `threshold`.
+    pub early_snap: Option<(f64, [bool; 7])>,
+}
+
+/// How a least-squares run ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct End {
+    /// Best point evaluated (EN) and the stop reason.
+    pub run: RunEnd,
+    /// The run ended because a gene fell below the early-snap threshold.
+    pub early_snap: bool,
+}
+
 /// One least-squares run from genes `start` over the `free` genes, at most `cap` evaluations.
 /// Returns the best point evaluated (EN of the residuals), and why the run ended: `Converged`
-/// (LM's tolerance test), `MaxEvaluations` (the per-start cap), `Stall` (LM cannot improve
-/// further in f64), or the global budget's reason.
+/// (LM's tolerance test or an exact fit), `MaxEvaluations` (the per-start cap), `Stall` (LM
+/// cannot improve further in f64), or the global budget's reason.
 pub fn run<M: CurveModel>(
     ctx: &mut Ctx<'_, M>,
     start: &[f64; 7],
     free: &FreeGenes,
     cap: u64,
 ) -> RunEnd {
+    run_with(
+        ctx,
+        start,
+        free,
+        &Options {
+            cap,
+            target: 0.0,
+            early_snap: None,
+        },
+    )
+    .run
+}
+
+/// [`run`] with all options.
+pub fn run_with<M: CurveModel>(
+    ctx: &mut Ctx<'_, M>,
+    start: &[f64; 7],
+    free: &FreeGenes,
+    opts: &Options,
+) -> End {
+    let cap = opts.cap;
     let data_scale = ctx.data().iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let n_data = ctx.data().len();
     let x0 = DVector::from_iterator(free.len(), free.0.iter().map(|&k| start[k].max(0.0).sqrt()));
@@ -150,13 +217,21 @@ pub fn run<M: CurveModel>(
         local_evals: Cell::new(0),
         cap,
         refused: Cell::new(None),
+        target: opts.target,
+        reached: Cell::new(false),
+        early_snap: opts.early_snap,
+        early_hit: Cell::new(false),
+        jac_calls: Cell::new(0),
         penalty: 1e3 * (data_scale + 1.0),
     };
     if free.is_empty() {
-        return RunEnd {
-            stop: StopReason::Converged,
-            f: f64::INFINITY,
-            g: *start,
+        return End {
+            run: RunEnd {
+                stop: StopReason::Converged,
+                f: f64::INFINITY,
+                g: *start,
+            },
+            early_snap: false,
         };
     }
     let lm = LevenbergMarquardt::new()
@@ -168,13 +243,18 @@ pub fn run<M: CurveModel>(
         .with_patience(usize::try_from(cap).unwrap_or(usize::MAX).max(1));
     let (problem, report) = lm.minimize(problem);
     let (f, g) = problem.best.get();
+    let early = problem.early_hit.get();
     let stop = match (problem.refused.get(), report.termination) {
         (Some(reason), _) => reason,
+        _ if problem.reached.get() || early => StopReason::Converged,
         (None, t) if t.was_successful() => StopReason::Converged,
         (None, TerminationReason::LostPatience) => StopReason::MaxEvaluations,
         (None, _) => StopReason::Stall,
     };
-    RunEnd { stop, f, g }
+    End {
+        run: RunEnd { stop, f, g },
+        early_snap: early && problem.refused.get().is_none(),
+    }
 }
 
 #[cfg(test)]
