@@ -41,3 +41,34 @@ fn every_operation_is_documented() {
         }
     }
 }
+
+/// Every property of every schema carries a description (meaning, unit, range): clients read
+/// the units from the docs. An `Option<Struct>` field needs `#[schema(nullable = false)]`, or
+/// utoipa wraps it in a `oneOf` that drops the doc comment.
+#[test]
+fn every_schema_property_is_described() {
+    let api = serde_json::to_value(mechcalc::http::openapi()).expect("document serializes");
+    let mut missing = Vec::new();
+    if let Some(schemas) = api
+        .pointer("/components/schemas")
+        .and_then(|s| s.as_object())
+    {
+        for (name, schema) in schemas {
+            if let Some(props) = schema.get("properties").and_then(|p| p.as_object()) {
+                for (prop, body) in props {
+                    if body
+                        .get("description")
+                        .and_then(|d| d.as_str())
+                        .is_none_or(str::is_empty)
+                    {
+                        missing.push(format!("{name}.{prop}"));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "schema properties without a description: {missing:?}"
+    );
+}

@@ -5,6 +5,7 @@
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
 //! [`run_calc`], and register it in [`api_router`] with one `.routes(routes!(...))` line.
 
+pub mod cam_law;
 pub mod json;
 pub mod meta;
 pub mod pool;
@@ -102,6 +103,7 @@ fn api_router() -> OpenApiRouter<AppState> {
     OpenApiRouter::with_openapi(ApiDoc::openapi())
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
+        .routes(routes!(cam_law::evaluate))
 }
 
 /// The OpenAPI document of the service, generated from the handlers and wire types.
