@@ -6,6 +6,7 @@
 //! [`run_calc`], and register it in [`api_router`] with one `.routes(routes!(...))` line.
 
 pub mod cam_law;
+pub mod cam_law_fit;
 pub mod json;
 pub mod meta;
 pub mod pool;
@@ -104,6 +105,7 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
         .routes(routes!(cam_law::evaluate))
+        .routes(routes!(cam_law_fit::fit))
 }
 
 /// The OpenAPI document of the service, generated from the handlers and wire types.

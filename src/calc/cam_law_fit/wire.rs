@@ -40,6 +40,7 @@ pub struct FitCamLawRequest {
     /// Quantity compared by the objective (default `acceleration`, the paper's best case on
     /// clean data).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub fit_on: Option<FitQuantity>,
     /// Differentiate a lower channel numerically when the `fit_on` channel is absent
     /// (s → v → a only; second-order differences as numpy `gradient`, spec §3.3). Default false.
@@ -64,6 +65,7 @@ pub struct FitCamLawRequest {
     /// simple_harmonic, cycloidal, modified_trapezoid, modified_sine). Exclusive with
     /// `initial_coefficients`.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub initial_law: Option<NamedLaw>,
     /// 7 flags forcing segments to zero length; both pulses must keep a free segment.
     /// Default all false.
@@ -75,6 +77,7 @@ pub struct FitCamLawRequest {
     pub outputs: OutputsIn,
     /// Free-text unit labels, echoed back.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub units: Option<Units>,
 }
 
@@ -89,6 +92,7 @@ pub struct FitAbscissa {
     pub values: Option<Vec<f64>>,
     /// Uniform grid `x_k = start + k·(end − start)/(count − 1)`, `k = 0..count−1`.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub grid: Option<FitGrid>,
 }
 
@@ -232,6 +236,7 @@ pub struct OptimizerIn {
     pub time_limit_ms: Option<u64>,
     /// GA settings (paper Table 2 defaults).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub ga: Option<GaIn>,
     /// IPOP-CMA-ES restarts of `auto` when the metric is DTW, 0..9 (default 3).
     #[serde(default)]
@@ -290,6 +295,7 @@ pub struct GaIn {
 pub struct OutputsIn {
     /// Dense curves of the fitted law (default none).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub curves: Option<CurvesIn>,
     /// EN and DTW of the fitted law against every supplied or derived channel (default true).
     #[serde(default)]
@@ -332,12 +338,15 @@ pub struct FitCamLawResponse {
     pub objective: ObjectiveOut,
     /// EN and DTW of the fitted law against every supplied or derived channel (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub error_table: Option<ErrorTable>,
     /// Nearest Table-3 law (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub classification: Option<Classification>,
     /// Dense curves of the fitted law (when `outputs.curves.count` > 0).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub curves: Option<Curves>,
     /// Best objective after each generation/iteration (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -348,6 +357,7 @@ pub struct FitCamLawResponse {
     pub warnings: Vec<Warning>,
     /// The request's unit labels, echoed.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub units: Option<Units>,
 }
 
@@ -381,12 +391,15 @@ pub struct ChannelErrors {
 pub struct ErrorTable {
     /// Displacement errors [U] (when the channel was supplied).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub displacement: Option<ChannelErrors>,
     /// Velocity errors [U/x] (when supplied or derived).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub velocity: Option<ChannelErrors>,
     /// Acceleration errors [U/x²] (when supplied or derived).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub acceleration: Option<ChannelErrors>,
 }
 
