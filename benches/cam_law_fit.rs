@@ -1,1 +1,2 @@
+//! Benchmarks of the cam-law fit (placeholder).
 fn main() {}

@@ -562,7 +562,7 @@ pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, F
     let mut final_value = objective_of(&law, input, data, &mut dtw);
     let initial_law = SevenSegmentLaw::try_new(&input.initial, &input.bc)?;
     let initial_value = objective_of(&initial_law, input, data, &mut dtw);
-    if !(final_value <= initial_value) {
+    if final_value.is_nan() || final_value > initial_value {
         law = initial_law;
         final_value = initial_value;
     }

@@ -657,7 +657,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     #[allow(clippy::cast_precision_loss)]
     let cost = {
         let w = if metric == MetricName::Dtw {
-            2.0 * (dtw_window.min(n - 1) as f64) + 1.0
+            2.0f64.mul_add(dtw_window.min(n - 1) as f64, 1.0)
         } else {
             1.0
         };

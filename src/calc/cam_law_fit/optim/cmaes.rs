@@ -57,7 +57,12 @@ pub struct CmaParams {
 
 /// One CMA-ES run from `x0` (free genes) with the given settings. Returns the best point of the
 /// run (folded genes) and why it stopped.
-#[allow(clippy::too_many_lines, clippy::similar_names)]
+// Hansen's default constants read best in their published form.
+#[allow(
+    clippy::too_many_lines,
+    clippy::similar_names,
+    clippy::suboptimal_flops
+)]
 pub fn run<M: CurveModel, R: Rng>(
     ctx: &mut Ctx<'_, M>,
     free: &FreeGenes,

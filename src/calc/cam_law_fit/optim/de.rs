@@ -164,7 +164,7 @@ mod tests {
         let (a, ea) = go(1);
         let (b, eb) = go(1);
         assert_eq!(ea, eb);
-        assert!(a.g == b.g);
+        assert_eq!(a.g.map(f64::to_bits), b.g.map(f64::to_bits));
         assert_eq!(a.stop, StopReason::MaxEvaluations);
         let mut ctx = Ctx::new(&m, &y, Metric::Euclidean, Budget::unlimited(), false);
         let f0 = ctx.value(&[1.0 / 7.0; 7]).unwrap_or(f64::NAN);

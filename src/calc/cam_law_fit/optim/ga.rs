@@ -198,7 +198,7 @@ pub fn run<M: CurveModel>(
             }
         }
         let gen_best = fit.iter().copied().fold(f64::INFINITY, f64::min);
-        if gen_best < best - STALL_REL_TOL * best.abs() {
+        if gen_best < STALL_REL_TOL.mul_add(-best.abs(), best) {
             stalled = 0;
         } else {
             stalled += 1;
@@ -247,7 +247,8 @@ mod tests {
         let (a, ea, ha) = run_once(3);
         let (b, eb, _) = run_once(3);
         assert_eq!(ea, eb);
-        assert!((a.f - b.f).abs() <= 0.0 && a.g == b.g);
+        assert_eq!(a.f.to_bits(), b.f.to_bits());
+        assert_eq!(a.g.map(f64::to_bits), b.g.map(f64::to_bits));
         assert_eq!(ea, 100 + 40 * 99);
         assert_eq!(ha.len(), 40);
         assert!(ha.windows(2).all(|w| w[1] <= w[0]));
