@@ -4,6 +4,9 @@
 //! 1e-9 absolute, identification to the §5.4 limits. Heavier runs (every polynomial DTW row,
 //! more GA seeds) run with `CAMFIT_HEAVY=1`.
 
+// Reference expressions are written as in the spec.
+#![allow(clippy::suboptimal_flops)]
+
 use std::path::Path;
 
 use mechcalc::calc::cam_law::catalogue::{NamedLaw, TABLE3};

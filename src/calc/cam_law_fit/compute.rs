@@ -358,12 +358,43 @@ pub fn fit<M: CurveModel>(ctx: &mut Ctx<'_, M>, s: &Settings) -> FitOutcome {
                 en: f64::INFINITY,
                 g: s.initial,
             };
+            let mut examined: Vec<f64> = Vec::new();
             for start in auto_starts(&s.initial, &s.fixed_zero) {
                 if ctx.check().is_some() {
                     break;
                 }
                 starts_used += 1;
-                let end = descend(ctx, &start, &free, s.snap_tol, MAX_EVALS_PER_START, exact);
+                let mut end = descend(ctx, &start, &free, s.snap_tol, MAX_EVALS_PER_START, exact);
+                // The early snap can trap a start at a zero that is only locally optimal; when
+                // the start did not reach an exact fit, it is repeated as the plain least-squares
+                // run of spec §3.5.2 step 2, and the zero-snapped result is kept unless the plain
+                // one is better beyond the snap acceptance tolerance.
+                // One repetition per distinct trapped value: starts that end at an EN already
+                // examined (within 1e-9) are the same local minimum.
+                let snapped_any = free.0.iter().any(|&k| end.g[k] <= 0.0);
+                let seen = examined
+                    .iter()
+                    .any(|e: &f64| (end.en - e).abs() <= SNAP_ACCEPT_REL * e.abs());
+                if end.en > exact && snapped_any && !seen && ctx.check().is_none() {
+                    examined.push(end.en);
+                    let plain = lsq::run_with(
+                        ctx,
+                        &start,
+                        &free,
+                        &lsq::Options {
+                            cap: MAX_EVALS_PER_START,
+                            target: exact,
+                            early_snap: None,
+                        },
+                    )
+                    .run;
+                    if plain.f.mul_add(1.0 + SNAP_ACCEPT_REL, SNAP_ACCEPT_ABS) < end.en {
+                        end = EnBest {
+                            en: plain.f,
+                            g: normalized(&plain.g),
+                        };
+                    }
+                }
                 if end.en < best.en {
                     best = end;
                 }

@@ -675,20 +675,31 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     }
 
     // Infeasible boundary conditions: the initial law must exist in f64.
-    if let Err(e) = SevenSegmentLaw::try_new(&initial, &bc) {
-        let (class, code) = match e {
-            LawError::Overflow { .. } => (ProblemClass::Infeasible, "INFEASIBLE_CONSTRAINTS"),
-            _ => (ProblemClass::InvalidInput, "INVALID_INPUT"),
-        };
-        return Err(CalcFailure::field(
-            class,
-            code,
-            "/constraints",
-            format!(
-                "no 7-segment law over Δt = {} can meet these end conditions in f64 ({e}): widen [t_a, t_b], reduce the end rates or rescale the units",
-                bc.t_b - bc.t_a
-            ),
-        ));
+    match SevenSegmentLaw::try_new(&initial, &bc) {
+        Ok(_) => {}
+        Err(e @ (LawError::EmptyFirstPulse { .. } | LawError::EmptySecondPulse { .. })) => {
+            return Err(CalcFailure::field(
+                ProblemClass::InvalidInput,
+                "EMPTY_PULSE",
+                initial_pointer.unwrap_or("/fixed_zero"),
+                format!("{e}: give the segments of that pulse a longer initial duration"),
+            ));
+        }
+        Err(e) => {
+            let (class, code) = match e {
+                LawError::Overflow { .. } => (ProblemClass::Infeasible, "INFEASIBLE_CONSTRAINTS"),
+                _ => (ProblemClass::InvalidInput, "INVALID_INPUT"),
+            };
+            return Err(CalcFailure::field(
+                class,
+                code,
+                "/constraints",
+                format!(
+                    "no 7-segment law over Δt = {} can meet these end conditions in f64 ({e}): widen [t_a, t_b], reduce the end rates or rescale the units",
+                    bc.t_b - bc.t_a
+                ),
+            ));
+        }
     }
 
     // Channels, derived ones included (spec §3.3).
