@@ -281,3 +281,25 @@ async fn one_millisecond_budget_returns_best_so_far_with_deadline() {
     assert!(j["objective"]["final"].as_f64() <= j["objective"]["initial"].as_f64());
     assert!(j["optimizer_report"]["evaluations"].as_u64() < Some(49_600));
 }
+
+#[tokio::test]
+async fn missing_required_members_are_422() {
+    let r = post_json(PATH, &json!({})).await;
+    r.problem(422);
+    assert_eq!(r.pointers(), vec!["/abscissa"]);
+    let r = post_json(
+        PATH,
+        &json!({"abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": 12}}}),
+    )
+    .await;
+    r.problem(422);
+    assert_eq!(r.pointers(), vec!["/channels"]);
+    let r = post_json(
+        PATH,
+        &json!({"abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": 12}},
+                                    "channels": {}}),
+    )
+    .await;
+    r.problem(422);
+    assert_eq!(r.pointers(), vec!["/channels"]);
+}

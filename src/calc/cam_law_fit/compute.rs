@@ -509,6 +509,8 @@ pub fn fit<M: CurveModel>(ctx: &mut Ctx<'_, M>, s: &Settings) -> FitOutcome {
         _ => ctx.best(),
     };
     let stop = ctx.stop().unwrap_or(main_stop);
+    // Report only snapped segments that are still zero in the answer (a DTW restart may reopen).
+    snapped.retain(|k| best_g[*k] <= 0.0);
     FitOutcome {
         coefficients: normalized(&best_g),
         initial,

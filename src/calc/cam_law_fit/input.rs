@@ -333,13 +333,15 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let s_data = supplied[0];
     let s_a = c.s_a.or_else(|| s_data.and_then(|s| s.first().copied()));
     let s_b = c.s_b.or_else(|| s_data.and_then(|s| s.last().copied()));
-    if s_a.is_none() && s_data.is_none() {
+    // (With no channel at all, `/channels` already says what is missing.)
+    let any_channel = supplied.iter().any(Option::is_some);
+    if s_a.is_none() && s_data.is_none() && any_channel {
         v.push(
             "/constraints/s_a",
             "required when no displacement channel is supplied (the start displacement)",
         );
     }
-    if s_b.is_none() && s_data.is_none() {
+    if s_b.is_none() && s_data.is_none() && any_channel {
         v.push(
             "/constraints/s_b",
             "required when no displacement channel is supplied (the end displacement)",
