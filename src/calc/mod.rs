@@ -3,6 +3,7 @@
 
 pub mod cam_law;
 pub mod cam_law_fit;
+pub mod cognates;
 pub mod problem;
 
 pub use problem::{CalcFailure, FieldIssue, ProblemClass, Validator};
