@@ -35,10 +35,6 @@
 //!   pulses are nearly cancelled by the end rates (|A| ≪ |Δs|/Δt²) is poorly determined: the
 //!   fit matches the data but the coefficients of that pulse may differ.
 
-// Doc comments give units in brackets (`[x]`, `[U/x²]`, `[ms]`, STYLE.md) and double as the
-// OpenAPI descriptions, so they are not escaped; they are not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod compute;
 pub mod error;
 pub mod input;
