@@ -2,6 +2,7 @@
 //! each module exposes `compute(input, budget) -> Result<Output, Error>` and its wire types.
 
 pub mod cam_law;
+pub mod cam_law_fit;
 pub mod cognates;
 pub mod component_importance;
 pub mod irefc;

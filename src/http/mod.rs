@@ -6,6 +6,7 @@
 //! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
 pub mod cam_law;
+pub mod cam_law_fit;
 pub mod cognates;
 pub mod component_importance;
 pub mod irefc;
@@ -110,6 +111,7 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
         .routes(routes!(cam_law::evaluate))
+        .routes(routes!(cam_law_fit::fit))
         .routes(routes!(cognates::construct))
         .routes(routes!(component_importance::rank))
         .routes(routes!(irefc::stress))
