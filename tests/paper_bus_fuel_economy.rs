@@ -1,0 +1,455 @@
+//! Validation cases of spec `bus_fuel_economy.md` §7.1 (V1-V9) and §7.2, table-driven.
+//! Reference values are those of the spec's independent Python implementation.
+
+use approx::assert_relative_eq;
+use mechcalc::calc::bus_fuel_economy::ac_factor::{AcFactor, Dowell, dowell_f1, dowell_f2};
+use mechcalc::calc::bus_fuel_economy::compare::{desirability, overall_desirability, paper};
+use mechcalc::calc::bus_fuel_economy::cycles::{self, BUILTIN_NAMES};
+use mechcalc::calc::bus_fuel_economy::ipmsm::{
+    Ipmsm, IpmsmParams, OpMode, psi_from_back_emf, rpm_to_rad_s,
+};
+use mechcalc::calc::bus_fuel_economy::{BusFuelEconomyRequest, BusFuelEconomyResponse, run};
+use mechcalc::numerics::Budget;
+use serde_json::{Value, json};
+
+const CYCLES: [&str; 3] = ["manhattan", "hwfet", "hdudds"];
+
+fn run_json(v: Value) -> BusFuelEconomyResponse {
+    let req: BusFuelEconomyRequest = serde_json::from_value(v).expect("request decodes");
+    run(req, &Budget::unlimited()).expect("run succeeds")
+}
+
+/// Constant motor η_M = 0.93 with the 800 N·m / 130 kW / 5200 rpm envelope (V3, V4, V9).
+fn constant_motor() -> Value {
+    json!({"id": "c93", "model": "constant", "efficiency": 0.93, "t_peak_nm": 800, "p_peak_w": 130000, "n_max_rpm": 5200})
+}
+
+/// The spec's demo IPMSM (V5).
+fn demo_ipmsm_json(id: &str, h: f64) -> Value {
+    json!({"id": id, "model": "ipmsm", "pole_pairs": 4, "back_emf": {"v_peak_phase": 83.3, "at_rpm": 1000},
+           "ld_h": 0.00035, "lq_h": 0.00055, "r_phase_20c_ohm": 0.006, "winding_temp_c": 100, "i_max_arms": 500,
+           "v_dc": 360, "n_max_rpm": 5200, "t_cap_nm": 800, "p_cap_w": 130000,
+           "ac_factor": {"model": "dowell", "conductor_height_m": h, "layers": 6, "porosity": 0.9,
+                         "stack_length_m": 0.083, "end_length_m": 0.05},
+           "iron": {"k_h": 3.0, "k_e": 0.03}})
+}
+
+fn demo_ipmsm(caps: bool) -> Ipmsm {
+    Ipmsm::new(&IpmsmParams {
+        pole_pairs: 4.0,
+        psi_m_wb: psi_from_back_emf(83.3, 1000.0, 4.0),
+        ld_h: 0.00035,
+        lq_h: 0.00055,
+        r_20_ohm: 0.006,
+        winding_temp_c: 100.0,
+        i_max_arms: 500.0,
+        v_dc: 360.0,
+        voltage_utilization: 1.0,
+        n_max_rpm: 5200.0,
+        t_cap_nm: if caps { 800.0 } else { f64::INFINITY },
+        p_cap_w: if caps { 130_000.0 } else { f64::INFINITY },
+        ac: AcFactor::Dowell(Dowell {
+            conductor_height_m: 0.0035,
+            layers: 6.0,
+            porosity: 0.9,
+            stack_length_m: 0.083,
+            end_length_m: 0.05,
+        }),
+        k_h: 3.0,
+        k_e: 0.03,
+        c_fric: 0.0,
+        c_wind: 0.0,
+        stack_scale: 1.0,
+    })
+}
+
+/// V1 (§4 table): cycle facts, exact to 1e-9.
+#[test]
+fn v1_cycle_facts() {
+    // (name, samples, duration s, distance km, max speed km/h, max motor speed rpm at defaults)
+    let table = [
+        ("manhattan", 1090, 1089.0, 3.324368, 40.716, 2137.6),
+        ("hwfet", 766, 765.0, 16.506550, 96.400, 5061.0),
+        ("hdudds", 1061, 1060.0, 8.935105, 93.342, 4900.0),
+    ];
+    assert_eq!(BUILTIN_NAMES, CYCLES);
+    let resp = run_json(json!({"cycles": CYCLES, "motors": [constant_motor()]}));
+    for (k, (name, n, dur, km, kmh, rpm)) in table.into_iter().enumerate() {
+        let c = cycles::builtin(name).expect("built-in cycle parses");
+        assert_eq!(c.time_s.len(), n, "{name} samples");
+        assert_relative_eq!(c.duration_s(), dur, max_relative = 1e-12);
+        // The spec prints distance to 1e-6 km, max speed to 1e-3 km/h, motor speed to 0.1 rpm
+        // (HWFET/HDUDDS to 1 rpm): the tolerance is half a printed unit.
+        assert!(
+            (c.distance_m() / 1000.0 - km).abs() <= 5e-7,
+            "{name} distance {}",
+            c.distance_m()
+        );
+        assert!(
+            (c.max_speed_mps() * 3.6 - kmh).abs() <= 5e-4,
+            "{name} max speed"
+        );
+        let r = &resp.results[k];
+        assert_eq!(r.cycle, name);
+        assert_relative_eq!(r.distance_km, c.distance_m() / 1000.0, max_relative = 1e-9);
+        assert_relative_eq!(r.duration_s, dur, max_relative = 1e-9);
+        let tol = if name == "manhattan" { 0.05 } else { 0.5 };
+        assert!(
+            (r.max_motor_speed_rpm - rpm).abs() <= tol,
+            "{name} motor speed {}",
+            r.max_motor_speed_rpm
+        );
+    }
+}
+
+/// V2: lossless chain, unlimited regen, backward: E_in equals the road-load energy (1e-9), and
+/// the positive / negative wheel energies (1e-4).
+#[test]
+fn v2_lossless_identity() {
+    let resp = run_json(json!({
+        "vehicle": {"gear_efficiency": 1.0}, "inverter": {"efficiency": 1.0},
+        "battery": {"model": "constant", "efficiency": 1.0}, "cycles": CYCLES,
+        "motors": [{"id": "ideal", "model": "constant", "efficiency": 1.0}],
+        "options": {"regen_limit": false, "outputs": ["traces"]}
+    }));
+    let expect = [
+        (1.095141, 3.035563, 4.5702, -3.4751),
+        (11.895652, 1.387612, 14.1176, -2.2220),
+        (5.272665, 1.694609, 9.2625, -3.9898),
+    ];
+    for (r, (e, fe, pos, neg)) in resp.results.iter().zip(expect) {
+        // Printed to 1e-6 kWh / 1e-6 km/kWh: rel tolerance from the printed digits.
+        assert_relative_eq!(r.energy_in_kwh, e, max_relative = 1e-6);
+        assert_relative_eq!(
+            r.fe_km_per_kwh.expect("positive energy"),
+            fe,
+            max_relative = 1e-6
+        );
+        assert_relative_eq!(r.energy_traction_kwh, pos, max_relative = 1e-4);
+        assert_relative_eq!(r.energy_regen_kwh, neg, max_relative = 1e-4);
+        assert_relative_eq!(
+            r.energy_in_kwh,
+            r.energy_traction_kwh + r.energy_regen_kwh,
+            max_relative = 1e-12
+        );
+        // Identity to 1e-9: E_in equals Σ (F_roll + F_aero) v̄ Δt recomputed independently.
+        let c = cycles::builtin(&r.cycle).expect("cycle");
+        let (m, g, fr, k) = (15_100.0, 9.81, 0.007, 0.5 * 1.28 * 0.7 * 6.72);
+        let mut road = 0.0;
+        for j in 1..c.time_s.len() {
+            let vb = 0.5 * (c.speed_mps[j - 1] + c.speed_mps[j]);
+            let dt = c.time_s[j] - c.time_s[j - 1];
+            if vb > 0.0 {
+                road += (m * g * fr + k * vb * vb) * vb * dt;
+            }
+        }
+        assert_relative_eq!(r.energy_in_kwh, road / 3.6e6, max_relative = 1e-9);
+    }
+}
+
+/// V3: constant η_M = 0.93, backward: FE, over-envelope counts and friction-brake energy (1e-6).
+#[test]
+fn v3_constant_motor_backward() {
+    let resp = run_json(json!({"cycles": CYCLES, "motors": [constant_motor()]}));
+    let expect = [
+        (1.178235, 66, 0.349203),
+        (1.075621, 92, 0.465627),
+        (1.097645, 85, 0.540163),
+    ];
+    for (r, (fe, n, brake)) in resp.results.iter().zip(expect) {
+        assert_relative_eq!(r.fe_km_per_kwh.expect("fe"), fe, max_relative = 1e-6);
+        assert_eq!(r.n_over_envelope, n, "{}", r.cycle);
+        assert_relative_eq!(r.friction_brake_kwh, brake, max_relative = 1e-6);
+    }
+}
+
+/// V4: same, forward mode: FE and achieved distance (1e-5).
+#[test]
+fn v4_constant_motor_forward() {
+    let resp = run_json(
+        json!({"cycles": CYCLES, "motors": [constant_motor()], "options": {"mode": "forward"}}),
+    );
+    let expect = [
+        (1.173060, 3.234668),
+        (1.080252, 16.400480),
+        (1.108798, 8.883315),
+    ];
+    for (r, (fe, km)) in resp.results.iter().zip(expect) {
+        assert_relative_eq!(r.fe_km_per_kwh.expect("fe"), fe, max_relative = 1e-5);
+        assert_relative_eq!(r.distance_km, km, max_relative = 1e-5);
+        let miss = r.trace_miss_km.expect("forward reports the trace miss");
+        assert!(miss > 0.0);
+    }
+}
+
+/// V5: k_AC of the demo winding at 100 °C (1e-6).
+#[test]
+fn v5_ac_factor() {
+    let m = demo_ipmsm(true);
+    for (f, k) in [
+        (50.0, 1.022887),
+        (100.0, 1.091446),
+        (200.0, 1.364159),
+        (346.667, 2.081249),
+        (500.0, 3.207322),
+    ] {
+        assert_relative_eq!(m.ac.k_ac(f, 100.0), k, max_relative = 1e-6);
+    }
+    assert_relative_eq!(m.psi, 0.198864, max_relative = 5e-6);
+}
+
+/// V5: envelope without and with caps (1e-5).
+#[test]
+fn v5_envelope() {
+    let raw = demo_ipmsm(false);
+    for (rpm, t) in [
+        (0.0, 994.724),
+        (500.0, 994.724),
+        (1000.0, 994.724),
+        (1600.0, 947.093),
+        (2000.0, 819.119),
+        (3000.0, 570.263),
+        (4000.0, 423.153),
+        (5000.0, 335.917),
+        (5200.0, 322.654),
+    ] {
+        assert_relative_eq!(raw.t_max(rpm_to_rad_s(rpm)), t, max_relative = 1e-5);
+    }
+    let capped = demo_ipmsm(true);
+    assert_relative_eq!(
+        capped.t_max(rpm_to_rad_s(1600.0)),
+        775.880,
+        max_relative = 1e-5
+    );
+    assert_relative_eq!(
+        capped.t_max(rpm_to_rad_s(5200.0)),
+        238.732,
+        max_relative = 1e-5
+    );
+    assert_relative_eq!(
+        capped.t_max(rpm_to_rad_s(500.0)),
+        800.0,
+        max_relative = 1e-12
+    );
+}
+
+/// V5: loss points (1e-5 relative; printed to 3 decimals, so also 5e-4 absolute).
+#[test]
+fn v5_loss_points() {
+    let m = demo_ipmsm(true);
+    // (rpm, T, mode, i_d, i_q, k_AC, P_cu,DC, P_cu, P_fe, P_loss, η)
+    let table = [
+        (
+            1000.0,
+            100.0,
+            OpMode::Mtpa,
+            -6.9187,
+            83.2302,
+            1.040677,
+            82.513,
+            85.869,
+            265.285,
+            351.154,
+            Some(0.967555),
+        ),
+        (
+            4600.0,
+            100.0,
+            OpMode::FluxWeakening,
+            -279.578,
+            65.416,
+            1.849376,
+            975.270,
+            1803.641,
+            1347.114,
+            3150.755,
+            Some(0.938608),
+        ),
+        (
+            4600.0,
+            -100.0,
+            OpMode::FluxWeakening,
+            -275.850,
+            -65.608,
+            1.849376,
+            951.075,
+            1758.894,
+            1379.087,
+            3137.981,
+            Some(0.938842),
+        ),
+        (
+            5200.0,
+            0.0,
+            OpMode::FluxWeakening,
+            -295.565,
+            0.0,
+            2.081249,
+            1033.419,
+            2150.802,
+            1355.329,
+            3506.131,
+            None,
+        ),
+        (
+            5200.0,
+            238.7,
+            OpMode::FluxWeakening,
+            -416.875,
+            140.956,
+            2.081249,
+            2290.842,
+            4767.812,
+            1312.235,
+            6080.048,
+            Some(0.955314),
+        ),
+        (
+            3000.0,
+            400.0,
+            OpMode::FluxWeakening,
+            -325.463,
+            252.567,
+            1.364159,
+            2007.677,
+            2738.790,
+            1355.995,
+            4094.785,
+            Some(0.968443),
+        ),
+    ];
+    let close = |a: f64, b: f64, what: &str| {
+        assert!(
+            (a - b).abs() <= 1e-5 * b.abs() + 5e-4,
+            "{what}: got {a}, expected {b}"
+        );
+    };
+    for (rpm, t, mode, id, iq, kac, cudc, cu, fe, loss, eta) in table {
+        let w = rpm_to_rad_s(rpm);
+        let tm = m.t_max(w);
+        let (s, c, fallback) = m.evaluate(w, t, tm);
+        let tag = format!("{rpm} rpm {t} N·m");
+        assert!(!fallback, "{tag}");
+        assert_eq!(c.mode, mode, "{tag}");
+        close(c.i_d, id, &format!("{tag} i_d"));
+        close(c.i_q, iq, &format!("{tag} i_q"));
+        close(s.k_ac, kac, &format!("{tag} k_ac"));
+        close(s.cu_dc, cudc, &format!("{tag} P_cu,DC"));
+        close(s.cu, cu, &format!("{tag} P_cu"));
+        close(s.iron, fe, &format!("{tag} P_fe"));
+        close(s.total, loss, &format!("{tag} P_loss"));
+        if let Some(eta) = eta {
+            let p = (t * w).abs();
+            close(p / (p + s.total), eta, &format!("{tag} η"));
+        }
+    }
+}
+
+/// V5: FE of the demo IPMSM, backward, direct evaluation, 15 100 kg and 12 500 kg (1e-4).
+#[test]
+fn v5_demo_ipmsm_fe() {
+    for (passengers, expect) in [
+        (40, [1.250528, 1.113615, 1.163423]),
+        (0, [1.576495, 1.213515, 1.326687]),
+    ] {
+        let resp = run_json(json!({
+            "vehicle": {"passengers": passengers}, "cycles": CYCLES,
+            "motors": [demo_ipmsm_json("demo", 0.0035)], "options": {"motor_eval": "direct"}
+        }));
+        for (r, fe) in resp.results.iter().zip(expect) {
+            assert_relative_eq!(r.fe_km_per_kwh.expect("fe"), fe, max_relative = 1e-4);
+            assert_eq!(r.n_envelope_fallback, 0);
+        }
+    }
+}
+
+/// V6: Dowell functions (1e-12 relative).
+#[test]
+fn v6_dowell_functions() {
+    let table = [
+        (0.1, 1.0000088888550265, 3.333319841e-5),
+        (1.0, 1.0856357047503278, 0.32037337190294546),
+        (2.0, 1.8978064467695104, 3.2486829680767317),
+        (5.0, 4.999372104140527, 10.089742480707653),
+    ];
+    for (xi, f1, f2) in table {
+        assert_relative_eq!(dowell_f1(xi), f1, max_relative = 1e-12);
+        // F2(0.1) is printed with 10 significant digits.
+        let tol2 = if xi < 0.3 { 1e-9 } else { 1e-12 };
+        assert_relative_eq!(dowell_f2(xi), f2, max_relative = tol2);
+    }
+}
+
+/// V7: desirability (eq. 12-13).
+#[test]
+fn v7_desirability() {
+    let d: Vec<f64> = [10.0, 12.0, 11.0]
+        .iter()
+        .map(|&f| desirability(f, 9.0, 13.0))
+        .collect();
+    for (a, b) in d.iter().zip([0.75, 0.25, 0.5]) {
+        assert_relative_eq!(*a, b, max_relative = 1e-15);
+    }
+    let w = [1.0 / 3.0; 3];
+    assert_relative_eq!(overall_desirability(&d, &w), 0.454280, max_relative = 1e-6);
+    assert_relative_eq!(
+        overall_desirability(&[0.5, 0.0, 1.0], &w),
+        0.0,
+        epsilon = 0.0
+    );
+    assert_relative_eq!(desirability(5.0, 5.0, 5.0), 1.0, epsilon = 0.0);
+}
+
+/// V8: paper constants.
+#[test]
+fn v8_paper_constants() {
+    assert_relative_eq!(paper::g1_torque_nm(), 840.0, max_relative = 1e-12);
+    assert_relative_eq!(paper::g2_torque_nm(), 250.845, max_relative = 1e-12);
+    assert_relative_eq!(
+        paper::torque_at_power(130_000.0, 5200.0),
+        238.73,
+        max_relative = 5e-5
+    );
+    assert_eq!(paper::initial_samples(3), 10);
+    assert_relative_eq!(
+        paper::vehicle_speed_kmh(5200.0, 9.5, 0.48),
+        99.049,
+        max_relative = 5e-6
+    );
+    assert_relative_eq!(
+        paper::vehicle_speed_kmh(1600.0, 9.5, 0.48),
+        30.477,
+        max_relative = 5e-5
+    );
+    assert_relative_eq!(
+        paper::back_emf_error(83.3, 83.2),
+        0.0012,
+        max_relative = 0.01
+    );
+    // 800 N·m at the 1600 rpm base speed is 134 kW > 130 kW (corner at 1552 rpm).
+    assert!((800.0 * rpm_to_rad_s(1600.0) / 1000.0 - 134.0).abs() < 0.05);
+    assert!((130_000.0 / 800.0 / rpm_to_rad_s(1.0) - 1552.0).abs() < 0.5);
+}
+
+/// V9: 2RC battery on HDUDDS, constant motor, clip mode (1e-6).
+#[test]
+fn v9_ecm_battery() {
+    let base = json!({
+        "cycles": ["hdudds"], "motors": [constant_motor()], "options": {"mode": "clip"},
+        "battery": {"model": "ecm_2rc", "ocv_soc": [0.0, 1.0], "ocv_v": [330.0, 390.0], "r0_ohm": 0.03,
+                    "r1_ohm": 0.01, "c1_f": 3000.0, "r2_ohm": 0.01, "c2_f": 30000.0, "soc_initial": 0.9,
+                    "capacity_kwh": 256.0, "nominal_voltage": 360.0}
+    });
+    let r = &run_json(base.clone()).results[0];
+    assert_relative_eq!(r.fe_km_per_kwh.expect("fe"), 1.280689, max_relative = 1e-6);
+    assert_relative_eq!(
+        r.battery_soc_end.expect("soc"),
+        0.874399,
+        max_relative = 1e-6
+    );
+    assert_eq!(r.battery_flags.as_deref(), Some(&[][..]));
+    let mut c = base;
+    c["battery"] = json!({"model": "constant", "efficiency": 1.0});
+    let r = &run_json(c).results[0];
+    assert_relative_eq!(r.fe_km_per_kwh.expect("fe"), 1.336814, max_relative = 1e-6);
+}
