@@ -189,7 +189,7 @@ pub fn motor_map(
                     data.fallbacks += u64::from(fb);
                     (s.total, Some((s, c.i_d, c.i_q, c.mode)))
                 }
-                _ => (ev.loss(w, t, tm, false).loss, None),
+                _ => (ev.loss(w, t, t, tm, false).loss, None),
             };
             let p = (t * w).abs();
             lrow.push(Some(loss));
@@ -358,9 +358,10 @@ pub fn compute(
         };
         for (ci, c) in input.cycles.iter().enumerate() {
             let mut ev = match (&ipmsm_map, &m.kind) {
-                (Some(map), _) => MotorEvaluator::IpmsmMap {
+                (Some(map), MotorKind::Ipmsm(im)) => MotorEvaluator::IpmsmMap {
                     map,
-                    omega_max: m.omega_max,
+                    motor: im,
+                    cache: HashMap::new(),
                 },
                 _ => evaluator_direct(m),
             };

@@ -8,6 +8,11 @@
 //! the amplitude-invariant form used here is equivalent. Sign convention: i_q has the sign of the
 //! torque; i_d ≤ 0 (demagnetising); the rotor turns forward (ω_m ≥ 0).
 
+// Plain products instead of `mul_add`: without FMA hardware in the target (the default x86-64
+// baseline) `mul_add` is a libm call, ~10x slower in these per-interval loops, and plain
+// arithmetic follows the rounding of the spec's reference implementation.
+#![allow(clippy::suboptimal_flops)]
+
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use super::ac_factor::{AcFactor, temp_factor};
@@ -130,6 +135,8 @@ pub struct Ipmsm {
     pub c_fric: f64,
     /// Windage coefficient c_wind.
     pub c_wind: f64,
+    /// (sin β_k, cos β_k) of the envelope's β grid.
+    trig: Vec<(f64, f64)>,
 }
 
 /// Parameters of [`Ipmsm::new`] as given on the wire (before temperature and stack scaling).
@@ -194,7 +201,7 @@ pub fn rad_s_to_rpm(w: f64) -> f64 {
 /// Roots (low, high) of a s² + b s + c = 0 in the cancellation-free form (spec §8 item 6), or
 /// `None` when the discriminant is negative. `a` must be > 0.
 fn quadratic_roots(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
-    let disc = b.mul_add(b, -4.0 * a * c);
+    let disc = b * b - 4.0 * a * c;
     if disc < 0.0 {
         return None;
     }
@@ -207,6 +214,15 @@ fn quadratic_roots(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
     let (r1, r2) = (q / a, c / q);
     Some((r1.min(r2), r1.max(r2)))
 }
+
+/// (sin β, cos β) on the N_BETA-point grid of [0, π/2].
+fn beta_grid() -> Vec<(f64, f64)> {
+    let step = FRAC_PI_2 / (N_BETA - 1) as f64;
+    (0..N_BETA).map(|k| (k as f64 * step).sin_cos()).collect()
+}
+
+/// Stride of the coarse pre-scan that looks for a binding torque/power cap.
+const CAP_PRESCAN_STRIDE: usize = 16;
 
 impl Ipmsm {
     /// Build from wire parameters: hot resistance R(T_w) = R_20 (1 + 0.00393 (T_w − 20)),
@@ -223,7 +239,7 @@ impl Ipmsm {
                 let slot = r_hot * ls / (ls + le);
                 let end = r_hot * le / (ls + le);
                 d.stack_length_m *= s;
-                slot.mul_add(s, end)
+                slot * s + end
             }
             _ => r_hot,
         };
@@ -244,30 +260,38 @@ impl Ipmsm {
             k_e: p.k_e * s,
             c_fric: p.c_fric,
             c_wind: p.c_wind,
+            trig: beta_grid(),
         }
     }
 
     /// Electromagnetic torque T = 1.5 p [ψ_m i_q + (L_d − L_q) i_d i_q] [N·m].
     #[must_use]
     pub fn torque(&self, i_d: f64, i_q: f64) -> f64 {
-        1.5 * self.p * i_q * (self.ld - self.lq).mul_add(i_d, self.psi)
+        1.5 * self.p * i_q * (self.psi + (self.ld - self.lq) * i_d)
     }
 
     /// Steady-state voltage amplitude |v| [V peak] at electrical speed `w_e`.
     #[must_use]
     pub fn voltage(&self, w_e: f64, i_d: f64, i_q: f64) -> f64 {
-        let vd = self.r.mul_add(i_d, -w_e * self.lq * i_q);
-        let vq = self.r.mul_add(i_q, w_e * self.ld.mul_add(i_d, self.psi));
+        let vd = self.r * i_d - w_e * self.lq * i_q;
+        let vq = self.r * i_q + w_e * (self.psi + self.ld * i_d);
         vd.hypot(vq)
+    }
+
+    /// Squared voltage amplitude |v|² [V²] (comparisons against V_max² avoid a square root).
+    fn voltage_sq(&self, w_e: f64, i_d: f64, i_q: f64) -> f64 {
+        let vd = self.r * i_d - w_e * self.lq * i_q;
+        let vq = self.r * i_q + w_e * (self.psi + self.ld * i_d);
+        vd * vd + vq * vq
     }
 
     /// Largest current s* ≤ I_pk at angle β inside the voltage limit, for torque sign `sign`
     /// (i_d = −s sinβ, i_q = sign·s cosβ); `None` if the angle is infeasible (§5.5.4).
     fn s_star(&self, w_e: f64, sin_b: f64, cos_b: f64, sign: f64) -> Option<f64> {
-        let a = (-self.r).mul_add(sin_b, -sign * w_e * self.lq * cos_b);
-        let b = (sign * self.r).mul_add(cos_b, -w_e * self.ld * sin_b);
+        let a = -self.r * sin_b - sign * w_e * self.lq * cos_b;
+        let b = sign * self.r * cos_b - w_e * self.ld * sin_b;
         let c = w_e * self.psi;
-        let qa = a.mul_add(a, b * b);
+        let qa = a * a + b * b;
         let (s_lo, s_hi) = if 2.0 * qa < QUAD_EPS {
             // |v| = |C| independent of s.
             if c.abs() <= self.v_max {
@@ -276,29 +300,61 @@ impl Ipmsm {
                 return None;
             }
         } else {
-            quadratic_roots(qa, 2.0 * b * c, c.mul_add(c, -self.v_max * self.v_max))?
+            quadratic_roots(qa, 2.0 * b * c, c * c - self.v_max * self.v_max)?
         };
         let s = s_hi.min(self.i_pk);
         (s >= s_lo.max(0.0) && s > 0.0).then_some(s)
     }
 
     /// Torque magnitude at angle β with the largest admissible current (0 if infeasible).
-    fn torque_at_beta(&self, w_e: f64, beta: f64, sign: f64) -> (f64, f64) {
-        let (sin_b, cos_b) = beta.sin_cos();
+    fn torque_at_sc(&self, w_e: f64, sin_b: f64, cos_b: f64, sign: f64) -> (f64, f64) {
         match self.s_star(w_e, sin_b, cos_b, sign) {
             Some(s) => (
-                1.5 * self.p * s * cos_b * ((self.lq - self.ld) * s).mul_add(sin_b, self.psi),
+                1.5 * self.p * s * cos_b * (self.psi + (self.lq - self.ld) * s * sin_b),
                 s,
             ),
             None => (0.0, 0.0),
         }
     }
 
+    fn torque_at_beta(&self, w_e: f64, beta: f64, sign: f64) -> (f64, f64) {
+        let (sin_b, cos_b) = beta.sin_cos();
+        self.torque_at_sc(w_e, sin_b, cos_b, sign)
+    }
+
+    /// The MTPA point on the current circle s = I_pk: (torque, β). sinβ solves
+    /// ∂T/∂β = 0, 2ΔL I sin²β + ψ sinβ − ΔL I = 0 (β = 0 for ΔL = 0).
+    fn mtpa_at_current_limit(&self) -> (f64, f64) {
+        let (dl, i) = (self.lq - self.ld, self.i_pk);
+        // Cancellation-free root of 2ΔL I x² + ψ x − ΔL I = 0.
+        let sin_b =
+            2.0 * dl * i / (self.psi + (self.psi * self.psi + 8.0 * dl * dl * i * i).sqrt());
+        let beta = sin_b.clamp(0.0, 1.0).asin();
+        let cos_b = beta.cos();
+        (1.5 * self.p * i * cos_b * (self.psi + dl * i * sin_b), beta)
+    }
+
     /// Envelope from the current and voltage limits only (no caps, no n_max), §5.5.4:
     /// best of 721 angles, then 60 golden-section steps on the neighbouring bracket.
+    ///
+    /// Shortcut (exact): when the voltage limit admits the full current at the MTPA angle of the
+    /// current circle, that point is the global maximum (T grows with s at every β ∈ [0, π/2]),
+    /// which the scan would converge to.
     #[must_use]
     pub fn envelope_raw(&self, omega_m: f64, sign: f64) -> EnvelopePoint {
         let w_e = self.p * omega_m;
+        let (t_m, beta_m) = self.mtpa_at_current_limit();
+        let (sin_m, cos_m) = beta_m.sin_cos();
+        if self
+            .s_star(w_e, sin_m, cos_m, sign)
+            .is_some_and(|s| s >= self.i_pk)
+        {
+            return EnvelopePoint {
+                torque: t_m,
+                beta: beta_m,
+                current: self.i_pk,
+            };
+        }
         let step = FRAC_PI_2 / (N_BETA - 1) as f64;
         let mut best = EnvelopePoint {
             torque: 0.0,
@@ -306,13 +362,12 @@ impl Ipmsm {
             current: 0.0,
         };
         let mut best_k = 0usize;
-        for k in 0..N_BETA {
-            let beta = k as f64 * step;
-            let (t, s) = self.torque_at_beta(w_e, beta, sign);
+        for (k, &(sin_b, cos_b)) in self.trig.iter().enumerate() {
+            let (t, s) = self.torque_at_sc(w_e, sin_b, cos_b, sign);
             if t > best.torque {
                 best = EnvelopePoint {
                     torque: t,
-                    beta,
+                    beta: k as f64 * step,
                     current: s,
                 };
                 best_k = k;
@@ -356,18 +411,31 @@ impl Ipmsm {
     }
 
     /// Envelope T_max(ω_m) with caps: min(T_raw, t_cap, p_cap/ω_m); 0 above n_max.
+    ///
+    /// Exact shortcut: once any grid angle reaches the binding cap, T_max is the cap (a coarse
+    /// pre-scan finds such an angle for most speeds of a capped motor).
     #[must_use]
     pub fn t_max(&self, omega_m: f64) -> f64 {
         if omega_m > self.omega_max {
             return 0.0;
         }
-        let raw = self.envelope_raw(omega_m, 1.0).torque;
         let cap_p = if omega_m > 0.0 {
             self.p_cap / omega_m
         } else {
             f64::INFINITY
         };
-        raw.min(self.t_cap).min(cap_p)
+        let cap = self.t_cap.min(cap_p);
+        if cap.is_finite() {
+            let w_e = self.p * omega_m;
+            let reaches = |k: usize| {
+                let (sin_b, cos_b) = self.trig[k];
+                self.torque_at_sc(w_e, sin_b, cos_b, 1.0).0 >= cap
+            };
+            if (0..N_BETA).step_by(CAP_PRESCAN_STRIDE).any(reaches) {
+                return cap;
+            }
+        }
+        self.envelope_raw(omega_m, 1.0).torque.min(cap)
     }
 
     /// MTPA d-current for a q-current, i_d = −2ΔL i_q² / (ψ + √(ψ² + 4ΔL² i_q²)): the
@@ -375,9 +443,7 @@ impl Ipmsm {
     #[must_use]
     pub fn mtpa_id(&self, i_q: f64) -> f64 {
         let dl = self.lq - self.ld;
-        let root = (4.0 * dl * dl * i_q)
-            .mul_add(i_q, self.psi * self.psi)
-            .sqrt();
+        let root = (self.psi * self.psi + 4.0 * dl * dl * i_q * i_q).sqrt();
         -2.0 * dl * i_q * i_q / (self.psi + root)
     }
 
@@ -387,6 +453,7 @@ impl Ipmsm {
         let sign = if t < 0.0 { -1.0 } else { 1.0 };
         let ta = t.abs();
         let w_e = self.p * omega_m;
+        let v2 = self.v_max * self.v_max;
         // a. MTPA current by bisection on i_q.
         let t_mtpa = |iq: f64| self.torque(self.mtpa_id(iq), iq);
         if t_mtpa(self.i_pk) < ta {
@@ -404,7 +471,7 @@ impl Ipmsm {
         let iq_m = hi;
         let id_m = self.mtpa_id(iq_m);
         // b. Inside the voltage limit?
-        if self.voltage(w_e, id_m, sign * iq_m) <= self.v_max {
+        if self.voltage_sq(w_e, id_m, sign * iq_m) <= v2 {
             return Some(Currents {
                 i_d: id_m,
                 i_q: sign * iq_m,
@@ -412,20 +479,20 @@ impl Ipmsm {
             });
         }
         // c. Flux weakening along the constant-torque curve.
-        let iq_of = |id: f64| ta / (1.5 * self.p * (self.ld - self.lq).mul_add(id, self.psi));
+        let iq_of = |id: f64| ta / (1.5 * self.p * (self.psi + (self.ld - self.lq) * id));
         let step = (-self.i_pk - id_m) / FW_SCAN_STEPS as f64;
         let mut prev = id_m;
         for k in 1..=FW_SCAN_STEPS {
-            let id = step.mul_add(k as f64, id_m);
+            let id = id_m + step * k as f64;
             let iq = iq_of(id);
-            if id.hypot(iq) > self.i_pk {
+            if id * id + iq * iq > self.i_pk * self.i_pk {
                 return None;
             }
-            if self.voltage(w_e, id, sign * iq) <= self.v_max {
+            if self.voltage_sq(w_e, id, sign * iq) <= v2 {
                 let (mut bad, mut good) = (prev, id);
                 for _ in 0..BISECT_ITERS {
                     let mid = 0.5 * (bad + good);
-                    if self.voltage(w_e, mid, sign * iq_of(mid)) <= self.v_max {
+                    if self.voltage_sq(w_e, mid, sign * iq_of(mid)) <= v2 {
                         good = mid;
                     } else {
                         bad = mid;
@@ -484,8 +551,7 @@ impl Ipmsm {
         // T(β, s) = 1.5 p cosβ (ψ s + ΔL sinβ s²): smallest s ≥ 0 with T = |t|.
         let c = ta / (1.5 * self.p * cos_b);
         let k = (self.lq - self.ld) * sin_b;
-        let s =
-            (2.0 * c / (self.psi + (4.0 * k).mul_add(c, self.psi * self.psi).sqrt())).min(s_max);
+        let s = (2.0 * c / (self.psi + (self.psi * self.psi + 4.0 * k * c).sqrt())).min(s_max);
         let (i_d, i_q) = (-s * sin_b, sign * s * cos_b);
         (s.is_finite()).then_some(Currents {
             i_d,
@@ -529,12 +595,12 @@ impl Ipmsm {
         let w = omega_m.abs();
         let w_e = self.p * w;
         let k_ac = self.ac.k_ac(w_e / (2.0 * PI), self.temp_c);
-        let cu_dc = 1.5 * self.r * i_d.mul_add(i_d, i_q * i_q);
+        let cu_dc = 1.5 * self.r * (i_d * i_d + i_q * i_q);
         let cu = k_ac * cu_dc;
-        let fd = self.ld.mul_add(i_d, self.psi);
+        let fd = self.psi + self.ld * i_d;
         let fq = self.lq * i_q;
-        let iron = self.k_e.mul_add(w_e * w_e, self.k_h * w_e) * fd.mul_add(fd, fq * fq);
-        let mech = (self.c_wind * w * w).mul_add(w, self.c_fric * w);
+        let iron = (self.k_h * w_e + self.k_e * w_e * w_e) * (fd * fd + fq * fq);
+        let mech = self.c_fric * w + self.c_wind * w * w * w;
         LossSplit {
             k_ac,
             cu_dc,

@@ -202,12 +202,15 @@ pub enum MotorEvaluator<'a> {
         /// T_max per speed (key: f64 bits).
         cache: HashMap<u64, f64>,
     },
-    /// ipmsm through its precomputed loss map.
+    /// ipmsm through its precomputed loss map; T_max still evaluated exactly (cached per
+    /// distinct speed), as the spec's reference implementation does.
     IpmsmMap {
         /// The map.
         map: &'a IpmsmMap,
-        /// n_max [rad/s].
-        omega_max: f64,
+        /// The motor (for T_max).
+        motor: &'a Ipmsm,
+        /// T_max per speed (key: f64 bits).
+        cache: HashMap<u64, f64>,
     },
 }
 
@@ -231,22 +234,20 @@ impl MotorEvaluator<'_> {
                     envelope.t_max(w)
                 }
             }
-            Self::IpmsmDirect { motor, cache } => {
+            Self::IpmsmDirect { motor, cache } | Self::IpmsmMap { motor, cache, .. } => {
                 *cache.entry(w.to_bits()).or_insert_with(|| motor.t_max(w))
-            }
-            Self::IpmsmMap { map, omega_max } => {
-                if w > *omega_max {
-                    0.0
-                } else {
-                    map.envelope.t_max(w)
-                }
             }
         }
     }
 
-    /// Loss at (ω, t) with `t` already clamped to ±`t_max`; `want_parts` asks for the ipmsm
-    /// split (a map lookup per part).
-    pub fn loss(&mut self, w: f64, t: f64, t_max: f64, want_parts: bool) -> LossEval {
+    /// Loss at speed ω for the delivered torque `t_del`, `t` being it clamped to ±`t_max`
+    /// (spec §5.4: losses at the envelope); `want_parts` asks for the ipmsm split.
+    ///
+    /// The ipmsm loss map is looked up at `t_del` itself (clamped to its torque axis only): its
+    /// grid points beyond the envelope already hold the envelope loss of their speed, so the
+    /// clamp is applied at the grid points. This is what the spec's reference implementation does
+    /// (it reproduces the §10 example and the §9 accuracy table to the printed digits).
+    pub fn loss(&mut self, w: f64, t_del: f64, t: f64, t_max: f64, want_parts: bool) -> LossEval {
         match self {
             Self::Constant { eta, .. } => LossEval {
                 loss: (t * w).abs() * (1.0 / *eta - 1.0),
@@ -267,6 +268,7 @@ impl MotorEvaluator<'_> {
                 }
             }
             Self::IpmsmMap { map, .. } => {
+                let t = t_del;
                 let parts = want_parts.then(|| {
                     let p = &map.parts;
                     [
