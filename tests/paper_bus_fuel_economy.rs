@@ -86,7 +86,7 @@ fn v1_cycle_facts() {
             c.distance_m()
         );
         assert!(
-            (c.max_speed_mps() * 3.6 - kmh).abs() <= 5e-4,
+            c.max_speed_mps().mul_add(3.6, -kmh).abs() <= 5e-4,
             "{name} max speed"
         );
         let r = &resp.results[k];
@@ -140,7 +140,7 @@ fn v2_lossless_identity() {
             let vb = 0.5 * (c.speed_mps[j - 1] + c.speed_mps[j]);
             let dt = c.time_s[j] - c.time_s[j - 1];
             if vb > 0.0 {
-                road += (m * g * fr + k * vb * vb) * vb * dt;
+                road += (k * vb).mul_add(vb, m * g * fr) * vb * dt;
             }
         }
         assert_relative_eq!(r.energy_in_kwh, road / 3.6e6, max_relative = 1e-9);
@@ -320,7 +320,7 @@ fn v5_loss_points() {
     ];
     let close = |a: f64, b: f64, what: &str| {
         assert!(
-            (a - b).abs() <= 1e-5 * b.abs() + 5e-4,
+            (a - b).abs() <= 1e-5f64.mul_add(b.abs(), 5e-4),
             "{what}: got {a}, expected {b}"
         );
     };
@@ -452,4 +452,208 @@ fn v9_ecm_battery() {
     c["battery"] = json!({"model": "constant", "efficiency": 1.0});
     let r = &run_json(c).results[0];
     assert_relative_eq!(r.fe_km_per_kwh.expect("fe"), 1.336814, max_relative = 1e-6);
+}
+
+/// §10 wire example (two motors, backward, loss map 250 × 50): the oracle's printed values
+/// (energy 2.6591 kWh, FE 1.2502, 66 / 0.0606 over the envelope, 1709.5 N·m, 0.349 kWh of
+/// friction braking; fe_change_pct 0.145 / 0.396 / 0.315), tolerance half a printed unit.
+#[test]
+fn section10_example_values() {
+    let resp = run_json(json!({
+        "cycles": CYCLES, "motors": [demo_ipmsm_json("initial", 0.0035), demo_ipmsm_json("low_kac", 0.0032)],
+        "options": {"mode": "backward", "substeps": 1, "motor_eval": "loss_map",
+                    "loss_map_grid": {"speed_step_rpm": 250, "torque_step_nm": 50}}
+    }));
+    let r = &resp.results[0];
+    let half = |x: f64, v: f64, unit: f64| assert!((x - v).abs() <= 0.5 * unit, "{x} vs {v}");
+    half(r.energy_in_kwh, 2.6591, 1e-4);
+    half(r.fe_km_per_kwh.expect("fe"), 1.2502, 1e-4);
+    assert_eq!(r.n_over_envelope, 66);
+    half(r.frac_over_envelope, 0.0606, 1e-4);
+    half(r.max_motor_torque_demand_nm, 1709.5, 0.1);
+    half(r.friction_brake_kwh, 0.349, 1e-3);
+    let c = resp.comparison.expect("two motors");
+    let chg = &c.fe_change_pct["low_kac"];
+    for (cyc, v) in [("manhattan", 0.145), ("hwfet", 0.396), ("hdudds", 0.315)] {
+        half(chg[cyc].expect("fe"), v, 1e-3);
+    }
+    assert_eq!(c.desirability["low_kac"].d, vec![1.0, 1.0, 1.0]);
+    assert!(c.desirability["initial"].overall.abs() <= 0.0);
+}
+
+/// §9 accuracy table (errors relative to the spec's reference, direct with 16 substeps in clip
+/// mode: 1.541758 / 1.184759 / 1.412497): direct k = 1 and the loss maps at k = 16. The table
+/// prints two significant digits, so each error must match within half a unit of its second digit.
+#[test]
+fn section9_accuracy_table() {
+    let reference = [1.541758, 1.184759, 1.412497];
+    type Row = (&'static str, u32, (f64, f64), [f64; 3]);
+    let rows: [Row; 5] = [
+        ("direct", 1, (250.0, 50.0), [-8.0e-4, -4.7e-5, 2.5e-5]),
+        ("loss_map", 16, (500.0, 100.0), [-9.3e-4, 8.5e-5, -3.3e-5]),
+        ("loss_map", 16, (250.0, 50.0), [5e-6, 1.7e-4, 3.9e-4]),
+        ("loss_map", 16, (100.0, 20.0), [1.2e-4, 1.2e-4, 2.1e-4]),
+        ("loss_map", 16, (50.0, 10.0), [6.6e-5, 7.0e-5, 1.2e-4]),
+    ];
+    for (eval, k, grid, errs) in rows {
+        let resp = run_json(json!({
+            "cycles": CYCLES, "motors": [demo_ipmsm_json("demo", 0.0035)],
+            "options": {"mode": "clip", "substeps": k, "motor_eval": eval,
+                        "loss_map_grid": {"speed_step_rpm": grid.0, "torque_step_nm": grid.1}}
+        }));
+        for ((r, fe_ref), e) in resp.results.iter().zip(reference).zip(errs) {
+            let err = r.fe_km_per_kwh.expect("fe") / fe_ref - 1.0;
+            // Half a unit of the second significant digit, plus the reference's own 6-digit rounding.
+            let unit = 10f64.powf(e.abs().log10().floor() - 1.0);
+            assert!(
+                (err - e).abs() <= 0.5f64.mul_add(unit, 5e-7 / fe_ref),
+                "{eval} k={k} {grid:?} {}: {err:e} vs {e:e}",
+                r.cycle
+            );
+        }
+    }
+}
+
+/// §7.2: main operating points (modal bins of 500 rpm × 100 N·m over moving time) and the peak
+/// demands of the three cycles at 15 100 kg.
+#[test]
+fn section7_2_operating_points_and_peaks() {
+    let resp = run_json(json!({
+        "cycles": CYCLES, "motors": [constant_motor()], "options": {"outputs": ["op_histogram", "traces"]}
+    }));
+    // (modal rpm, modal N·m, share, peak torque N·m, peak motoring kW, peak braking kW)
+    let expect = [
+        ([1000.0, 1500.0], [0.0, 100.0], 0.036, 1709.0, 200.0, 166.0),
+        (
+            [4500.0, 5000.0],
+            [100.0, 200.0],
+            0.219,
+            1209.0,
+            270.0,
+            351.0,
+        ),
+        (
+            [4500.0, 5000.0],
+            [100.0, 200.0],
+            0.096,
+            1632.0,
+            363.0,
+            299.0,
+        ),
+    ];
+    for (r, (rpm, nm, share, t_peak, p_mot, p_brk)) in resp.results.iter().zip(expect) {
+        let h = r.op_histogram.as_ref().expect("histogram");
+        let m = h.modal_bin.as_ref().expect("moving");
+        let same = |a: [f64; 2], b: [f64; 2]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 0.0);
+        assert!(same(m.rpm, rpm), "{} modal rpm {:?}", r.cycle, m.rpm);
+        assert!(same(m.nm, nm), "{} modal N·m {:?}", r.cycle, m.nm);
+        assert!(
+            (m.share - share).abs() <= 5e-4,
+            "{} share {}",
+            r.cycle,
+            m.share
+        );
+        let total: f64 = h.share.iter().flatten().sum();
+        assert_relative_eq!(total, 1.0, max_relative = 1e-12);
+        assert!(
+            (r.max_motor_torque_demand_nm - t_peak).abs() <= 0.5,
+            "{}",
+            r.cycle
+        );
+        let tr = r.traces.as_ref().expect("traces");
+        let p: Vec<f64> = tr
+            .torque_demand_nm
+            .iter()
+            .zip(&tr.omega_rad_s)
+            .map(|(t, w)| t * w / 1000.0)
+            .collect();
+        let (pmax, pmin) = (
+            p.iter().copied().fold(f64::MIN, f64::max),
+            p.iter().copied().fold(f64::MAX, f64::min),
+        );
+        assert!(
+            (pmax - p_mot).abs() <= 0.5,
+            "{} peak motoring {pmax}",
+            r.cycle
+        );
+        // Peak powers are quoted at the motor shaft (T_M ω), braking included.
+        assert!(
+            (-pmin - p_brk).abs() <= 0.5,
+            "{} peak braking {}",
+            r.cycle,
+            -pmin
+        );
+    }
+}
+
+/// Leaves of `expected` must equal those of `actual` at the same path (numbers within rel 1e-6
+/// or abs 1e-9).
+fn leaves_match(expected: &Value, actual: &Value, path: &str) {
+    match (expected, actual) {
+        (Value::Object(e), Value::Object(a)) => {
+            for (k, v) in e {
+                let av = a.get(k).unwrap_or_else(|| panic!("missing {path}/{k}"));
+                leaves_match(v, av, &format!("{path}/{k}"));
+            }
+        }
+        (Value::Array(e), Value::Array(a)) => {
+            assert_eq!(e.len(), a.len(), "array length at {path}");
+            for (i, (x, y)) in e.iter().zip(a).enumerate() {
+                leaves_match(x, y, &format!("{path}/{i}"));
+            }
+        }
+        (Value::Number(e), Value::Number(a)) => {
+            let (e, a) = (e.as_f64().expect("f64"), a.as_f64().expect("f64"));
+            assert!(
+                (e - a).abs() <= 1e-9_f64.max(1e-6 * e.abs()),
+                "{path}: expected {e}, got {a}"
+            );
+        }
+        _ => assert_eq!(expected, actual, "{path}"),
+    }
+}
+
+/// The `api/bus_fuel_economy/` examples run and match their `.expected.json`.
+#[test]
+fn api_examples_match_expected() {
+    use mechcalc::calc::bus_fuel_economy::{MotorMapRequest, run_motor_map};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("api/bus_fuel_economy");
+    let mut n = 0;
+    for (sub, map) in [("", false), ("motor_map", true)] {
+        let d = dir.join(sub);
+        let mut files: Vec<_> = std::fs::read_dir(&d)
+            .expect("api dir")
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .collect();
+        files.sort();
+        for p in files {
+            let name = p
+                .file_name()
+                .and_then(|s| s.to_str())
+                .unwrap_or_default()
+                .to_owned();
+            if !name.ends_with(".json") || name.ends_with(".expected.json") {
+                continue;
+            }
+            let req: Value =
+                serde_json::from_str(&std::fs::read_to_string(&p).expect("read")).expect("json");
+            let exp: Value = serde_json::from_str(
+                &std::fs::read_to_string(p.with_extension("expected.json"))
+                    .expect("expected file exists"),
+            )
+            .expect("json");
+            let actual = if map {
+                let r: MotorMapRequest = serde_json::from_value(req).expect("decodes");
+                serde_json::to_value(run_motor_map(r, &Budget::unlimited()).expect("runs"))
+                    .expect("ser")
+            } else {
+                let r: BusFuelEconomyRequest = serde_json::from_value(req).expect("decodes");
+                serde_json::to_value(run(r, &Budget::unlimited()).expect("runs")).expect("ser")
+            };
+            leaves_match(&exp, &actual, &name);
+            n += 1;
+        }
+    }
+    assert_eq!(n, 3);
 }

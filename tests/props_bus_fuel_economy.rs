@@ -33,7 +33,8 @@ fn smooth_cycle(n: usize, dt: f64, v_peak: f64, a: f64, f: f64) -> Value {
         .map(|k| {
             let s = k as f64 / (n - 1) as f64;
             let base = (std::f64::consts::PI * s).sin().powi(2);
-            (v_peak * base * (1.0 + a * (2.0 * std::f64::consts::PI * f * s).sin())).max(0.0)
+            let wobble = a.mul_add((2.0 * std::f64::consts::PI * f * s).sin(), 1.0);
+            (v_peak * base * wobble).max(0.0)
         })
         .collect();
     let mut v = v;
@@ -88,8 +89,9 @@ fn demo_params(r20: f64, h: f64) -> IpmsmParams {
     }
 }
 
-fn ipmsm_json(id: &str, p: u32, psi: f64, ld: f64, lq: f64, r: f64, i: f64, h: f64) -> Value {
-    json!({"id": id, "model": "ipmsm", "pole_pairs": p, "psi_m_wb": psi, "ld_h": ld, "lq_h": lq,
+/// An IPMSM like the demo with (ψ_m, L_d, L_q, R_20, I_rms, conductor height) varied.
+fn ipmsm_json(psi: f64, ld: f64, lq: f64, r: f64, i: f64, h: f64) -> Value {
+    json!({"id": "rand", "model": "ipmsm", "pole_pairs": 4, "psi_m_wb": psi, "ld_h": ld, "lq_h": lq,
            "r_phase_20c_ohm": r, "i_max_arms": i, "v_dc": 360, "n_max_rpm": 5200,
            "t_cap_nm": 800, "p_cap_w": 130000,
            "ac_factor": {"model": "dowell", "conductor_height_m": h, "layers": 6, "porosity": 0.9,
@@ -107,7 +109,7 @@ fn ipmsm_strategy() -> impl Strategy<Value = Value> {
         450.0f64..600.0,
         0.002f64..0.004,
     )
-        .prop_map(|(psi, ld, dl, r, i, h)| ipmsm_json("rand", 4, psi, ld, ld + dl, r, i, h))
+        .prop_map(|(psi, ld, dl, r, i, h)| ipmsm_json(psi, ld, ld + dl, r, i, h))
 }
 
 /// Random IPMSMs whose low-speed envelope is the 800 N·m cap, like the spec's demo motor
@@ -121,7 +123,7 @@ fn capped_ipmsm_strategy() -> impl Strategy<Value = Value> {
         520.0f64..600.0,
         0.002f64..0.004,
     )
-        .prop_map(|(psi, ld, dl, r, i, h)| ipmsm_json("rand", 4, psi, ld, ld + dl, r, i, h))
+        .prop_map(|(psi, ld, dl, r, i, h)| ipmsm_json(psi, ld, ld + dl, r, i, h))
 }
 
 fn fe_of(resp: &BusFuelEconomyResponse) -> Vec<f64> {
@@ -171,7 +173,7 @@ proptest! {
         for j in 1..t.len() {
             let vb = 0.5 * (v[j - 1] + v[j]);
             if vb > 0.0 {
-                road += (mass * 9.81 * fr + k * vb * vb) * vb * (t[j] - t[j - 1]);
+                road += (k * vb).mul_add(vb, mass * 9.81 * fr) * vb * (t[j] - t[j - 1]);
             }
         }
         let e = resp.results[0].energy_in_kwh * 3.6e6;

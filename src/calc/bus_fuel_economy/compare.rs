@@ -9,7 +9,8 @@ pub fn desirability(f: f64, f_min: f64, f_max: f64) -> f64 {
     if span.abs() <= 0.0 {
         return 1.0;
     }
-    ((f - f_max) / span).clamp(0.0, 1.0)
+    // `+ 0.0` turns a −0 (f = f_max) into +0.
+    ((f - f_max) / span).clamp(0.0, 1.0) + 0.0
 }
 
 /// Overall desirability D = Π d_i^{w_i} with weights normalised to sum 1 (paper eq. 13); 0 when

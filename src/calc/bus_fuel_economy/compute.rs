@@ -7,7 +7,7 @@ use super::compare::{desirability, overall_desirability};
 use super::cycles::{Cycle, discretise};
 use super::error::BusFuelEconomyError;
 use super::input::BusFuelEconomyInput;
-use super::ipmsm::{Ipmsm, LossSplit, OpMode, rad_s_to_rpm};
+use super::ipmsm::{Currents, Ipmsm, LossSplit, rad_s_to_rpm, rpm_to_rad_s};
 use super::motor::{
     IpmsmMap, MotorEvaluator, MotorInput, MotorKind, build_ipmsm_map, grid_axes, grid_size,
 };
@@ -56,9 +56,14 @@ pub struct Histogram {
     pub modal: Option<(usize, usize, f64)>,
 }
 
+/// ipmsm loss split and currents per grid point (None outside the envelope).
+pub type PartsGrid = Vec<Vec<Option<(LossSplit, Currents)>>>;
+
 /// A motor map on a grid.
 #[derive(Debug, Clone)]
 pub struct MapData {
+    /// Speeds [rpm].
+    pub speed_rpm: Vec<f64>,
     /// Speeds [rad/s].
     pub speed: Vec<f64>,
     /// Torques [N·m].
@@ -70,7 +75,7 @@ pub struct MapData {
     /// Efficiency (None outside the envelope; 0 at zero power).
     pub eff: Vec<Vec<Option<f64>>>,
     /// ipmsm loss split, currents and mode (if requested).
-    pub parts: Option<Vec<Vec<Option<(LossSplit, f64, f64, OpMode)>>>>,
+    pub parts: Option<PartsGrid>,
     /// Grid points that needed the envelope fallback.
     pub fallbacks: u64,
     /// Model evaluations.
@@ -144,7 +149,7 @@ pub fn motor_map(
     budget: &Budget,
 ) -> Result<MapData, BusFuelEconomyError> {
     let top = t_top(m);
-    let points = grid_size(m.omega_max, top, grid.0, grid.1);
+    let points = grid_size(m.n_max_rpm, top, grid.0, grid.1);
     if points > MAX_MAP_POINTS {
         return Err(BusFuelEconomyError::MapTooLarge {
             motor: m.id.clone(),
@@ -152,9 +157,11 @@ pub fn motor_map(
             limit: MAX_MAP_POINTS,
         });
     }
-    let (speed, torque) = grid_axes(m.omega_max, top, grid.0, grid.1);
+    let (speed_rpm, torque) = grid_axes(m.n_max_rpm, top, grid.0, grid.1);
+    let speed: Vec<f64> = speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect();
     let mut ev = evaluator_direct(m);
     let mut data = MapData {
+        speed_rpm,
         speed: speed.clone(),
         torque: torque.clone(),
         t_max: Vec::with_capacity(speed.len()),
@@ -187,7 +194,7 @@ pub fn motor_map(
                 MotorKind::Ipmsm(im) => {
                     let (s, c, fb) = im.evaluate(w, t, tm);
                     data.fallbacks += u64::from(fb);
-                    (s.total, Some((s, c.i_d, c.i_q, c.mode)))
+                    (s.total, Some((s, c)))
                 }
                 _ => (ev.loss(w, t, t, tm, false).loss, None),
             };
@@ -332,7 +339,7 @@ pub fn compute(
         }
         let ipmsm_map: Option<IpmsmMap> = match (&m.kind, o.motor_eval) {
             (MotorKind::Ipmsm(im), MotorEval::LossMap) => {
-                let points = grid_size(m.omega_max, im.t_max(0.0), o.grid.0, o.grid.1);
+                let points = grid_size(m.n_max_rpm, im.t_max(0.0), o.grid.0, o.grid.1);
                 if points > MAX_MAP_POINTS {
                     return Err(BusFuelEconomyError::MapTooLarge {
                         motor: m.id.clone(),
@@ -340,7 +347,7 @@ pub fn compute(
                         limit: MAX_MAP_POINTS,
                     });
                 }
-                let map = build_ipmsm_map(im, m.omega_max, o.grid.0, o.grid.1, budget).ok_or(
+                let map = build_ipmsm_map(im, m.n_max_rpm, o.grid.0, o.grid.1, budget).ok_or(
                     BusFuelEconomyError::Deadline {
                         elapsed_ms: budget.elapsed_ms(),
                     },

@@ -52,7 +52,7 @@ pub struct Options {
     pub regen_limit: bool,
     /// ipmsm evaluation.
     pub motor_eval: MotorEval,
-    /// Map grid: speed step [rad/s], torque step [N·m].
+    /// Map grid: speed step [rpm], torque step [N·m].
     pub grid: (f64, f64),
     /// Loss breakdown requested.
     pub breakdown: bool,
@@ -151,11 +151,8 @@ fn table(
     v: &mut Validator,
     ptr: &str,
     t: &[Vec<f64>],
-    rows: usize,
-    cols: usize,
-    lo: f64,
-    hi: f64,
-    open_lo: bool,
+    (rows, cols): (usize, usize),
+    (lo, hi, open_lo): (f64, f64, bool),
 ) -> bool {
     if t.len() != rows {
         v.push(
@@ -324,13 +321,13 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
                             "/battery/ocv_v",
                             format!("must have {} values like ocv_soc, got {}", s.len(), o.len()),
                         );
-                    } else if v.all_finite("/battery/ocv_v", o) {
-                        if let Some(i) = o.iter().position(|&x| x <= 0.0 || x > 1e5) {
-                            v.push(
-                                format!("/battery/ocv_v/{i}"),
-                                format!("must be in (0, 100000] V, got {}", o[i]),
-                            );
-                        }
+                    } else if v.all_finite("/battery/ocv_v", o)
+                        && let Some(i) = o.iter().position(|&x| x <= 0.0 || x > 1e5)
+                    {
+                        v.push(
+                            format!("/battery/ocv_v/{i}"),
+                            format!("must be in (0, 100000] V, got {}", o[i]),
+                        );
                     }
                     (s.clone(), o.clone())
                 }
@@ -518,13 +515,13 @@ fn envelope(
                         t.t_max_nm.len()
                     ),
                 );
-            } else if v.all_finite(&format!("{p}/t_max_nm"), &t.t_max_nm) {
-                if let Some(i) = t.t_max_nm.iter().position(|&x| x <= 0.0 || x > 1e6) {
-                    v.push(
-                        format!("{p}/t_max_nm/{i}"),
-                        format!("must be in (0, 1000000] N·m, got {}", t.t_max_nm[i]),
-                    );
-                }
+            } else if v.all_finite(&format!("{p}/t_max_nm"), &t.t_max_nm)
+                && let Some(i) = t.t_max_nm.iter().position(|&x| x <= 0.0 || x > 1e6)
+            {
+                v.push(
+                    format!("{p}/t_max_nm/{i}"),
+                    format!("must be in (0, 1000000] N·m, got {}", t.t_max_nm[i]),
+                );
             }
             let _ = ok;
             Envelope::Table {
@@ -634,13 +631,13 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
                         t.k_ac.len()
                     ),
                 );
-            } else if v.all_finite(&format!("{ap}/k_ac"), &t.k_ac) {
-                if let Some(i) = t.k_ac.iter().position(|&k| !(1.0..=1000.0).contains(&k)) {
-                    v.push(
-                        format!("{ap}/k_ac/{i}"),
-                        format!("k_AC must be in [1, 1000], got {}", t.k_ac[i]),
-                    );
-                }
+            } else if v.all_finite(&format!("{ap}/k_ac"), &t.k_ac)
+                && let Some(i) = t.k_ac.iter().position(|&k| !(1.0..=1000.0).contains(&k))
+            {
+                v.push(
+                    format!("{ap}/k_ac/{i}"),
+                    format!("k_AC must be in [1, 1000], got {}", t.k_ac[i]),
+                );
             }
             AcFactor::Table {
                 freq_hz: t.freq_hz.clone(),
@@ -734,7 +731,8 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     let base = format!("/motors/{i}");
     name_ok(v, &format!("{base}/id"), spec.id(), "motor id");
     let mut warnings = Vec::new();
-    let (kind, omega_max) = match spec {
+    // The second element (admissible speed in rad/s) is recomputed below from the rpm values.
+    let (kind, _) = match spec {
         MotorSpec::Constant(m) => {
             open_closed(v, &format!("{base}/efficiency"), m.efficiency, 0.0, 1.0);
             let (env, w) = envelope(
@@ -771,22 +769,16 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                     v,
                     &format!("{base}/efficiency"),
                     &m.efficiency,
-                    ns,
-                    nt,
-                    0.0,
-                    1.0,
-                    true,
+                    (ns, nt),
+                    (0.0, 1.0, true),
                 );
                 if let Some(g) = &m.efficiency_gen {
                     ok &= table(
                         v,
                         &format!("{base}/efficiency_gen"),
                         g,
-                        ns,
-                        nt,
-                        0.0,
-                        1.0,
-                        true,
+                        (ns, nt),
+                        (0.0, 1.0, true),
                     );
                 }
             }
@@ -850,11 +842,8 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                     v,
                     &format!("{base}/loss_w"),
                     &m.loss_w,
-                    ns,
-                    nt,
-                    0.0,
-                    1e9,
-                    false,
+                    (ns, nt),
+                    (0.0, 1e9, false),
                 );
             let loss = Grid2 {
                 speed: m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
@@ -883,10 +872,24 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
             (MotorKind::Ipmsm(Box::new(im)), w)
         }
     };
+    // The admissible speed in rpm as given (axes of maps are built from it without a round trip).
+    let n_max_rpm = match spec {
+        MotorSpec::Constant(m) => m.n_max_rpm.unwrap_or(DEFAULT_N_MAX),
+        MotorSpec::EfficiencyMap(m) => m
+            .n_max_rpm
+            .unwrap_or(DEFAULT_N_MAX)
+            .min(m.speed_rpm.last().copied().unwrap_or(0.0)),
+        MotorSpec::LossMap(m) => m
+            .n_max_rpm
+            .unwrap_or(DEFAULT_N_MAX)
+            .min(m.speed_rpm.last().copied().unwrap_or(0.0)),
+        MotorSpec::Ipmsm(m) => m.n_max_rpm,
+    };
     MotorInput {
         id: spec.id().to_owned(),
         kind,
-        omega_max,
+        omega_max: rpm_to_rad_s(n_max_rpm),
+        n_max_rpm,
         warnings,
     }
 }
@@ -894,7 +897,7 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
 fn grid(v: &mut Validator, ptr: &str, g: &GridSpec) -> (f64, f64) {
     v.in_range(&format!("{ptr}/speed_step_rpm"), g.speed_step_rpm, 1.0, 1e4);
     v.in_range(&format!("{ptr}/torque_step_nm"), g.torque_step_nm, 0.1, 1e4);
-    (rpm_to_rad_s(g.speed_step_rpm), g.torque_step_nm)
+    (g.speed_step_rpm, g.torque_step_nm)
 }
 
 /// Validate a motor on its own (motor-map endpoint).

@@ -108,26 +108,34 @@ pub fn run_motor_map(
         ));
     }
     let components = data.parts.as_ref().map(|parts| {
-        let pick = |f: &dyn Fn(&(ipmsm::LossSplit, f64, f64, ipmsm::OpMode)) -> f64| -> Vec<Vec<Option<f64>>> {
-            parts.iter().map(|row| row.iter().map(|x| x.as_ref().map(f)).collect()).collect()
+        type Point = (ipmsm::LossSplit, ipmsm::Currents);
+        let pick = |f: &dyn Fn(&Point) -> f64| -> Vec<Vec<Option<f64>>> {
+            parts
+                .iter()
+                .map(|row| row.iter().map(|x| x.as_ref().map(f)).collect())
+                .collect()
         };
         LossComponentMaps {
             cu_dc_w: pick(&|x| x.0.cu_dc),
             cu_ac_extra_w: pick(&|x| x.0.cu_ac_extra()),
             iron_w: pick(&|x| x.0.iron),
             mech_w: pick(&|x| x.0.mech),
-            i_d_a: pick(&|x| x.1),
-            i_q_a: pick(&|x| x.2),
+            i_d_a: pick(&|x| x.1.i_d),
+            i_q_a: pick(&|x| x.1.i_q),
             mode: parts
                 .iter()
-                .map(|row| row.iter().map(|x| x.as_ref().map(|x| x.3.as_str().to_owned())).collect())
+                .map(|row| {
+                    row.iter()
+                        .map(|x| x.as_ref().map(|x| x.1.mode.as_str().to_owned()))
+                        .collect()
+                })
                 .collect(),
         }
     });
     let evaluations = data.evaluations;
     Ok(MotorMapResponse {
         motor: m.id.clone(),
-        speed_rpm: data.speed.iter().map(|&w| rad_s_to_rpm(w)).collect(),
+        speed_rpm: data.speed_rpm.clone(),
         torque_nm: data.torque.clone(),
         t_max_nm: data.t_max.clone(),
         loss_w: data.loss,
@@ -304,7 +312,7 @@ fn result_wire(
 fn map_wire(id: &str, m: MapData) -> MotorMapData {
     MotorMapData {
         motor: id.to_owned(),
-        speed_rpm: m.speed.iter().map(|&w| rad_s_to_rpm(w)).collect(),
+        speed_rpm: m.speed_rpm,
         torque_nm: m.torque,
         t_max_nm: m.t_max,
         efficiency: m.eff,

@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use super::ipmsm::{Ipmsm, LossSplit, rad_s_to_rpm};
+use super::ipmsm::{Ipmsm, LossSplit, rad_s_to_rpm, rpm_to_rad_s};
 use super::maps::{Envelope, Grid2};
 use crate::numerics::Budget;
 
@@ -17,6 +17,8 @@ pub struct MotorInput {
     pub kind: MotorKind,
     /// Highest admissible speed [rad/s] (n_max; for maps also the last map speed).
     pub omega_max: f64,
+    /// The same in rpm.
+    pub n_max_rpm: f64,
     /// Warnings from the input conversion (efficiency → loss map, ...).
     pub warnings: Vec<String>,
 }
@@ -74,26 +76,27 @@ pub struct IpmsmMap {
     pub evaluations: u64,
 }
 
-/// Grid axes of a map: speeds 0, Δn, 2Δn, … plus n_max itself; torques ±kΔT covering ±t_top.
+/// Grid axes of a map: speeds 0, Δn, 2Δn, … plus n_max itself [rpm]; torques ±kΔT covering
+/// ±t_top [N·m].
 #[must_use]
 pub fn grid_axes(
-    omega_max: f64,
+    n_max_rpm: f64,
     t_top: f64,
-    speed_step_rad_s: f64,
+    speed_step_rpm: f64,
     torque_step: f64,
 ) -> (Vec<f64>, Vec<f64>) {
     let mut speed = Vec::new();
     let mut k = 0.0;
     loop {
-        let w = k * speed_step_rad_s;
+        let n = k * speed_step_rpm;
         // Points within 1e-9 of n_max are merged with it.
-        if w >= omega_max * (1.0 - 1e-9) {
+        if n >= n_max_rpm * (1.0 - 1e-9) {
             break;
         }
-        speed.push(w);
+        speed.push(n);
         k += 1.0;
     }
-    speed.push(omega_max);
+    speed.push(n_max_rpm);
     let kt = (t_top / torque_step).ceil().max(1.0);
     let mut torque = Vec::new();
     let mut j = -kt;
@@ -106,9 +109,9 @@ pub fn grid_axes(
 
 /// Number of grid points of [`grid_axes`] without building it.
 #[must_use]
-pub fn grid_size(omega_max: f64, t_top: f64, speed_step_rad_s: f64, torque_step: f64) -> f64 {
-    ((omega_max / speed_step_rad_s).ceil() + 1.0)
-        * (2.0 * (t_top / torque_step).ceil().max(1.0) + 1.0)
+pub fn grid_size(n_max_rpm: f64, t_top: f64, speed_step_rpm: f64, torque_step: f64) -> f64 {
+    ((n_max_rpm / speed_step_rpm).ceil() + 1.0)
+        * 2.0f64.mul_add((t_top / torque_step).ceil().max(1.0), 1.0)
 }
 
 /// Build the ipmsm loss map of §5.5/§9: at every grid point the loss at the torque clamped to
@@ -117,13 +120,14 @@ pub fn grid_size(omega_max: f64, t_top: f64, speed_step_rad_s: f64, torque_step:
 #[must_use]
 pub fn build_ipmsm_map(
     m: &Ipmsm,
-    omega_max: f64,
-    speed_step_rad_s: f64,
+    n_max_rpm: f64,
+    speed_step_rpm: f64,
     torque_step: f64,
     budget: &Budget,
 ) -> Option<IpmsmMap> {
     let t_top = m.t_max(0.0);
-    let (speed, torque) = grid_axes(omega_max, t_top, speed_step_rad_s, torque_step);
+    let (speed_rpm, torque) = grid_axes(n_max_rpm, t_top, speed_step_rpm, torque_step);
+    let speed: Vec<f64> = speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect();
     let nt = torque.len();
     let mut total = Vec::with_capacity(speed.len() * nt);
     let mut parts: [Vec<f64>; 4] = Default::default();
