@@ -68,7 +68,8 @@ pub struct IpmsmMap {
     pub total: Grid2,
     /// DC copper, extra AC copper, iron, mechanical loss maps [W].
     pub parts: [Grid2; 4],
-    /// Envelope at the grid speeds (linear in between).
+    /// Envelope at the grid speeds (linear in between); informational: the simulation evaluates
+    /// T_max exactly per distinct speed, as the spec's reference does.
     pub envelope: Envelope,
     /// Grid points that needed the envelope fallback.
     pub fallbacks: u64,
@@ -290,12 +291,6 @@ impl MotorEvaluator<'_> {
                 }
             }
         }
-    }
-
-    /// Whether this motor reports the ipmsm loss split.
-    #[must_use]
-    pub fn has_parts(&self) -> bool {
-        matches!(self, Self::IpmsmDirect { .. } | Self::IpmsmMap { .. })
     }
 }
 
