@@ -5,6 +5,7 @@
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
 //! [`run_calc`], and register it in [`api_router`] with one `.routes(routes!(...))` line.
 
+pub mod bus_fuel_economy;
 pub mod cam_law;
 pub mod json;
 pub mod meta;
@@ -93,6 +94,7 @@ JSON pointers to the offending fields.",
     tags(
         (name = "service", description = "Health and discovery"),
         (name = "cam-law", description = "Cam motion laws: evaluation and identification"),
+        (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -104,6 +106,8 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
         .routes(routes!(cam_law::evaluate))
+        .routes(routes!(bus_fuel_economy::compute))
+        .routes(routes!(bus_fuel_economy::motor_map))
 }
 
 /// The OpenAPI document of the service, generated from the handlers and wire types.

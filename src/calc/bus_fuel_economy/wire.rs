@@ -257,6 +257,7 @@ pub struct ConstantMotor {
     #[schema(minimum = 0.0, maximum = 100000.0, example = 5200.0)]
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope (replaces `t_peak_nm` / `p_peak_w`).
+    #[schema(nullable = false)]
     pub envelope: Option<EnvelopeTable>,
 }
 
@@ -281,6 +282,7 @@ pub struct EfficiencyMapMotor {
     /// Maximum speed [rpm] (default 5200).
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope.
+    #[schema(nullable = false)]
     pub envelope: Option<EnvelopeTable>,
 }
 
@@ -303,6 +305,7 @@ pub struct LossMapMotor {
     /// Maximum speed [rpm] (default 5200).
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope.
+    #[schema(nullable = false)]
     pub envelope: Option<EnvelopeTable>,
 }
 
@@ -404,6 +407,7 @@ pub struct IpmsmMotor {
     #[schema(minimum = 0.0, maximum = 100.0, example = 0.198864)]
     pub psi_m_wb: Option<f64>,
     /// Back-EMF from which ψ_m is derived (give this or `psi_m_wb`).
+    #[schema(nullable = false)]
     pub back_emf: Option<BackEmf>,
     /// d-axis inductance L_d [H] (> 0).
     #[schema(minimum = 0.0, maximum = 1.0, example = 0.00035)]
@@ -436,10 +440,13 @@ pub struct IpmsmMotor {
     #[schema(minimum = 0.0, example = 130000.0)]
     pub p_cap_w: Option<f64>,
     /// AC resistance factor model (default `none`).
+    #[schema(nullable = false)]
     pub ac_factor: Option<AcFactorSpec>,
     /// Iron-loss coefficients (default 0).
+    #[schema(nullable = false)]
     pub iron: Option<IronSpec>,
     /// Mechanical-loss coefficients (default 0).
+    #[schema(nullable = false)]
     pub mech: Option<MechSpec>,
     /// Stack-length scale s (paper §3.2; needs the `dowell` AC model for the slot/end split).
     /// Not validated against data.
@@ -539,29 +546,49 @@ impl Default for HistogramSpec {
 
 /// Simulation options (§3.6).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields, default)]
+#[serde(deny_unknown_fields)]
 pub struct OptionsSpec {
     /// Envelope policy: `backward` (default), `clip` or `forward`.
+    #[serde(default)]
     pub mode: Mode,
     /// `paper` (default, eq. 2-3) or `loss` (additive losses).
+    #[serde(default)]
     pub power_convention: PowerConvention,
-    /// Split each cycle interval into k equal pieces (1..32; accuracy knob).
+    /// Split each cycle interval into k equal pieces (1..32; accuracy knob; default 1).
+    #[serde(default = "default_substeps")]
     #[schema(minimum = 1, maximum = 32, example = 1)]
     pub substeps: u32,
-    /// Allow regenerative braking.
+    /// Allow regenerative braking (default true).
+    #[serde(default = "default_true")]
     pub regen: bool,
-    /// Clip generating torque to −T_max(ω); the rest goes to the friction brakes.
+    /// Clip generating torque to −T_max(ω); the rest goes to the friction brakes (default true).
+    #[serde(default = "default_true")]
     pub regen_limit: bool,
     /// `direct` or `loss_map` (default) evaluation of `ipmsm` motors.
+    #[serde(default)]
+    #[schema(nullable = false)]
     pub motor_eval: Option<MotorEval>,
-    /// Grid of the precomputed ipmsm loss map and of the `efficiency_map` output.
+    /// Grid of the precomputed ipmsm loss map and of the `efficiency_map` output
+    /// (default 250 rpm × 50 N·m).
+    #[serde(default)]
     pub loss_map_grid: GridSpec,
     /// Optional outputs: `loss_breakdown`, `op_histogram`, `traces`, `efficiency_map`.
+    #[serde(default)]
     pub outputs: Vec<OutputKind>,
-    /// Bins of the `op_histogram` output.
+    /// Bins of the `op_histogram` output (default 500 rpm × 100 N·m).
+    #[serde(default)]
     pub op_histogram: HistogramSpec,
     /// Desirability weights per cycle (≥ 0, normalised; default equal, paper w1 = w2 = w3).
+    #[serde(default)]
     pub desirability_weights: Option<Vec<f64>>,
+}
+
+fn default_substeps() -> u32 {
+    1
+}
+
+fn default_true() -> bool {
+    true
 }
 
 impl Default for OptionsSpec {
@@ -592,9 +619,11 @@ pub struct BusFuelEconomyResponse {
     pub results: Vec<CycleResult>,
     /// Relative FE change and desirability (only with ≥ 2 motors).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub comparison: Option<Comparison>,
     /// Efficiency maps per motor (only with `outputs: ["efficiency_map"]`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub motor_maps: Option<Vec<MotorMapData>>,
     /// Settings used.
     pub echo: Echo,
@@ -653,12 +682,15 @@ pub struct CycleResult {
     pub battery_flags: Option<Vec<String>>,
     /// Energy per loss mechanism (only with `outputs: ["loss_breakdown"]`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub loss_breakdown: Option<LossBreakdown>,
     /// Operating-point histogram (only with `outputs: ["op_histogram"]`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub op_histogram: Option<OpHistogram>,
     /// Per-interval traces (only with `outputs: ["traces"]`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub traces: Option<Traces>,
     /// Human-readable warnings (envelope exceedance, trace miss, conventions used, ...).
     pub warnings: Vec<String>,
@@ -708,7 +740,9 @@ pub struct OpHistogram {
     pub torque_edges_nm: Vec<f64>,
     /// share[speed bin][torque bin] of the moving time (sums to 1).
     pub share: Vec<Vec<f64>>,
-    /// Bin with the largest share (null if the bus never moves).
+    /// Bin with the largest share (absent if the bus never moves).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub modal_bin: Option<ModalBin>,
 }
 
@@ -837,6 +871,7 @@ pub struct MotorMapResponse {
     pub efficiency: Vec<Vec<Option<f64>>>,
     /// ipmsm loss components (only with `include_components`).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub components: Option<LossComponentMaps>,
     /// Warnings (map conversions, extrapolations).
     pub warnings: Vec<String>,
