@@ -141,7 +141,7 @@ fn t_top(m: &MotorInput) -> f64 {
 /// Build the envelope / loss / efficiency map of one motor on a grid (direct evaluation).
 ///
 /// # Errors
-/// `MapTooLarge` (as [`BusFuelEconomyError::HistogramTooLarge`]-like size error) or `Deadline`.
+/// [`BusFuelEconomyError::MapTooLarge`] above [`MAX_MAP_POINTS`], [`BusFuelEconomyError::Deadline`].
 pub fn motor_map(
     m: &MotorInput,
     grid: (f64, f64),

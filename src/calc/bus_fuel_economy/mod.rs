@@ -39,6 +39,9 @@
 //!   silently); a cycle above a motor's speed limit, or beyond the speed where an IPMSM has torque
 //!   left, is rejected (HTTP 422); net regenerating cycles give `fe_km_per_kwh: null`.
 
+// Units in square brackets ([m], [W], [rpm]) are the crate's doc convention, not intra-doc links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 pub mod ac_factor;
 pub mod battery;
 pub mod compare;
