@@ -130,7 +130,7 @@ fn random_cycle(rng: &mut ChaCha8Rng) -> (Value, f64) {
     for _ in 0..n {
         ts.push(t);
         t += if rng.random_bool(0.1) {
-            rng.random_range(1e-6..1e-3)
+            rng.random_range(1e-3..2e-3)
         } else {
             rng.random_range(0.1..60.0)
         };
@@ -381,13 +381,51 @@ fn forward_mode_stuck_on_steep_grade() {
 
 #[test]
 fn tiny_steps_and_jumps_stay_finite() {
-    let c = json!({"name": "jumpy", "time_s": [0.0, 1e-6, 2e-6, 10.0, 10.000001, 20.0],
+    let c = json!({"name": "jumpy", "time_s": [0.0, 1e-3, 2e-3, 10.0, 10.001, 20.0],
                    "speed_mps": [0.0, 20.0, 0.0, 20.0, 0.0, 0.0]});
     for mode in ["backward", "clip", "forward"] {
         assert!(exercise(
             json!({"cycles": [c.clone()], "motors": [demo_ipmsm()], "options": {"mode": mode}})
         ));
     }
+    // The corner of every service limit at once: 200 m/s jumps over 1 ms, 2·10⁵ kg, the
+    // smallest gear ratio and efficiencies, the largest wheel: still finite numbers.
+    let c = json!({"name": "corner", "time_s": [0.0, 1e-3, 2e-3, 3e-3],
+                   "speed_mps": [0.0, 200.0, 200.0, 0.0], "grade": [0.3, -0.3, 0.3, -0.3]});
+    for mode in ["backward", "clip", "forward"] {
+        for battery in [
+            json!({"efficiency": 0.01}),
+            json!({"model": "ecm_2rc", "ocv_soc": [0.0, 1.0], "ocv_v": [1.0, 2.0], "r0_ohm": 100.0,
+                   "r1_ohm": 100.0, "c1_f": 1e-9, "r2_ohm": 0.0, "c2_f": 1e9, "soc_initial": 1.0,
+                   "capacity_kwh": 1e-3, "nominal_voltage": 5000.0}),
+        ] {
+            let motors = json!([
+                {"id": "c", "model": "constant", "efficiency": 0.01, "t_peak_nm": 1e6, "p_peak_w": 1e9, "n_max_rpm": 1e5},
+                {"id": "e", "model": "efficiency_map", "speed_rpm": [0.0, 1e5], "torque_nm": [0.0, 1e6],
+                 "efficiency": [[1e-6, 1e-6], [1e-6, 1e-6]], "n_max_rpm": 1e5}
+            ]);
+            assert!(exercise(json!({
+                "vehicle": {"curb_mass_kg": 1e5, "passengers": 500, "mass_per_passenger_kg": 200,
+                            "rotational_inertia_factor": 1.0, "wheel_radius_m": 2.0, "gear_ratio": 0.01,
+                            "gear_efficiency": 0.01, "aux_power_w": 1e5},
+                "inverter": {"efficiency": 0.01}, "battery": battery, "cycles": [c.clone()], "motors": motors,
+                "options": {"mode": mode, "power_convention": "loss", "substeps": 32, "regen_limit": false,
+                            "outputs": ["loss_breakdown", "traces"]}
+            })));
+        }
+    }
+    // Below the service limits: typed rejections, never overflow.
+    let c = json!({"name": "c", "time_s": [0.0, 1e-300], "speed_mps": [0.0, 1.0]});
+    expect_failure(
+        json!({"cycles": [c], "motors": [demo_ipmsm()]}),
+        "INVALID_INPUT",
+        "/cycles/0/time_s/1",
+    );
+    expect_failure(
+        json!({"vehicle": {"gear_ratio": 1e-300}, "cycles": ["manhattan"], "motors": [demo_ipmsm()]}),
+        "INVALID_INPUT",
+        "/vehicle/gear_ratio",
+    );
 }
 
 #[test]
@@ -398,7 +436,7 @@ fn degenerate_maps() {
                       "loss_w": [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]});
     // Efficiency map with one positive torque column (constant T = 0 extrapolation), η = 1 and tiny η.
     let one_col = json!({"id": "onecol", "model": "efficiency_map", "speed_rpm": [0.0, 5200.0], "torque_nm": [0.0, 800.0],
-                         "efficiency": [[0.5, 1.0], [0.5, 1e-9]]});
+                         "efficiency": [[0.5, 1.0], [0.5, 1e-6]]});
     let req: BusFuelEconomyRequest = serde_json::from_value(json!({
         "cycles": ["manhattan", "hwfet"], "motors": [zero, one_col],
         "options": {"outputs": ["loss_breakdown", "efficiency_map", "op_histogram"]}

@@ -23,6 +23,16 @@ pub const MAX_CYCLE_SAMPLES: usize = 200_000;
 pub const MAX_TOTAL_INTERVALS: usize = 1_000_000;
 /// Largest custom-cycle time step [s] (spec §3.4).
 pub const MAX_TIME_STEP_S: f64 = 60.0;
+/// Smallest custom-cycle time step [s] (1 kHz sampling): a service limit that bounds the
+/// acceleration (≤ 2·10⁵ m/s²) and so keeps every force, torque and power finite.
+pub const MIN_TIME_STEP_S: f64 = 1e-3;
+/// Smallest efficiency of the gear, inverter, battery and a constant motor [-]: a service limit
+/// (the spec allows (0, 1]) that keeps P/η finite; real drivetrains are far above it.
+pub const MIN_EFFICIENCY: f64 = 0.01;
+/// Smallest value of an efficiency map [-]: keeps the converted loss |P|(1/η − 1) finite.
+pub const MIN_MAP_EFFICIENCY: f64 = 1e-6;
+/// Smallest gear ratio [-]: a service limit (spec (0, 50]) that keeps T_w/(η_T i_g) finite.
+pub const MIN_GEAR_RATIO: f64 = 0.01;
 /// Largest trace speed [m/s] (720 km/h): a service limit that keeps v² and the road load finite.
 pub const MAX_SPEED_MPS: f64 = 200.0;
 /// Largest |time| of a custom trace [s] (about 30 years): keeps Δt well resolved.
@@ -221,8 +231,13 @@ fn vehicle(v: &mut Validator, s: &VehicleSpec) -> Vehicle {
     open_closed(v, "/vehicle/air_density", s.air_density, 0.0, 2.0);
     open_closed(v, "/vehicle/gravity", s.gravity, 9.0, 10.5);
     open_closed(v, "/vehicle/wheel_radius_m", s.wheel_radius_m, 0.1, 2.0);
-    open_closed(v, "/vehicle/gear_ratio", s.gear_ratio, 0.0, 50.0);
-    open_closed(v, "/vehicle/gear_efficiency", s.gear_efficiency, 0.0, 1.0);
+    v.in_range("/vehicle/gear_ratio", s.gear_ratio, MIN_GEAR_RATIO, 50.0);
+    v.in_range(
+        "/vehicle/gear_efficiency",
+        s.gear_efficiency,
+        MIN_EFFICIENCY,
+        1.0,
+    );
     v.in_range(
         "/vehicle/rotational_inertia_factor",
         s.rotational_inertia_factor,
@@ -269,7 +284,7 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
                 }
             }
             let eta = b.efficiency.unwrap_or(1.0);
-            open_closed(v, "/battery/efficiency", eta, 0.0, 1.0);
+            v.in_range("/battery/efficiency", eta, MIN_EFFICIENCY, 1.0);
             Battery::Constant { eta }
         }
         BatteryModel::Ecm2rc => {
@@ -431,13 +446,15 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
                     ),
                 );
                 ok = false;
-            } else if let Some(i) =
-                (1..n).find(|&i| cc.time_s[i] - cc.time_s[i - 1] > MAX_TIME_STEP_S)
-            {
+            } else if let Some(i) = (1..n).find(|&i| {
+                let dt = cc.time_s[i] - cc.time_s[i - 1];
+                // 1e-6 relative slack: 10.001 − 10.0 is 0.000999999… in binary.
+                !(MIN_TIME_STEP_S * (1.0 - 1e-6)..=MAX_TIME_STEP_S).contains(&dt)
+            }) {
                 v.push(
                     format!("{tp}/{i}"),
                     format!(
-                        "time step must be ≤ {MAX_TIME_STEP_S} s, got {} s",
+                        "time step must be in [{MIN_TIME_STEP_S}, {MAX_TIME_STEP_S}] s, got {} s",
                         cc.time_s[i] - cc.time_s[i - 1]
                     ),
                 );
@@ -734,7 +751,12 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     // The second element (admissible speed in rad/s) is recomputed below from the rpm values.
     let (kind, _) = match spec {
         MotorSpec::Constant(m) => {
-            open_closed(v, &format!("{base}/efficiency"), m.efficiency, 0.0, 1.0);
+            v.in_range(
+                &format!("{base}/efficiency"),
+                m.efficiency,
+                MIN_EFFICIENCY,
+                1.0,
+            );
             let (env, w) = envelope(
                 v,
                 &base,
@@ -770,7 +792,7 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                     &format!("{base}/efficiency"),
                     &m.efficiency,
                     (ns, nt),
-                    (0.0, 1.0, true),
+                    (MIN_MAP_EFFICIENCY, 1.0, false),
                 );
                 if let Some(g) = &m.efficiency_gen {
                     ok &= table(
@@ -778,7 +800,7 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                         &format!("{base}/efficiency_gen"),
                         g,
                         (ns, nt),
-                        (0.0, 1.0, true),
+                        (MIN_MAP_EFFICIENCY, 1.0, false),
                     );
                 }
             }
@@ -927,11 +949,10 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let veh = vehicle(&mut v, &req.vehicle);
-        open_closed(
-            &mut v,
+        v.in_range(
             "/inverter/efficiency",
             req.inverter.efficiency,
-            0.0,
+            MIN_EFFICIENCY,
             1.0,
         );
         let bat = battery(&mut v, &req.battery);

@@ -69,11 +69,11 @@ pub struct VehicleSpec {
     /// Wheel radius r [m].
     #[schema(minimum = 0.1, maximum = 2.0, example = 0.48)]
     pub wheel_radius_m: f64,
-    /// Single fixed reduction ratio i_g [-].
-    #[schema(minimum = 0.0, maximum = 50.0, example = 9.5)]
+    /// Single fixed reduction ratio i_g [-] (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 50.0, example = 9.5)]
     pub gear_ratio: f64,
-    /// Gear efficiency η_T [-], applied in both power directions.
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.95)]
+    /// Gear efficiency η_T [-], applied in both power directions (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 0.95)]
     pub gear_efficiency: f64,
     /// Rotational inertia factor δ [-]: effective mass m(1+δ).
     #[schema(minimum = 0.0, maximum = 1.0, example = 0.0)]
@@ -111,8 +111,8 @@ impl Default for VehicleSpec {
 #[derive(Debug, Clone, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct InverterSpec {
-    /// Inverter efficiency η_Inv [-], applied in both power directions.
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.95)]
+    /// Inverter efficiency η_Inv [-], applied in both power directions (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 0.95)]
     pub efficiency: f64,
 }
 
@@ -141,8 +141,8 @@ pub struct BatterySpec {
     /// `constant` (default) or `ecm_2rc`.
     #[serde(default)]
     pub model: BatteryModel,
-    /// constant: battery efficiency η_Bat [-] (default 1.0).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 1.0)]
+    /// constant: battery efficiency η_Bat [-] (default 1.0, service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 1.0)]
     pub efficiency: Option<f64>,
     /// ecm_2rc: nominal voltage [V] (default 360), used for the charge capacity Q.
     #[schema(minimum = 0.0, maximum = 5000.0, example = 360.0)]
@@ -184,7 +184,7 @@ pub enum CycleSpec {
     Custom(CustomCycle),
 }
 
-/// A custom speed trace: 2..200 000 samples, time strictly increasing, step ≤ 60 s, speeds ≥ 0.
+/// A custom speed trace: 2..200 000 samples, time steps in [0.001, 60] s, speeds in [0, 200] m/s.
 /// Give exactly one of `speed_kmh` and `speed_mps`.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
@@ -244,8 +244,8 @@ impl MotorSpec {
 pub struct ConstantMotor {
     /// Motor name (unique in the request, 1..64 characters).
     pub id: String,
-    /// Motor efficiency η_M (0, 1] [-], both directions.
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.93)]
+    /// Motor efficiency η_M [-], both directions (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 0.93)]
     pub efficiency: f64,
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
     #[schema(minimum = 0.0, example = 800.0)]
@@ -271,7 +271,7 @@ pub struct EfficiencyMapMotor {
     pub speed_rpm: Vec<f64>,
     /// Torque axis [N·m]: strictly increasing, ≥ 2 points, first ≥ 0.
     pub torque_nm: Vec<f64>,
-    /// Efficiency η[speed][torque] in (0, 1] (motoring).
+    /// Efficiency η[speed][torque] in [1e-6, 1] (motoring).
     pub efficiency: Vec<Vec<f64>>,
     /// Generating efficiency at −torque_nm, same shape (default: mirror of `efficiency`).
     pub efficiency_gen: Option<Vec<Vec<f64>>>,
