@@ -3,6 +3,7 @@
 
 pub mod bus_fuel_economy;
 pub mod cam_law;
+pub mod cognates;
 pub mod problem;
 
 pub use problem::{CalcFailure, FieldIssue, ProblemClass, Validator};

@@ -3,10 +3,11 @@
 //! decodes, runs the module's `run` on the compute pool, and responds.
 //!
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
-//! [`run_calc`], and register it in [`api_router`] with one `.routes(routes!(...))` line.
+//! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
 pub mod bus_fuel_economy;
 pub mod cam_law;
+pub mod cognates;
 pub mod json;
 pub mod meta;
 pub mod pool;
@@ -94,6 +95,7 @@ JSON pointers to the offending fields.",
     tags(
         (name = "service", description = "Health and discovery"),
         (name = "cam-law", description = "Cam motion laws: evaluation and identification"),
+        (name = "linkages", description = "Planar linkages: Roberts–Chebyshev cognates of a four-bar"),
         (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
     ),
     components(schemas(Problem, ProblemField))
@@ -106,6 +108,7 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
         .routes(routes!(cam_law::evaluate))
+        .routes(routes!(cognates::construct))
         .routes(routes!(bus_fuel_economy::compute))
         .routes(routes!(bus_fuel_economy::motor_map))
 }

@@ -52,9 +52,6 @@
 //! * The Dowell series carries a third term so that series and closed form agree to 1e-10 at
 //!   ξ = 0.3 (spec §7.3); with the spec's two terms F2 differs by 3e-10 there.
 
-// Units in square brackets ([m], [W], [rpm]) are the crate's doc convention, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod ac_factor;
 pub mod battery;
 pub mod compare;
