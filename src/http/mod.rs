@@ -5,6 +5,7 @@
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
 //! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
+pub mod bus_fuel_economy;
 pub mod cam_law;
 pub mod cam_law_fit;
 pub mod cognates;
@@ -98,6 +99,7 @@ JSON pointers to the offending fields.",
         (name = "cam-law", description = "Cam motion laws: evaluation and identification"),
         (name = "linkages", description = "Planar linkages: Roberts–Chebyshev cognates of a four-bar"),
         (name = "reliability", description = "Reliability and maintenance: component importance under fault propagation"),
+        (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -112,6 +114,8 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(cam_law_fit::fit))
         .routes(routes!(cognates::construct))
         .routes(routes!(component_importance::rank))
+        .routes(routes!(bus_fuel_economy::compute))
+        .routes(routes!(bus_fuel_economy::motor_map))
 }
 
 /// The OpenAPI document of the service, generated from the handlers and wire types.
