@@ -5,6 +5,7 @@
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
 //! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
+pub mod bus_fuel_economy;
 pub mod cam_law;
 pub mod cam_law_fit;
 pub mod cognates;
@@ -99,6 +100,7 @@ JSON pointers to the offending fields.",
         (name = "cam-law", description = "Cam motion laws: evaluation and identification"),
         (name = "linkages", description = "Planar linkages: Roberts–Chebyshev cognates of a four-bar"),
         (name = "reliability", description = "Reliability and maintenance: component importance under fault propagation"),
+        (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
     ),
     components(schemas(Problem, ProblemField))
@@ -114,6 +116,8 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(cam_law_fit::fit))
         .routes(routes!(cognates::construct))
         .routes(routes!(component_importance::rank))
+        .routes(routes!(bus_fuel_economy::compute))
+        .routes(routes!(bus_fuel_economy::motor_map))
         .routes(routes!(irefc::stress))
         .routes(routes!(irefc::efficiency))
 }
