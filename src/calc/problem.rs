@@ -54,13 +54,21 @@ impl CalcFailure {
             class,
             code,
             detail: detail.clone(),
-            errors: vec![FieldIssue { pointer: pointer.into(), detail }],
+            errors: vec![FieldIssue {
+                pointer: pointer.into(),
+                detail,
+            }],
         }
     }
 
     /// A failure of the whole request, not tied to one field.
     pub fn general(class: ProblemClass, code: &'static str, detail: impl Into<String>) -> Self {
-        Self { class, code, detail: detail.into(), errors: Vec::new() }
+        Self {
+            class,
+            code,
+            detail: detail.into(),
+            errors: Vec::new(),
+        }
     }
 }
 
@@ -100,11 +108,19 @@ impl Validator {
 
     /// Record a problem at `pointer`.
     pub fn push(&mut self, pointer: impl Into<String>, detail: impl Into<String>) {
-        self.issues.push(FieldIssue { pointer: pointer.into(), detail: detail.into() });
+        self.issues.push(FieldIssue {
+            pointer: pointer.into(),
+            detail: detail.into(),
+        });
     }
 
     /// Record a problem at `pointer` unless `ok`.
-    pub fn ensure(&mut self, ok: bool, pointer: impl Into<String>, detail: impl FnOnce() -> String) {
+    pub fn ensure(
+        &mut self,
+        ok: bool,
+        pointer: impl Into<String>,
+        detail: impl FnOnce() -> String,
+    ) {
         if !ok {
             self.push(pointer, detail());
         }
@@ -125,8 +141,15 @@ impl Validator {
         let mut bad = values.iter().enumerate().filter(|(_, v)| !v.is_finite());
         if let Some((i, v)) = bad.next() {
             let more = bad.count();
-            let tail = if more > 0 { format!(" ({more} more non-finite values follow)") } else { String::new() };
-            self.push(format!("{pointer}/{i}"), format!("must be a finite number, got {v}{tail}"));
+            let tail = if more > 0 {
+                format!(" ({more} more non-finite values follow)")
+            } else {
+                String::new()
+            };
+            self.push(
+                format!("{pointer}/{i}"),
+                format!("must be a finite number, got {v}{tail}"),
+            );
             false
         } else {
             true
@@ -175,6 +198,11 @@ impl Validator {
         } else {
             format!("{n} fields failed validation")
         };
-        Err(CalcFailure { class: ProblemClass::InvalidInput, code: "INVALID_INPUT", detail, errors: self.issues })
+        Err(CalcFailure {
+            class: ProblemClass::InvalidInput,
+            code: "INVALID_INPUT",
+            detail,
+            errors: self.issues,
+        })
     }
 }

@@ -24,7 +24,9 @@ impl Budget {
         let start = Instant::now();
         Self {
             start,
-            deadline: start.checked_add(limit).unwrap_or(start + Duration::from_secs(86_400)),
+            deadline: start
+                .checked_add(limit)
+                .unwrap_or(start + Duration::from_secs(86_400)),
             max_evaluations: None,
         }
     }

@@ -35,15 +35,15 @@ pub fn c_of(psi: f64, theta1: f64) -> f64 {
 #[must_use]
 pub fn elastica(ei: f64, len: f64, theta1: f64, psi: f64, k: f64, q: u32) -> Option<Elastica> {
     let c = c_of(psi, theta1);
-    if k == 0.0 || !(k.abs() < 1.0) || c.abs() > k.abs() || q == 0 {
+    if k == 0.0 || k.is_nan() || k.abs() >= 1.0 || c.abs() > k.abs() || q == 0 {
         return None;
     }
     let m = k * k;
     let phi1 = (c / k).clamp(-1.0, 1.0).asin();
-    let phi2 = (2.0 * f64::from(q) - 1.0) * PI / 2.0;
+    let phi2 = (f64::from(q) - 0.5) * PI;
     let f1 = ellip_f(phi1, m);
     let f2 = ellip_f(phi2, m);
-    if !(f2 > f1) {
+    if f2.is_nan() || f1.is_nan() || f2 <= f1 {
         return None;
     }
     let e1 = ellip_e_inc(phi1, m);

@@ -114,18 +114,18 @@ pub struct ModesOutput {
 #[derive(Debug, Clone)]
 pub enum Output {
     /// FK.
-    Fk(FkOutput),
+    Fk(Box<FkOutput>),
     /// Sweep.
-    Workspace(WorkspaceOutput),
+    Workspace(Box<WorkspaceOutput>),
     /// Mode search.
-    Modes(ModesOutput),
+    Modes(Box<ModesOutput>),
 }
 
 /// Run the computation.
 pub fn compute(input: &Input, budget: &Budget) -> Result<Output, ContinuumError> {
     match input.mode {
-        Mode::Fk => Ok(Output::Fk(run_fk(input, budget)?)),
-        Mode::Workspace => Ok(Output::Workspace(run_workspace(input, budget)?)),
+        Mode::Fk => Ok(Output::Fk(Box::new(run_fk(input, budget)?))),
+        Mode::Workspace => Ok(Output::Workspace(Box::new(run_workspace(input, budget)?))),
         Mode::AssemblyModes => {
             let mut counter = Counter::default();
             let result = modes::search(
@@ -137,7 +137,11 @@ pub fn compute(input: &Input, budget: &Budget) -> Result<Output, ContinuumError>
                 budget,
                 &mut counter,
             );
-            Ok(Output::Modes(ModesOutput { result, warnings: input.warnings.clone(), evaluations: counter.evaluations }))
+            Ok(Output::Modes(Box::new(ModesOutput {
+                result,
+                warnings: input.warnings.clone(),
+                evaluations: counter.evaluations,
+            })))
         }
     }
 }
@@ -161,8 +165,16 @@ fn smallest_angle_stable(model: &Model, res: &ModeResult) -> Option<FromModes> {
         .iter()
         .enumerate()
         .filter(|(_, s)| s.stable)
-        .min_by(|a, b| model.angle(&a.1.solution.v).abs().total_cmp(&model.angle(&b.1.solution.v).abs()))
-        .map(|(index, s)| FromModes { solution: s.solution.clone(), index })
+        .min_by(|a, b| {
+            model
+                .angle(&a.1.solution.v)
+                .abs()
+                .total_cmp(&model.angle(&b.1.solution.v).abs())
+        })
+        .map(|(index, s)| FromModes {
+            solution: s.solution.clone(),
+            index,
+        })
 }
 
 fn stop_of(f: &Failed) -> StopReason {
@@ -181,12 +193,20 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
     let mut continuation_steps = 0usize;
     let mut newton_iterations = 0usize;
     let result: Result<Solution, Failed> = match &input.start {
-        Start::Guess(v) => newton::solve(model, target, v, input.newton, budget, &mut counter).map(|s| {
-            newton_iterations = s.iterations;
-            s
-        }),
+        Start::Guess(v) => newton::solve(model, target, v, input.newton, budget, &mut counter)
+            .inspect(|s| {
+                newton_iterations = s.iterations;
+            }),
         Start::AssemblyMode(index) => {
-            let res = modes::search(model, target, input.modes, input.newton, input.segments, budget, &mut counter);
+            let res = modes::search(
+                model,
+                target,
+                input.modes,
+                input.newton,
+                input.segments,
+                budget,
+                &mut counter,
+            );
             warnings.push(format!(
                 "assembly_mode_search: non-certified grid search found {} solution(s) ({} stable)",
                 res.solutions.len(),
@@ -208,14 +228,24 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 let k = input
                     .continuation_steps
                     .unwrap_or_else(|| fk::continuation_steps(model, &home.lambda, &target.lambda));
-                fk::from_home(model, &home, target, k, input.newton, budget, &mut counter).map(|r| {
-                    continuation_steps = r.steps;
-                    newton_iterations = r.newton_iterations;
-                    r.solution
-                })
+                fk::from_home(model, &home, target, k, input.newton, budget, &mut counter).map(
+                    |r| {
+                        continuation_steps = r.steps;
+                        newton_iterations = r.newton_iterations;
+                        r.solution
+                    },
+                )
             }
             None => {
-                let res = modes::search(model, target, input.modes, input.newton, input.segments, budget, &mut counter);
+                let res = modes::search(
+                    model,
+                    target,
+                    input.modes,
+                    input.newton,
+                    input.segments,
+                    budget,
+                    &mut counter,
+                );
                 match smallest_angle_stable(model, &res) {
                     Some(f) => {
                         warnings.push(format!(
@@ -231,7 +261,9 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                         );
                         Err(Failed {
                             reason: match res.stop {
-                                StopReason::Deadline | StopReason::MaxEvaluations => NewtonFailure::Budget(res.stop),
+                                StopReason::Deadline | StopReason::MaxEvaluations => {
+                                    NewtonFailure::Budget(res.stop)
+                                }
                                 _ => NewtonFailure::LineSearch,
                             },
                             v: model.home_state([0.0, 0.0]),
@@ -246,12 +278,19 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
     match result {
         Err(f) => {
             for i in fk::taut_rods(model, target, &f.v) {
-                warnings.push(format!("taut_rod {i}: chord/L > {} in the last iterate", fk::TAUT_CHORD));
+                warnings.push(format!(
+                    "taut_rod {i}: chord/L > {} in the last iterate",
+                    fk::TAUT_CHORD
+                ));
             }
             Ok(FkOutput {
                 status: FkStatus::NoConvergence,
                 solution: None,
-                residual_inf: if f.residual_inf.is_finite() { f.residual_inf } else { f64::MAX },
+                residual_inf: if f.residual_inf.is_finite() {
+                    f.residual_inf
+                } else {
+                    f64::MAX
+                },
                 cond: crate::calc::continuum_workspace::linalg::COND_CAP,
                 newton_iterations: newton_iterations.max(f.iterations),
                 continuation_steps,
@@ -281,12 +320,17 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
             if let Some(lim) = model.design.sigma_allow {
                 for (i, s) in described.stresses.iter().enumerate() {
                     if let Some(s) = s.filter(|s| *s > lim) {
-                        warnings.push(format!("stress_above_allowable {i}: {s:.4e} Pa > sigma_allow {lim:.4e} Pa"));
+                        warnings.push(format!(
+                            "stress_above_allowable {i}: {s:.4e} Pa > sigma_allow {lim:.4e} Pa"
+                        ));
                     }
                 }
             }
             if described.margin.is_some_and(|m| m <= fk::STABLE_MARGIN) {
-                warnings.push("unstable: the equilibrium found is unstable (stability margin <= 0)".to_string());
+                warnings.push(
+                    "unstable: the equilibrium found is unstable (stability margin <= 0)"
+                        .to_string(),
+                );
             }
             Ok(FkOutput {
                 status,
@@ -312,7 +356,11 @@ fn nearest_node(s: &sweep::SweepSettings, x: [f64; 2]) -> (usize, usize) {
         let n = s.grid[k];
         let r = s.ranges[k];
         let t = ((x[k] - r[0]) / (r[1] - r[0]) * (n - 1) as f64).round();
-        if t.is_finite() { t.clamp(0.0, (n - 1) as f64) as usize } else { 0 }
+        if t.is_finite() {
+            t.clamp(0.0, (n - 1) as f64) as usize
+        } else {
+            0
+        }
     };
     (pick(0), pick(1))
 }
@@ -332,46 +380,73 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
     let mut warnings = input.warnings.clone();
     let mut counter = Counter::default();
     let home = resolve_home(model);
-    let SeedInput { kind, inputs, state, index } = &sw.seed;
+    let SeedInput {
+        kind,
+        inputs,
+        state,
+        index,
+    } = &sw.seed;
     let seed_x = inputs.unwrap_or_else(|| match &home {
         Some(h) => [h.lambda[0], h.lambda[1]],
-        None => [0.5 * (s.ranges[0][0] + s.ranges[0][1]), 0.5 * (s.ranges[1][0] + s.ranges[1][1])],
+        None => [
+            0.5 * (s.ranges[0][0] + s.ranges[0][1]),
+            0.5 * (s.ranges[1][0] + s.ranges[1][1]),
+        ],
     });
     let node = nearest_node(s, seed_x);
     let lam0 = sweep::lambda_at(s, node.0, node.1);
-    let params0 = Params { lambda: lam0.to_vec(), force: input.params.force, moment: input.params.moment };
+    let params0 = Params {
+        lambda: lam0.to_vec(),
+        force: input.params.force,
+        moment: input.params.moment,
+    };
     let fail = |f: Failed| match f.reason {
         NewtonFailure::Budget(_) => NodeStatus::Unvisited,
         _ => NodeStatus::NoConvergence,
     };
     let mut seeds: Vec<SeedResult> = Vec::new();
-    let search = |counter: &mut Counter| modes::search(model, &params0, input.modes, input.newton, input.segments, budget, counter);
+    let search = |counter: &mut Counter| {
+        modes::search(
+            model,
+            &params0,
+            input.modes,
+            input.newton,
+            input.segments,
+            budget,
+            counter,
+        )
+    };
     match kind {
-        SeedKind::Home => match &home {
-            Some(h) => {
-                let k = fk::continuation_steps(model, &h.lambda, &lam0);
-                let r = fk::from_home(model, h, &params0, k, input.newton, budget, &mut counter);
-                seeds.push((None, r.map(|r| r.solution).map_err(fail)));
-            }
-            None => {
-                let res = search(&mut counter);
-                match smallest_angle_stable(model, &res) {
-                    Some(f) => {
-                        warnings.push(format!(
+        SeedKind::Home => {
+            match &home {
+                Some(h) => {
+                    let k = fk::continuation_steps(model, &h.lambda, &lam0);
+                    let r =
+                        fk::from_home(model, h, &params0, k, input.newton, budget, &mut counter);
+                    seeds.push((None, r.map(|r| r.solution).map_err(fail)));
+                }
+                None => {
+                    let res = search(&mut counter);
+                    match smallest_angle_stable(model, &res) {
+                        Some(f) => {
+                            warnings.push(format!(
                             "no_stress_free_home: the wave starts from assembly mode {} (stable, smallest |theta_EE|, non-certified search)",
                             f.index
                         ));
-                        seeds.push((Some(f.index), Ok(f.solution)));
-                    }
-                    None => {
-                        warnings.push("no_stress_free_home: no stable assembly mode found at the seed node".to_string());
-                        seeds.push((None, Err(NodeStatus::Unstable)));
+                            seeds.push((Some(f.index), Ok(f.solution)));
+                        }
+                        None => {
+                            warnings.push("no_stress_free_home: no stable assembly mode found at the seed node".to_string());
+                            seeds.push((None, Err(NodeStatus::Unstable)));
+                        }
                     }
                 }
             }
-        },
+        }
         SeedKind::Guess => {
-            let v0 = state.clone().unwrap_or_else(|| model.home_state([0.0, 0.0]));
+            let v0 = state
+                .clone()
+                .unwrap_or_else(|| model.home_state([0.0, 0.0]));
             let r = newton::solve(model, &params0, &v0, input.newton, budget, &mut counter);
             seeds.push((None, r.map_err(fail)));
         }
@@ -394,7 +469,10 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
                 seeds.push((Some(i), Ok(m.solution.clone())));
             }
             if seeds.is_empty() {
-                warnings.push("all_stable_modes: the non-certified search found no stable assembly mode".to_string());
+                warnings.push(
+                    "all_stable_modes: the non-certified search found no stable assembly mode"
+                        .to_string(),
+                );
                 seeds.push((None, Err(NodeStatus::Unstable)));
             }
         }
@@ -405,7 +483,10 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
     let mut attempts = 0u64;
     let mut stop = StopReason::Completed;
     for (mode_index, seed) in seeds {
-        let seed_pose = seed.as_ref().ok().map(|sol| (model.position(&sol.v), model.angle(&sol.v)));
+        let seed_pose = seed
+            .as_ref()
+            .ok()
+            .map(|sol| (model.position(&sol.v), model.angle(&sol.v)));
         let accepted: Result<NodeData, NodeStatus> = seed.and_then(|sol| {
             if let Some(st) = sweep::input_limits(model, s, &lam0) {
                 return Err(st);
@@ -420,8 +501,21 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
             Err(st) => {
                 let mut status = vec![NodeStatus::Unvisited; n];
                 status[node.0 * s.grid[1] + node.1] = st;
-                let stop = if budget.expired() { StopReason::Deadline } else { StopReason::Completed };
-                (st, WaveResult { status, nodes: vec![None; n], stop, attempts: 0, evaluations: 0 })
+                let stop = if budget.expired() {
+                    StopReason::Deadline
+                } else {
+                    StopReason::Completed
+                };
+                (
+                    st,
+                    WaveResult {
+                        status,
+                        nodes: vec![None; n],
+                        stop,
+                        attempts: 0,
+                        evaluations: 0,
+                    },
+                )
             }
         };
         evaluations += wave.evaluations;
@@ -445,22 +539,43 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
         stop = StopReason::Deadline;
     }
     if stop == StopReason::Deadline || stop == StopReason::MaxEvaluations {
-        warnings.push("budget_exhausted: the sweep stopped early; unvisited nodes were not attempted".to_string());
+        warnings.push(
+            "budget_exhausted: the sweep stopped early; unvisited nodes were not attempted"
+                .to_string(),
+        );
     }
-    Ok(WorkspaceOutput { waves, warnings, evaluations, attempts, stop })
+    Ok(WorkspaceOutput {
+        waves,
+        warnings,
+        evaluations,
+        attempts,
+        stop,
+    })
 }
 
 /// Metrics of one wave (spec 4.8).
 #[must_use]
-pub fn metrics(model: &Model, grid: [usize; 2], wave: &WaveResult, qt: f64, union: bool) -> Metrics {
+pub fn metrics(
+    model: &Model,
+    grid: [usize; 2],
+    wave: &WaveResult,
+    qt: f64,
+    union: bool,
+) -> Metrics {
     let (n1, n2) = (grid[0], grid[1]);
     let node = |i: usize, j: usize| wave.nodes[i * n2 + j].as_ref();
     let accepted: Vec<&NodeData> = wave.nodes.iter().flatten().collect();
-    let mut m = Metrics { n_accepted: accepted.len(), ..Metrics::default() };
+    let mut m = Metrics {
+        n_accepted: accepted.len(),
+        ..Metrics::default()
+    };
     if !accepted.is_empty() {
         m.max_abs_angle = accepted.iter().fold(0.0f64, |a, d| a.max(d.angle.abs()));
-        m.mean_abs_angle = accepted.iter().map(|d| d.angle.abs()).sum::<f64>() / accepted.len() as f64;
-        m.max_stress = accepted.iter().try_fold(0.0f64, |a, d| d.max_stress.map(|s| a.max(s)));
+        m.mean_abs_angle =
+            accepted.iter().map(|d| d.angle.abs()).sum::<f64>() / accepted.len() as f64;
+        m.max_stress = accepted
+            .iter()
+            .try_fold(0.0f64, |a, d| d.max_stress.map(|s| a.max(s)));
     }
     let mut quads: Vec<Quad> = Vec::new();
     let mut signed: Vec<f64> = Vec::new();
@@ -468,7 +583,12 @@ pub fn metrics(model: &Model, grid: [usize; 2], wave: &WaveResult, qt: f64, unio
     let mut qt_sum = 0.0;
     for i in 0..n1.saturating_sub(1) {
         for j in 0..n2.saturating_sub(1) {
-            let (Some(a), Some(b), Some(c), Some(d)) = (node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)) else {
+            let (Some(a), Some(b), Some(c), Some(d)) = (
+                node(i, j),
+                node(i + 1, j),
+                node(i + 1, j + 1),
+                node(i, j + 1),
+            ) else {
                 continue;
             };
             let q: Quad = [a.position, b.position, c.position, d.position];

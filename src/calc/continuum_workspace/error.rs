@@ -6,7 +6,9 @@ use crate::calc::{CalcFailure, ProblemClass};
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ContinuumError {
     /// The assembly-mode search returned fewer solutions than the requested index.
-    #[error("assembly mode {index} was requested but the (non-certified) search found {found} solution(s)")]
+    #[error(
+        "assembly mode {index} was requested but the (non-certified) search found {found} solution(s)"
+    )]
     AssemblyModeNotFound {
         /// Requested index.
         index: usize,

@@ -45,8 +45,10 @@ pub fn home_fit(model: &Model, fixed: Option<&[f64]>) -> Home {
         let act = &d.actuators[r.actuator];
         let (s, c) = r.clamp.sin_cos();
         let rhs = [
-            r.attach[0] - act.origin[0] - r.offset[0] - r.length * c,
-            r.attach[1] - act.origin[1] - r.offset[1] - r.length * s,
+            r.length
+                .mul_add(-c, r.attach[0] - act.origin[0] - r.offset[0]),
+            r.length
+                .mul_add(-s, r.attach[1] - act.origin[1] - r.offset[1]),
         ];
         for k in 0..2 {
             let row = 2 * i + k;
@@ -60,23 +62,40 @@ pub fn home_fit(model: &Model, fixed: Option<&[f64]>) -> Home {
         }
     }
     let svd = a.clone().svd(true, true);
-    let x = svd.solve(&b, 1e-12).unwrap_or_else(|_| nalgebra::DVector::zeros(nunk));
+    let x = svd
+        .solve(&b, 1e-12)
+        .unwrap_or_else(|_| nalgebra::DVector::zeros(nunk));
     let res = &a * &x - &b;
     let residual = res.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let lambda = match fixed {
         Some(l) => l.to_vec(),
         None => x.iter().take(na).copied().collect(),
     };
-    let residual = if residual.is_finite() { residual } else { f64::INFINITY };
-    Home { lambda, position: [x[nunk - 2], x[nunk - 1]], residual }
+    let residual = if residual.is_finite() {
+        residual
+    } else {
+        f64::INFINITY
+    };
+    Home {
+        lambda,
+        position: [x[nunk - 2], x[nunk - 1]],
+        residual,
+    }
 }
 
 /// Number of continuation steps of spec 4.3 from `from` to `to`.
 #[must_use]
 pub fn continuation_steps(model: &Model, from: &[f64], to: &[f64]) -> usize {
-    let dmax = from.iter().zip(to).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let dmax = from
+        .iter()
+        .zip(to)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
     let k = (dmax / (CONTINUATION_REL_STEP * model.l_ref)).ceil();
-    if k.is_finite() && k < 1e6 { (k as usize).max(MIN_CONTINUATION_STEPS) } else { 1_000_000 }
+    if k.is_finite() && k < 1e6 {
+        (k as usize).max(MIN_CONTINUATION_STEPS)
+    } else {
+        1_000_000
+    }
 }
 
 /// Solve at home then continue to `target` (spec 4.3 rule 2).
@@ -89,10 +108,23 @@ pub fn from_home(
     budget: &Budget,
     counter: &mut Counter,
 ) -> Result<ContinuationResult, Failed> {
-    let start_params = Params { lambda: home.lambda.clone(), force: [0.0, 0.0], moment: 0.0 };
+    let start_params = Params {
+        lambda: home.lambda.clone(),
+        force: [0.0, 0.0],
+        moment: 0.0,
+    };
     let v0 = model.home_state(home.position);
     let start = newton::solve(model, &start_params, &v0, opts, budget, counter)?;
-    newton::continuation(model, start, &start_params, target, k, opts, budget, counter)
+    newton::continuation(
+        model,
+        start,
+        &start_params,
+        target,
+        k,
+        opts,
+        budget,
+        counter,
+    )
 }
 
 /// Everything reported about one solved equilibrium.
@@ -141,23 +173,48 @@ pub fn margin_of(model: &Model, sol: &Solution, segments: usize) -> Option<f64> 
         .map(|i| {
             let tr = model.trace(&sol.v, i, sol.steps[i]);
             let r = &model.design.rods[i];
-            let angles = (0..m).map(|j| tr.at((j as f64 + 0.5) / m as f64)[2]).collect();
-            RodDisc { ei: r.ei, length: r.length, clamp: r.clamp, angles, force: sol.eval.forces[i] }
+            let angles = (0..m)
+                .map(|j| tr.at((j as f64 + 0.5) / m as f64)[2])
+                .collect();
+            RodDisc {
+                ei: r.ei,
+                length: r.length,
+                clamp: r.clamp,
+                angles,
+                force: sol.eval.forces[i],
+            }
         })
         .collect();
     let attach: Vec<[f64; 2]> = model.design.rods.iter().map(|r| r.attach).collect();
-    stability::margin(&rods, Tips::Platform { theta: model.angle(&sol.v), attach: &attach }, model.l_ref, model.ei_ref)
+    stability::margin(
+        &rods,
+        Tips::Platform {
+            theta: model.angle(&sol.v),
+            attach: &attach,
+        },
+        model.l_ref,
+        model.ei_ref,
+    )
 }
 
 /// Describe a solution: forces, moments, stresses, energies, optional shapes and stability.
 #[must_use]
-pub fn describe(model: &Model, sol: &Solution, shape_points: usize, stability_segments: Option<usize>) -> Described {
+pub fn describe(
+    model: &Model,
+    sol: &Solution,
+    shape_points: usize,
+    stability_segments: Option<usize>,
+) -> Described {
     let nr = model.n_rods();
     let mut base_moments = Vec::with_capacity(nr);
     let mut max_moments = Vec::with_capacity(nr);
     let mut stresses = Vec::with_capacity(nr);
     let mut energies = Vec::with_capacity(nr);
-    let mut shapes = if shape_points > 0 { Some(Vec::with_capacity(nr)) } else { None };
+    let mut shapes = if shape_points > 0 {
+        Some(Vec::with_capacity(nr))
+    } else {
+        None
+    };
     for i in 0..nr {
         let r = &model.design.rods[i];
         let tr = model.trace(&sol.v, i, sol.steps[i]);
@@ -171,12 +228,25 @@ pub fn describe(model: &Model, sol: &Solution, shape_points: usize, stability_se
         }));
         energies.push(tr.bending_energy * scale);
         if let Some(sh) = shapes.as_mut() {
-            let base = [sol.eval.tips[i][0] - r.length * tr.nodes[tr.steps()][0], sol.eval.tips[i][1] - r.length * tr.nodes[tr.steps()][1]];
+            let end = tr.nodes[tr.steps()];
+            let base = [
+                r.length.mul_add(-end[0], sol.eval.tips[i][0]),
+                r.length.mul_add(-end[1], sol.eval.tips[i][1]),
+            ];
             let pts = (0..shape_points)
                 .map(|k| {
-                    let sb = if shape_points == 1 { 1.0 } else { k as f64 / (shape_points - 1) as f64 };
+                    let sb = if shape_points == 1 {
+                        1.0
+                    } else {
+                        k as f64 / (shape_points - 1) as f64
+                    };
                     let z = tr.at(sb);
-                    [r.length.mul_add(z[0], base[0]), r.length.mul_add(z[1], base[1]), z[2].to_degrees(), z[3] * scale]
+                    [
+                        r.length.mul_add(z[0], base[0]),
+                        r.length.mul_add(z[1], base[1]),
+                        z[2].to_degrees(),
+                        z[3] * scale,
+                    ]
                 })
                 .collect();
             sh.push(pts);
@@ -223,5 +293,5 @@ pub fn taut_rods(model: &Model, p: &Params, v: &[f64]) -> Vec<usize> {
 #[must_use]
 pub fn wrap_pi(t: f64) -> f64 {
     let w = (t + PI).rem_euclid(2.0 * PI) - PI;
-    if w <= -PI { w + 2.0 * PI } else { w }
+    if w <= -PI { 2.0f64.mul_add(PI, w) } else { w }
 }

@@ -9,7 +9,8 @@ use super::newton::NewtonOptions;
 use super::presets::Preset;
 use super::sweep::{Limits, StabilityCheck, SweepSettings};
 use super::wire::{
-    AreaMethod, ContinuumWorkspaceRequest, Mode, PresetName, RodCrossing, SeedKind, StabilityCheckName, StartKind,
+    AreaMethod, ContinuumWorkspaceRequest, Mode, PresetName, RodCrossing, SeedKind,
+    StabilityCheckName, StartKind,
 };
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
@@ -150,14 +151,23 @@ fn usize_of(x: u32) -> usize {
 }
 
 /// Validate the design part; returns the design (possibly partial when invalid).
-fn design_of(req: &ContinuumWorkspaceRequest, v: &mut Validator, warnings: &mut Vec<String>) -> (Design, Option<Preset>) {
+fn design_of(
+    req: &ContinuumWorkspaceRequest,
+    v: &mut Validator,
+    warnings: &mut Vec<String>,
+) -> (Design, Option<Preset>) {
     let d = &req.design;
     if let Some(p) = d.preset {
-        for (present, name) in
-            [(d.actuators.is_some(), "actuators"), (d.rods.is_some(), "rods"), (d.home_inputs_m.is_some(), "home_inputs_m")]
-        {
+        for (present, name) in [
+            (d.actuators.is_some(), "actuators"),
+            (d.rods.is_some(), "rods"),
+            (d.home_inputs_m.is_some(), "home_inputs_m"),
+        ] {
             if present {
-                v.push(format!("/design/{name}"), "must be absent when design.preset is given (presets fix the geometry)");
+                v.push(
+                    format!("/design/{name}"),
+                    "must be absent when design.preset is given (presets fix the geometry)",
+                );
             }
         }
         let preset = preset_of(p);
@@ -173,7 +183,10 @@ fn design_of(req: &ContinuumWorkspaceRequest, v: &mut Validator, warnings: &mut 
         None => v.push("/design/actuators", "required (or give design.preset)"),
         Some(acts) => {
             if acts.is_empty() || acts.len() > 4 {
-                v.push("/design/actuators", format!("must list 1..4 actuators, got {}", acts.len()));
+                v.push(
+                    "/design/actuators",
+                    format!("must list 1..4 actuators, got {}", acts.len()),
+                );
             }
             for (j, a) in acts.iter().enumerate() {
                 let p = format!("/design/actuators/{j}");
@@ -184,16 +197,28 @@ fn design_of(req: &ContinuumWorkspaceRequest, v: &mut Validator, warnings: &mut 
                     if nrm > MIN_DIRECTION_NORM {
                         dir = [a.direction[0] / nrm, a.direction[1] / nrm];
                     } else {
-                        v.push(format!("{p}/direction"), format!("norm must be > {MIN_DIRECTION_NORM}, got {nrm}"));
+                        v.push(
+                            format!("{p}/direction"),
+                            format!("norm must be > {MIN_DIRECTION_NORM}, got {nrm}"),
+                        );
                     }
                 }
-                if v.all_finite(&format!("{p}/stroke_m"), &a.stroke_m) && a.stroke_m[0] >= a.stroke_m[1] {
+                if v.all_finite(&format!("{p}/stroke_m"), &a.stroke_m)
+                    && a.stroke_m[0] >= a.stroke_m[1]
+                {
                     v.push(
                         format!("{p}/stroke_m"),
-                        format!("min must be < max, got [{}, {}]", a.stroke_m[0], a.stroke_m[1]),
+                        format!(
+                            "min must be < max, got [{}, {}]",
+                            a.stroke_m[0], a.stroke_m[1]
+                        ),
                     );
                 }
-                actuators.push(Actuator { origin: a.origin_m, dir, stroke: a.stroke_m });
+                actuators.push(Actuator {
+                    origin: a.origin_m,
+                    dir,
+                    stroke: a.stroke_m,
+                });
             }
         }
     }
@@ -203,14 +228,20 @@ fn design_of(req: &ContinuumWorkspaceRequest, v: &mut Validator, warnings: &mut 
         None => v.push("/design/rods", "required (or give design.preset)"),
         Some(rs) => {
             if rs.len() < 2 || rs.len() > 8 {
-                v.push("/design/rods", format!("must list 2..8 rods, got {}", rs.len()));
+                v.push(
+                    "/design/rods",
+                    format!("must list 2..8 rods, got {}", rs.len()),
+                );
             }
             for (i, r) in rs.iter().enumerate() {
                 let p = format!("/design/rods/{i}");
                 if r.actuator >= n_act {
                     v.push(
                         format!("{p}/actuator"),
-                        format!("unknown actuator index {} (design has {n_act} actuators)", r.actuator),
+                        format!(
+                            "unknown actuator index {} (design has {n_act} actuators)",
+                            r.actuator
+                        ),
                     );
                 }
                 let offset = r.offset_m.unwrap_or([0.0, 0.0]);
@@ -221,9 +252,11 @@ fn design_of(req: &ContinuumWorkspaceRequest, v: &mut Validator, warnings: &mut 
                 let e = r.youngs_modulus_pa.unwrap_or(DEFAULT_E);
                 let e_ok = v.greater_than(&format!("{p}/youngs_modulus_pa"), e, 0.0);
                 let mut diameter = None;
-                if let Some(dm) = r.diameter_m {
-                    if v.greater_than(&format!("{p}/diameter_m"), dm, 0.0) {
-                        diameter = Some(dm);
+                if let Some(dm) = r.diameter_m
+                    && v.greater_than(&format!("{p}/diameter_m"), dm, 0.0)
+                {
+                    diameter = Some(dm);
+                    {
                         if len_ok {
                             let slender = r.length_m / dm;
                             if slender < MIN_SLENDERNESS {
@@ -269,13 +302,18 @@ fn design_of(req: &ContinuumWorkspaceRequest, v: &mut Validator, warnings: &mut 
             }
             for j in 0..n_act {
                 if !rs.iter().any(|r| r.actuator == j) {
-                    v.push(format!("/design/actuators/{j}"), "carries no rod: its input would be undetermined");
+                    v.push(
+                        format!("/design/actuators/{j}"),
+                        "carries no rod: its input would be undetermined",
+                    );
                 }
             }
             if rods.len() >= 2 && v.is_clean() {
                 let l_ref = rods.iter().map(|r| r.length).sum::<f64>() / rods.len() as f64;
                 let r0 = rods[0].attach;
-                let spread = rods.iter().fold(0.0f64, |m, r| m.max((r.attach[0] - r0[0]).hypot(r.attach[1] - r0[1])));
+                let spread = rods.iter().fold(0.0f64, |m, r| {
+                    m.max((r.attach[0] - r0[0]).hypot(r.attach[1] - r0[1]))
+                });
                 if spread <= COINCIDENT_REL * l_ref {
                     v.push(
                         "/design/rods",
@@ -290,12 +328,23 @@ fn design_of(req: &ContinuumWorkspaceRequest, v: &mut Validator, warnings: &mut 
     }
     if let Some(h) = &d.home_inputs_m {
         if h.len() != n_act {
-            v.push("/design/home_inputs_m", format!("must have {n_act} entries (one per actuator), got {}", h.len()));
+            v.push(
+                "/design/home_inputs_m",
+                format!(
+                    "must have {n_act} entries (one per actuator), got {}",
+                    h.len()
+                ),
+            );
         } else {
             v.all_finite("/design/home_inputs_m", h);
         }
     }
-    let design = Design { actuators, rods, home: d.home_inputs_m.clone(), sigma_allow: d.sigma_allow_pa };
+    let design = Design {
+        actuators,
+        rods,
+        home: d.home_inputs_m.clone(),
+        sigma_allow: d.sigma_allow_pa,
+    };
     (design, None)
 }
 
@@ -312,7 +361,10 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         let max_iter = u32_in(&mut v, "/solver/max_iter", solver.max_iter, 5, 200, 50);
         let extensible = solver.axial_extensibility.unwrap_or(false);
         if extensible && design.rods.iter().any(|r| r.ea.is_none()) {
-            v.push("/solver/axial_extensibility", "needs diameter_m (and youngs_modulus_pa) on every rod to compute EA");
+            v.push(
+                "/solver/axial_extensibility",
+                "needs diameter_m (and youngs_modulus_pa) on every rod to compute EA",
+            );
         }
         // Structural problems make everything below meaningless: stop here.
         v.finish()?;
@@ -323,7 +375,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         // Given home inputs must really be stress-free.
         if let (Some(h), None) = (&model.design.home, preset) {
             let fit = fk::home_fit(&model, Some(h));
-            if !(fit.residual <= HOME_REL_TOL * model.l_ref) {
+            if fit.residual.is_nan() || fit.residual > HOME_REL_TOL * model.l_ref {
                 v.push(
                     "/design/home_inputs_m",
                     format!(
@@ -341,13 +393,22 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             let fmax = MAX_LOAD_REL * model.f_ref;
             let fnorm = force[0].hypot(force[1]);
             if fnorm > fmax {
-                v.push("/load/force_n", format!("|F| = {fnorm} N exceeds 1e4 EI_ref/L_ref^2 = {fmax} N"));
+                v.push(
+                    "/load/force_n",
+                    format!("|F| = {fnorm} N exceeds 1e4 EI_ref/L_ref^2 = {fmax} N"),
+                );
             }
         }
         if v.finite("/load/moment_nm", moment) {
             let mmax = MAX_LOAD_REL * model.f_ref * model.l_ref;
             if moment.abs() > mmax {
-                v.push("/load/moment_nm", format!("|M| = {} N m exceeds 1e4 EI_ref/L_ref = {mmax} N m", moment.abs()));
+                v.push(
+                    "/load/moment_nm",
+                    format!(
+                        "|M| = {} N m exceeds 1e4 EI_ref/L_ref = {mmax} N m",
+                        moment.abs()
+                    ),
+                );
             }
         }
         // Inputs.
@@ -356,7 +417,13 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             match &req.inputs_m {
                 None => v.push("/inputs_m", "required for mode fk and assembly_modes"),
                 Some(l) if l.len() != n_act => {
-                    v.push("/inputs_m", format!("must have {n_act} entries (one per actuator), got {}", l.len()));
+                    v.push(
+                        "/inputs_m",
+                        format!(
+                            "must have {n_act} entries (one per actuator), got {}",
+                            l.len()
+                        ),
+                    );
                 }
                 Some(l) => {
                     for (j, (&x, a)) in l.iter().zip(&model.design.actuators).enumerate() {
@@ -380,7 +447,14 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                     }
                     Some(st) => {
                         if st.v.len() != 3 * nr + 3 {
-                            v.push("/start/state/v", format!("must have 3N+3 = {} entries, got {}", 3 * nr + 3, st.v.len()));
+                            v.push(
+                                "/start/state/v",
+                                format!(
+                                    "must have 3N+3 = {} entries, got {}",
+                                    3 * nr + 3,
+                                    st.v.len()
+                                ),
+                            );
                         } else {
                             v.all_finite("/start/state/v", &st.v);
                         }
@@ -392,25 +466,70 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         let continuation_steps = start_req
             .as_ref()
             .and_then(|s| s.continuation_steps)
-            .map(|k| usize_of(u32_in(&mut v, "/start/continuation_steps", Some(k), 1, 10_000, 30)));
+            .map(|k| {
+                usize_of(u32_in(
+                    &mut v,
+                    "/start/continuation_steps",
+                    Some(k),
+                    1,
+                    10_000,
+                    30,
+                ))
+            });
         // Outputs.
         let outputs = req.outputs.clone().unwrap_or_default();
         let stability = outputs.stability.unwrap_or(true);
-        let segments = u32_in(&mut v, "/outputs/stability_segments", outputs.stability_segments, 10, 400, 40);
-        let shape_points = u32_in(&mut v, "/outputs/rod_shape_points", outputs.rod_shape_points, 0, 1000, 0);
+        let segments = u32_in(
+            &mut v,
+            "/outputs/stability_segments",
+            outputs.stability_segments,
+            10,
+            400,
+            40,
+        );
+        let shape_points = u32_in(
+            &mut v,
+            "/outputs/rod_shape_points",
+            outputs.rod_shape_points,
+            0,
+            1000,
+            0,
+        );
         // Mode search.
         let am = req.assembly_modes.clone().unwrap_or_default();
         let n_grid = u32_in(&mut v, "/assembly_modes/n_grid", am.n_grid, 1, 50, 6);
-        let mtol = f64_in(&mut v, "/assembly_modes/tol", am.tol, f64::MIN_POSITIVE, 10.0, 0.45);
+        let mtol = f64_in(
+            &mut v,
+            "/assembly_modes/tol",
+            am.tol,
+            f64::MIN_POSITIVE,
+            10.0,
+            0.45,
+        );
         let cell = u32_in(&mut v, "/assembly_modes/cell", am.cell, 1, 100, 2);
-        let max_refine = u32_in(&mut v, "/assembly_modes/max_refine", am.max_refine, 1, 20_000, 4000);
-        let modes = ModeSearch { n_grid: usize_of(n_grid), tol: mtol, cell: usize_of(cell), max_refine: usize_of(max_refine) };
+        let max_refine = u32_in(
+            &mut v,
+            "/assembly_modes/max_refine",
+            am.max_refine,
+            1,
+            20_000,
+            4000,
+        );
+        let modes = ModeSearch {
+            n_grid: usize_of(n_grid),
+            tol: mtol,
+            cell: usize_of(cell),
+            max_refine: usize_of(max_refine),
+        };
         // Time limit.
         let time_limit = req.time_limit_ms.and_then(|ms| {
             if (1..=MAX_TIME_LIMIT_MS).contains(&ms) {
                 Some(Duration::from_millis(ms))
             } else {
-                v.push("/time_limit_ms", format!("must be in [1, {MAX_TIME_LIMIT_MS}] ms, got {ms}"));
+                v.push(
+                    "/time_limit_ms",
+                    format!("must be in [1, {MAX_TIME_LIMIT_MS}] ms, got {ms}"),
+                );
                 None
             }
         });
@@ -418,13 +537,19 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         let mut too_large: Option<CalcFailure> = None;
         let sweep = if req.mode == Mode::Workspace {
             if n_act != 2 {
-                v.push("/design/actuators", format!("mode workspace needs exactly 2 actuators (2-D grid), got {n_act}"));
+                v.push(
+                    "/design/actuators",
+                    format!("mode workspace needs exactly 2 actuators (2-D grid), got {n_act}"),
+                );
             }
             let w = req.workspace.clone().unwrap_or_default();
             let grid = w.grid.unwrap_or([31, 31]);
             for (k, &g) in grid.iter().enumerate() {
                 if !(2..=MAX_GRID_SIDE).contains(&g) {
-                    v.push(format!("/workspace/grid/{k}"), format!("must be in [2, {MAX_GRID_SIDE}], got {g}"));
+                    v.push(
+                        format!("/workspace/grid/{k}"),
+                        format!("must be in [2, {MAX_GRID_SIDE}], got {g}"),
+                    );
                 }
             }
             let nodes = u64::from(grid[0]) * u64::from(grid[1]);
@@ -440,29 +565,62 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                 ));
             }
             let strokes = if n_act == 2 {
-                [model.design.actuators[0].stroke, model.design.actuators[1].stroke]
+                [
+                    model.design.actuators[0].stroke,
+                    model.design.actuators[1].stroke,
+                ]
             } else {
                 [[0.0, 1.0], [0.0, 1.0]]
             };
             let ranges = w.ranges_m.unwrap_or(strokes);
             for (k, r) in ranges.iter().enumerate() {
                 if v.all_finite(&format!("/workspace/ranges_m/{k}"), r) && r[0] >= r[1] {
-                    v.push(format!("/workspace/ranges_m/{k}"), format!("min must be < max, got [{}, {}]", r[0], r[1]));
+                    v.push(
+                        format!("/workspace/ranges_m/{k}"),
+                        format!("min must be < max, got [{}, {}]", r[0], r[1]),
+                    );
                 }
             }
             let neighbours = w.neighbours.unwrap_or(4);
             if neighbours != 4 && neighbours != 8 {
-                v.push("/workspace/neighbours", format!("must be 4 or 8, got {neighbours}"));
+                v.push(
+                    "/workspace/neighbours",
+                    format!("must be 4 or 8, got {neighbours}"),
+                );
             }
             let max_substeps = u32_in(&mut v, "/workspace/max_substeps", w.max_substeps, 1, 64, 8);
             if !max_substeps.is_power_of_two() {
-                v.push("/workspace/max_substeps", format!("must be a power of two (1, 2, 4, ..., 64), got {max_substeps}"));
+                v.push(
+                    "/workspace/max_substeps",
+                    format!("must be a power of two (1, 2, 4, ..., 64), got {max_substeps}"),
+                );
             }
             let max_tries = u32_in(&mut v, "/workspace/max_tries", w.max_tries, 1, 8, 4);
+            let substep_max_iter = u32_in(
+                &mut v,
+                "/workspace/substep_max_iter",
+                w.substep_max_iter,
+                5,
+                200,
+                20,
+            );
             let jl = w.jump_limits.clone().unwrap_or_default();
-            let angle_jump = f64_in(&mut v, "/workspace/jump_limits/angle_deg", jl.angle_deg, 1e-6, 180.0, 5.0);
-            let position_factor =
-                f64_in(&mut v, "/workspace/jump_limits/position_factor", jl.position_factor, 1e-6, 1000.0, 5.0);
+            let angle_jump = f64_in(
+                &mut v,
+                "/workspace/jump_limits/angle_deg",
+                jl.angle_deg,
+                1e-6,
+                180.0,
+                5.0,
+            );
+            let position_factor = f64_in(
+                &mut v,
+                "/workspace/jump_limits/position_factor",
+                jl.position_factor,
+                1e-6,
+                1000.0,
+                5.0,
+            );
             let cond_max = f64_in(&mut v, "/workspace/cond_max", w.cond_max, 10.0, 1e18, 1e12);
             let stab = match w.stability_check.unwrap_or(StabilityCheckName::Full) {
                 StabilityCheckName::Full => StabilityCheck::Full,
@@ -484,9 +642,21 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             if let Some(s) = lim.sigma_allow_pa {
                 v.greater_than("/workspace/limits/sigma_allow_pa", s, 0.0);
             }
-            let qt = f64_in(&mut v, "/workspace/quasi_translational_deg", w.quasi_translational_deg, 1e-9, 180.0, 1.0);
+            let qt = f64_in(
+                &mut v,
+                "/workspace/quasi_translational_deg",
+                w.quasi_translational_deg,
+                1e-9,
+                180.0,
+                1.0,
+            );
             let seed = match &w.seed {
-                None => SeedInput { kind: SeedKind::Home, inputs: None, state: None, index: 0 },
+                None => SeedInput {
+                    kind: SeedKind::Home,
+                    inputs: None,
+                    state: None,
+                    index: 0,
+                },
                 Some(s) => {
                     if let Some(i) = &s.inputs_m {
                         v.all_finite("/workspace/seed/inputs_m", i);
@@ -500,7 +670,11 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                             if st.v.len() != 3 * nr + 3 {
                                 v.push(
                                     "/workspace/seed/state/v",
-                                    format!("must have 3N+3 = {} entries, got {}", 3 * nr + 3, st.v.len()),
+                                    format!(
+                                        "must have 3N+3 = {} entries, got {}",
+                                        3 * nr + 3,
+                                        st.v.len()
+                                    ),
                                 );
                             } else {
                                 v.all_finite("/workspace/seed/state/v", &st.v);
@@ -509,7 +683,12 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                         }
                         _ => None,
                     };
-                    SeedInput { kind: s.kind, inputs: s.inputs_m, state, index: s.index.unwrap_or(0) }
+                    SeedInput {
+                        kind: s.kind,
+                        inputs: s.inputs_m,
+                        state,
+                        index: s.index.unwrap_or(0),
+                    }
                 }
             };
             Some(SweepInput {
@@ -520,6 +699,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                     predictor: w.predictor.unwrap_or(true),
                     max_substeps: usize_of(max_substeps),
                     max_tries: usize_of(max_tries),
+                    substep_max_iter: usize_of(substep_max_iter),
                     angle_jump: angle_jump.to_radians(),
                     position_factor,
                     cond_max,
@@ -541,12 +721,15 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             None
         };
         // The mode search runs when asked for, or when there is no stress-free home to start from.
-        let has_home = model.design.home.is_some() || fk::home_fit(&model, None).residual <= HOME_REL_TOL * model.l_ref;
+        let has_home = model.design.home.is_some()
+            || fk::home_fit(&model, None).residual <= HOME_REL_TOL * model.l_ref;
         let search_needed = req.mode == Mode::AssemblyModes
             || matches!(start, Start::AssemblyMode(_))
             || sweep.as_ref().is_some_and(|s| {
-                matches!(s.seed.kind, SeedKind::AssemblyMode | SeedKind::AllStableModes)
-                    || (s.seed.kind == SeedKind::Home && !has_home)
+                matches!(
+                    s.seed.kind,
+                    SeedKind::AssemblyMode | SeedKind::AllStableModes
+                ) || (s.seed.kind == SeedKind::Home && !has_home)
             })
             || (req.mode == Mode::Fk && start == Start::Home && !has_home);
         v.finish()?;
@@ -556,7 +739,11 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         if search_needed {
             let combos = modes::combinations(modes.n_grid, nr);
             if combos > MAX_COMBINATIONS {
-                let why = if has_home { "" } else { " (the design has no stress-free home, so the FK starts from the mode search)" };
+                let why = if has_home {
+                    ""
+                } else {
+                    " (the design has no stress-free home, so the FK starts from the mode search)"
+                };
                 return Err(CalcFailure::field(
                     ProblemClass::TooLarge,
                     "SEARCH_TOO_LARGE",
@@ -572,8 +759,15 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             mode: req.mode,
             model,
             preset,
-            params: Params { lambda, force, moment },
-            newton: NewtonOptions { tol, max_iter: usize_of(max_iter) },
+            params: Params {
+                lambda,
+                force,
+                moment,
+            },
+            newton: NewtonOptions {
+                tol,
+                max_iter: usize_of(max_iter),
+            },
             start,
             continuation_steps,
             stability,

@@ -35,7 +35,7 @@ impl Lu {
         let scale = m.iter().fold(0.0f64, |s, x| s.max(x.abs()));
         let mut piv: Vec<usize> = (0..n).collect();
         let mut parity = 1.0;
-        let mut singular = !(scale > 0.0) || !scale.is_finite();
+        let mut singular = scale.is_nan() || scale <= 0.0 || !scale.is_finite();
         for k in 0..n {
             let mut p = k;
             let mut best = m[k * n + k].abs();
@@ -46,7 +46,7 @@ impl Lu {
                     p = r;
                 }
             }
-            if !(best > PIVOT_REL_TOL * scale) {
+            if best.is_nan() || best <= PIVOT_REL_TOL * scale {
                 singular = true;
                 continue;
             }
@@ -69,7 +69,13 @@ impl Lu {
                 }
             }
         }
-        Self { n, a: m, piv, parity, singular }
+        Self {
+            n,
+            a: m,
+            piv,
+            parity,
+            singular,
+        }
     }
 
     /// Whether a pivot was (numerically) zero.
@@ -94,6 +100,10 @@ impl Lu {
     }
 
     /// Solve `A x = b` in place (only meaningful when not singular).
+    #[allow(
+        clippy::needless_range_loop,
+        reason = "triangular solves read clearest with indices"
+    )]
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let n = self.n;
         let mut y: Vec<f64> = self.piv.iter().map(|&p| b[p]).collect();
@@ -152,7 +162,11 @@ pub fn cond2(a: &[f64], n: usize) -> f64 {
     let sv = m.singular_values();
     let smax = sv.iter().fold(0.0f64, |s, &x| s.max(x));
     let smin = sv.iter().fold(f64::INFINITY, |s, &x| s.min(x));
-    if smin > 0.0 && smax.is_finite() { (smax / smin).min(COND_CAP) } else { COND_CAP }
+    if smin > 0.0 && smax.is_finite() {
+        (smax / smin).min(COND_CAP)
+    } else {
+        COND_CAP
+    }
 }
 
 #[cfg(test)]

@@ -72,15 +72,18 @@ use self::compute::{FkOutput, ModesOutput, Output, WaveOutput, WorkspaceOutput};
 use self::presets::Preset;
 use self::sweep::NodeStatus;
 use self::wire::{
-    ActuatorRequest, AssemblyModeOut, AssemblyModesResponse, DiagnosticsOut, FkResponse, GridOut, MetricsOut, Mode,
-    NodesOut, PlatformOut, PresetName, PresetOut, RodOut, RodRequest, SeedOut, SolverState, StabilityOut, WaveOut,
-    WorkspaceResponse,
+    ActuatorRequest, AssemblyModeOut, AssemblyModesResponse, DiagnosticsOut, FkResponse, GridOut,
+    MetricsOut, Mode, NodesOut, PlatformOut, PresetName, PresetOut, RodOut, RodRequest, SeedOut,
+    SolverState, StabilityOut, WaveOut, WorkspaceResponse,
 };
 use crate::calc::CalcFailure;
 use crate::numerics::{Budget, SolverReport, StopReason};
 
 /// Validate, compute and build the wire response (called on the blocking pool).
-pub fn run(req: ContinuumWorkspaceRequest, budget: &Budget) -> Result<ContinuumWorkspaceResponse, CalcFailure> {
+pub fn run(
+    req: ContinuumWorkspaceRequest,
+    budget: &Budget,
+) -> Result<ContinuumWorkspaceResponse, CalcFailure> {
     let input = Input::try_from(&req)?;
     let budget = match input.time_limit {
         Some(t) => budget.capped(t),
@@ -93,7 +96,8 @@ pub fn run(req: ContinuumWorkspaceRequest, budget: &Budget) -> Result<ContinuumW
 /// The request's own time limit (`time_limit_ms`, capped at the service maximum).
 #[must_use]
 pub fn time_limit(req: &ContinuumWorkspaceRequest) -> Option<Duration> {
-    req.time_limit_ms.map(|ms| Duration::from_millis(ms.clamp(1, input::MAX_TIME_LIMIT_MS)))
+    req.time_limit_ms
+        .map(|ms| Duration::from_millis(ms.clamp(1, input::MAX_TIME_LIMIT_MS)))
 }
 
 fn wire_preset(p: Preset) -> PresetName {
@@ -117,7 +121,11 @@ fn preset_out(input: &Input) -> Option<PresetOut> {
         actuators: d
             .actuators
             .iter()
-            .map(|a| ActuatorRequest { origin_m: a.origin, direction: a.dir, stroke_m: a.stroke })
+            .map(|a| ActuatorRequest {
+                origin_m: a.origin,
+                direction: a.dir,
+                stroke_m: a.stroke,
+            })
             .collect(),
         rods: d
             .rods
@@ -138,7 +146,12 @@ fn preset_out(input: &Input) -> Option<PresetOut> {
 }
 
 fn report(stop: StopReason, iterations: u64, evaluations: u64, budget: &Budget) -> SolverReport {
-    SolverReport { stop_reason: stop, iterations, evaluations, elapsed_ms: budget.elapsed_ms() }
+    SolverReport {
+        stop_reason: stop,
+        iterations,
+        evaluations,
+        elapsed_ms: budget.elapsed_ms(),
+    }
 }
 
 fn u64_of(x: usize) -> u64 {
@@ -146,7 +159,10 @@ fn u64_of(x: usize) -> u64 {
 }
 
 fn platform(pos: [f64; 2], angle: f64) -> PlatformOut {
-    PlatformOut { position_m: pos, parasitic_angle_deg: wrap_deg(angle) }
+    PlatformOut {
+        position_m: pos,
+        parasitic_angle_deg: wrap_deg(angle),
+    }
 }
 
 /// Wrap an angle [rad] to (-180, 180] deg.
@@ -157,9 +173,13 @@ fn wrap_deg(t: f64) -> f64 {
 
 fn respond(input: &Input, out: Output, budget: &Budget) -> ContinuumWorkspaceResponse {
     match out {
-        Output::Fk(f) => ContinuumWorkspaceResponse::Fk(Box::new(fk_response(input, f, budget))),
-        Output::Workspace(w) => ContinuumWorkspaceResponse::Workspace(Box::new(workspace_response(input, w, budget))),
-        Output::Modes(m) => ContinuumWorkspaceResponse::AssemblyModes(Box::new(modes_response(input, m, budget))),
+        Output::Fk(f) => ContinuumWorkspaceResponse::Fk(Box::new(fk_response(input, *f, budget))),
+        Output::Workspace(w) => {
+            ContinuumWorkspaceResponse::Workspace(Box::new(workspace_response(input, *w, budget)))
+        }
+        Output::Modes(m) => {
+            ContinuumWorkspaceResponse::AssemblyModes(Box::new(modes_response(input, *m, budget)))
+        }
     }
 }
 
@@ -224,19 +244,45 @@ fn wave_out(input: &Input, w: &WaveOutput, return_nodes: bool) -> WaveOut {
             *failures.entry(st.code().to_string()).or_insert(0) += 1;
         }
     }
-    let full = input.sweep.as_ref().is_some_and(|s| s.settings.stability == sweep::StabilityCheck::Full);
+    let full = input
+        .sweep
+        .as_ref()
+        .is_some_and(|s| s.settings.stability == sweep::StabilityCheck::Full);
     let nodes = return_nodes.then(|| {
         let nd = &w.wave.nodes;
         NodesOut {
             status: status.iter().map(|s| s.code()).collect(),
-            px_m: nd.iter().map(|d| d.as_ref().map(|d| d.position[0])).collect(),
-            py_m: nd.iter().map(|d| d.as_ref().map(|d| d.position[1])).collect(),
-            parasitic_angle_deg: nd.iter().map(|d| d.as_ref().map(|d| d.angle.to_degrees())).collect(),
-            stability_margin: full.then(|| nd.iter().map(|d| d.as_ref().and_then(|d| d.margin)).collect()),
-            max_stress_pa: nd.iter().map(|d| d.as_ref().and_then(|d| d.max_stress)).collect(),
+            px_m: nd
+                .iter()
+                .map(|d| d.as_ref().map(|d| d.position[0]))
+                .collect(),
+            py_m: nd
+                .iter()
+                .map(|d| d.as_ref().map(|d| d.position[1]))
+                .collect(),
+            parasitic_angle_deg: nd
+                .iter()
+                .map(|d| d.as_ref().map(|d| d.angle.to_degrees()))
+                .collect(),
+            stability_margin: full.then(|| {
+                nd.iter()
+                    .map(|d| d.as_ref().and_then(|d| d.margin))
+                    .collect()
+            }),
+            max_stress_pa: nd
+                .iter()
+                .map(|d| d.as_ref().and_then(|d| d.max_stress))
+                .collect(),
             actuator_forces_n: nd
                 .iter()
-                .map(|d| d.as_ref().map(|d| [d.actuator_forces[0], d.actuator_forces.get(1).copied().unwrap_or(0.0)]))
+                .map(|d| {
+                    d.as_ref().map(|d| {
+                        [
+                            d.actuator_forces[0],
+                            d.actuator_forces.get(1).copied().unwrap_or(0.0),
+                        ]
+                    })
+                })
                 .collect(),
         }
     });
@@ -272,15 +318,29 @@ fn workspace_response(input: &Input, w: WorkspaceOutput, budget: &Budget) -> Wor
             let s = &sw.settings;
             (
                 GridOut {
-                    lambda1_m: (0..s.grid[0]).map(|i| sweep::lambda_at(s, i, 0)[0]).collect(),
-                    lambda2_m: (0..s.grid[1]).map(|j| sweep::lambda_at(s, 0, j)[1]).collect(),
+                    lambda1_m: (0..s.grid[0])
+                        .map(|i| sweep::lambda_at(s, i, 0)[0])
+                        .collect(),
+                    lambda2_m: (0..s.grid[1])
+                        .map(|j| sweep::lambda_at(s, 0, j)[1])
+                        .collect(),
                 },
                 sw.return_nodes,
             )
         }
-        None => (GridOut { lambda1_m: Vec::new(), lambda2_m: Vec::new() }, false),
+        None => (
+            GridOut {
+                lambda1_m: Vec::new(),
+                lambda2_m: Vec::new(),
+            },
+            false,
+        ),
     };
-    let mut waves: Vec<WaveOut> = w.waves.iter().map(|x| wave_out(input, x, return_nodes)).collect();
+    let mut waves: Vec<WaveOut> = w
+        .waves
+        .iter()
+        .map(|x| wave_out(input, x, return_nodes))
+        .collect();
     let first = if waves.is_empty() {
         WaveOut {
             seed: SeedOut {

@@ -147,7 +147,11 @@ pub fn norm_inf(x: &[f64]) -> f64 {
 #[must_use]
 pub fn norm2(x: &[f64]) -> f64 {
     let s: f64 = x.iter().map(|v| v * v).sum();
-    if s.is_finite() { s.sqrt() } else { f64::INFINITY }
+    if s.is_finite() {
+        s.sqrt()
+    } else {
+        f64::INFINITY
+    }
 }
 
 impl Model {
@@ -168,7 +172,15 @@ impl Model {
                 },
             })
             .collect();
-        Self { design, l_ref, ei_ref, f_ref: ei_ref / (l_ref * l_ref), base_steps, extensible, odes }
+        Self {
+            design,
+            l_ref,
+            ei_ref,
+            f_ref: ei_ref / (l_ref * l_ref),
+            base_steps,
+            extensible,
+            odes,
+        }
     }
 
     /// Number of rods `N`.
@@ -208,7 +220,10 @@ impl Model {
         let r = &self.design.rods[i];
         let a = &self.design.actuators[r.actuator];
         let l = lambda[r.actuator];
-        [l.mul_add(a.dir[0], a.origin[0]) + r.offset[0], l.mul_add(a.dir[1], a.origin[1]) + r.offset[1]]
+        [
+            l.mul_add(a.dir[0], a.origin[0]) + r.offset[0],
+            l.mul_add(a.dir[1], a.origin[1]) + r.offset[1],
+        ]
     }
 
     /// Rod unknowns `q_i` from the unknown vector.
@@ -233,7 +248,9 @@ impl Model {
     /// Step counts the rule of spec 4.1 asks for at `v`.
     #[must_use]
     pub fn steps_for(&self, v: &[f64]) -> Vec<usize> {
-        (0..self.n_rods()).map(|i| rod::steps_for(self.base_steps, &self.q(v, i))).collect()
+        (0..self.n_rods())
+            .map(|i| rod::steps_for(self.base_steps, &self.q(v, i)))
+            .collect()
     }
 
     /// Evaluate the residual (and the Jacobian if `want_jac`) at `v` with `steps[i]` RK4 steps.
@@ -245,7 +262,11 @@ impl Model {
         let pos = self.position(v);
         let th = self.angle(v);
         let mut g = vec![0.0; n];
-        let mut jac = if want_jac { vec![0.0; n * n] } else { Vec::new() };
+        let mut jac = if want_jac {
+            vec![0.0; n * n]
+        } else {
+            Vec::new()
+        };
         let mut tips = Vec::with_capacity(nr);
         let mut forces = Vec::with_capacity(nr);
         let mut ends = Vec::with_capacity(nr);
@@ -257,7 +278,10 @@ impl Model {
             let end = if want_jac {
                 rod::shoot(&self.odes[i], &q, steps[i])
             } else {
-                RodEnd { z: rod::shoot_plain(&self.odes[i], &q, steps[i]), s: [[0.0; 3]; 4] }
+                RodEnd {
+                    z: rod::shoot_plain(&self.odes[i], &q, steps[i]),
+                    s: [[0.0; 3]; 4],
+                }
             };
             let a = self.base_point(i, &p.lambda);
             let li = rodd.length;
@@ -305,7 +329,13 @@ impl Model {
             jac[(3 * nr + 2) * n + 3 * nr] = -p.force[1] / f_ref;
             jac[(3 * nr + 2) * n + 3 * nr + 1] = p.force[0] / f_ref;
         }
-        Eval { g, jac, tips, forces, ends }
+        Eval {
+            g,
+            jac,
+            tips,
+            forces,
+            ends,
+        }
     }
 
     /// `dg/dlambda` (row-major `n x n_act`) at a solution with rod forces `forces`.
@@ -328,7 +358,14 @@ impl Model {
 
     /// `dg/dt` along the straight path `lambda(t) = l0 + t dl`, `F(t) = F0 + t dF`, `M(t) = M0 + t dM`.
     #[must_use]
-    pub fn dg_dt(&self, v: &[f64], forces: &[[f64; 2]], dl: &[f64], df: [f64; 2], dm: f64) -> Vec<f64> {
+    pub fn dg_dt(
+        &self,
+        v: &[f64],
+        forces: &[[f64; 2]],
+        dl: &[f64],
+        df: [f64; 2],
+        dm: f64,
+    ) -> Vec<f64> {
         let nr = self.n_rods();
         let n = self.n_unknowns();
         let na = self.n_act();

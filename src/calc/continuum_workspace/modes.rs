@@ -105,8 +105,12 @@ fn table(model: &Model, i: usize, lambda: &[f64], n_grid: usize) -> Vec<GridPoin
 /// Procrustes fit of the platform to the tips: `(theta, p)` (spec 4.6).
 fn procrustes(attach: &[[f64; 2]], tips: &[[f64; 2]]) -> (f64, [f64; 2]) {
     let n = attach.len() as f64;
-    let rc = attach.iter().fold([0.0, 0.0], |a, r| [a[0] + r[0] / n, a[1] + r[1] / n]);
-    let bc = tips.iter().fold([0.0, 0.0], |a, b| [a[0] + b[0] / n, a[1] + b[1] / n]);
+    let rc = attach
+        .iter()
+        .fold([0.0, 0.0], |a, r| [a[0] + r[0] / n, a[1] + r[1] / n]);
+    let bc = tips
+        .iter()
+        .fold([0.0, 0.0], |a, b| [a[0] + b[0] / n, a[1] + b[1] / n]);
     let (mut sx, mut sd) = (0.0, 0.0);
     for (r, b) in attach.iter().zip(tips) {
         let rr = [r[0] - rc[0], r[1] - rc[1]];
@@ -144,7 +148,9 @@ pub fn search(
     counter: &mut Counter,
 ) -> ModeResult {
     let nr = model.n_rods();
-    let tables: Vec<Vec<GridPoint>> = (0..nr).map(|i| table(model, i, &params.lambda, settings.n_grid)).collect();
+    let tables: Vec<Vec<GridPoint>> = (0..nr)
+        .map(|i| table(model, i, &params.lambda, settings.n_grid))
+        .collect();
     let attach: Vec<[f64; 2]> = model.design.rods.iter().map(|r| r.attach).collect();
     let (l_ref, f_ref) = (model.l_ref, model.f_ref);
     let tol = settings.tol;
@@ -153,7 +159,10 @@ pub fn search(
     let last = nr - 1;
     let mut last_sorted: Vec<usize> = (0..tables[last].len()).collect();
     last_sorted.sort_by(|&a, &b| tables[last][a].force[0].total_cmp(&tables[last][b].force[0]));
-    let last_fx: Vec<f64> = last_sorted.iter().map(|&k| tables[last][k].force[0]).collect();
+    let last_fx: Vec<f64> = last_sorted
+        .iter()
+        .map(|&k| tables[last][k].force[0])
+        .collect();
     let mut best: BTreeMap<Vec<u32>, Candidate> = BTreeMap::new();
     let mut candidates = 0u64;
     let mut combos = 0u64;
@@ -174,12 +183,15 @@ pub fn search(
                 fsum[1] += tables[i][k].force[1];
             }
             let need = [params.force[0] - fsum[0], params.force[1] - fsum[1]];
-            let lo = last_fx.partition_point(|&x| x < need[0] - tol * f_ref);
-            let hi = last_fx.partition_point(|&x| x <= need[0] + tol * f_ref);
+            let lo = last_fx.partition_point(|&x| x < tol.mul_add(-f_ref, need[0]));
+            let hi = last_fx.partition_point(|&x| x <= tol.mul_add(f_ref, need[0]));
             combos += lens[last] as u64;
             for &kl in &last_sorted[lo..hi] {
                 let gl = &tables[last][kl];
-                let fres = [(gl.force[0] - need[0]) / f_ref, (gl.force[1] - need[1]) / f_ref];
+                let fres = [
+                    (gl.force[0] - need[0]) / f_ref,
+                    (gl.force[1] - need[1]) / f_ref,
+                ];
                 let f2 = fres[0].mul_add(fres[0], fres[1] * fres[1]);
                 if f2 >= tol * tol {
                     continue;
@@ -193,7 +205,10 @@ pub fn search(
                 let mut mom = -params.moment;
                 for i in 0..nr {
                     let rr = rot(theta, attach[i]);
-                    let e = [(tips[i][0] - pos[0] - rr[0]) / l_ref, (tips[i][1] - pos[1] - rr[1]) / l_ref];
+                    let e = [
+                        (tips[i][0] - pos[0] - rr[0]) / l_ref,
+                        (tips[i][1] - pos[1] - rr[1]) / l_ref,
+                    ];
                     r2 += e[0].mul_add(e[0], e[1] * e[1]);
                     let g = &tables[i][idx[i]];
                     mom += cross([tips[i][0] - pos[0], tips[i][1] - pos[1]], g.force);
@@ -214,7 +229,15 @@ pub fn search(
                 let res = r2.sqrt();
                 let better = best.get(&key).is_none_or(|c| res < c.residual);
                 if better {
-                    best.insert(key, Candidate { residual: res, points: idx.clone(), theta, position: pos });
+                    best.insert(
+                        key,
+                        Candidate {
+                            residual: res,
+                            points: idx.clone(),
+                            theta,
+                            position: pos,
+                        },
+                    );
                 }
             }
             // Odometer over rods 0..nr-1.
@@ -261,15 +284,28 @@ pub fn search(
                 let th = &mut sol.v[3 * nr + 2];
                 *th = fk::wrap_pi(*th);
                 let dup = solutions.iter().any(|s| {
-                    s.solution.v.iter().zip(&sol.v).enumerate().all(|(k, (a, b))| {
-                        let d = if k == 3 * nr + 2 { fk::wrap_pi(a - b) } else { a - b };
-                        d.abs() < DEDUP_TOL
-                    })
+                    s.solution
+                        .v
+                        .iter()
+                        .zip(&sol.v)
+                        .enumerate()
+                        .all(|(k, (a, b))| {
+                            let d = if k == 3 * nr + 2 {
+                                fk::wrap_pi(a - b)
+                            } else {
+                                a - b
+                            };
+                            d.abs() < DEDUP_TOL
+                        })
                 });
                 if !dup {
                     let margin = fk::margin_of(model, &sol, segments);
                     let stable = margin.is_some_and(|m| m > STABLE_MARGIN);
-                    solutions.push(ModeSolution { solution: sol, margin, stable });
+                    solutions.push(ModeSolution {
+                        solution: sol,
+                        margin,
+                        stable,
+                    });
                 }
             }
             Err(f) => {
@@ -285,5 +321,11 @@ pub fn search(
         let mb = b.margin.unwrap_or(f64::NEG_INFINITY);
         mb.total_cmp(&ma)
     });
-    ModeResult { solutions, candidates, refined, combinations: combos, stop }
+    ModeResult {
+        solutions,
+        candidates,
+        refined,
+        combinations: combos,
+        stop,
+    }
 }

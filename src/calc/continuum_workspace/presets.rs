@@ -116,12 +116,23 @@ impl Preset {
                     Self::KeopsD2 => Some([-0.25, 0.25 - h]),
                     _ => None,
                 };
-                (vec![rod(0, -h, c1, 0.004, a1), rod(0, h, c1, 0.004, a2), rod(1, 0.0, c2, d3, a3)], home)
+                (
+                    vec![
+                        rod(0, -h, c1, 0.004, a1),
+                        rod(0, h, c1, 0.004, a2),
+                        rod(1, 0.0, c2, d3, a3),
+                    ],
+                    home,
+                )
             }
         };
         // Designs 3 and 4 have no home: centre their strokes on design 1's home.
         let centre = home.unwrap_or([-0.25, 0.25 + h]);
-        let guide = |c: f64| Actuator { origin: [0.0, 0.0], dir: [1.0, 0.0], stroke: [c - HALF_STROKE, c + HALF_STROKE] };
+        let guide = |c: f64| Actuator {
+            origin: [0.0, 0.0],
+            dir: [1.0, 0.0],
+            stroke: [c - HALF_STROKE, c + HALF_STROKE],
+        };
         Design {
             actuators: vec![guide(centre[0]), guide(centre[1])],
             rods,

@@ -165,8 +165,11 @@ pub fn margin(rods: &[RodDisc], tips: Tips<'_>, l_ref: f64, ei_ref: f64) -> Opti
 fn householder_pivoted(cols: &mut [Vec<f64>], nv: usize) -> Vec<(Vec<f64>, f64)> {
     let nc = cols.len();
     let mut out = Vec::with_capacity(nc);
-    let norm0 = cols.iter().map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt()).fold(0.0f64, f64::max);
-    if !(norm0 > 0.0) {
+    let norm0 = cols
+        .iter()
+        .map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .fold(0.0f64, f64::max);
+    if norm0.is_nan() || norm0 <= 0.0 {
         return out;
     }
     for k in 0..nc.min(nv) {
@@ -180,7 +183,7 @@ fn householder_pivoted(cols: &mut [Vec<f64>], nv: usize) -> Vec<(Vec<f64>, f64)>
                 best = j;
             }
         }
-        if !(best_norm > RANK_REL_TOL * norm0) {
+        if best_norm.is_nan() || best_norm <= RANK_REL_TOL * norm0 {
             break;
         }
         cols.swap(k, best);
@@ -190,7 +193,7 @@ fn householder_pivoted(cols: &mut [Vec<f64>], nv: usize) -> Vec<(Vec<f64>, f64)>
         v[k..].copy_from_slice(&x[k..]);
         v[k] -= alpha;
         let vv: f64 = v.iter().map(|a| a * a).sum();
-        if !(vv > 0.0) {
+        if vv.is_nan() || vv <= 0.0 {
             break;
         }
         let beta = 2.0 / vv;
@@ -248,7 +251,13 @@ fn reflect_both(a: &mut DMatrix<f64>, v: &[f64], beta: f64) {
 /// (20.19 pinned, pi^2/4 free).
 #[must_use]
 pub fn straight_rod_margin(p_nd: f64, m: usize, pinned: bool) -> Option<f64> {
-    let rod = RodDisc { ei: 1.0, length: 1.0, clamp: 0.0, angles: vec![0.0; m.max(1)], force: [-p_nd, 0.0] };
+    let rod = RodDisc {
+        ei: 1.0,
+        length: 1.0,
+        clamp: 0.0,
+        angles: vec![0.0; m.max(1)],
+        force: [-p_nd, 0.0],
+    };
     let tips = if pinned { Tips::Pinned } else { Tips::Free };
     margin(std::slice::from_ref(&rod), tips, 1.0, 1.0)
 }

@@ -13,6 +13,10 @@
 //! source first, the next only if the previous failed). The accepted set, statuses and solutions
 //! are therefore identical to the sequential FIFO algorithm for any number of threads.
 
+// Interpolation and predictor formulas in plain form; without a target FMA unit `mul_add` is a
+// libm call per term.
+#![allow(clippy::suboptimal_flops)]
+
 use std::collections::BTreeMap;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -60,6 +64,11 @@ pub struct SweepSettings {
     pub max_substeps: usize,
     /// Attempts per node.
     pub max_tries: usize,
+    /// Newton iterations per sub-step solve (capped by `solver.max_iter`): from the tangent
+    /// predictor a sub-step converges in 2-7 iterations; a solve still wandering after this many is
+    /// abandoned in favour of smaller sub-steps (on the design-1 reference sweep 20 accepts exactly
+    /// the nodes an uncapped Newton accepts at a third of the cost).
+    pub substep_max_iter: usize,
     /// Largest platform rotation within one sub-step [rad].
     pub angle_jump: f64,
     /// Largest platform displacement within one sub-step, as a multiple of the input change.
@@ -162,7 +171,11 @@ pub struct WaveResult {
 #[must_use]
 pub fn lambda_at(s: &SweepSettings, i: usize, j: usize) -> [f64; 2] {
     let f = |k: usize, n: usize, r: [f64; 2]| {
-        if n <= 1 { r[0] } else { r[0] + (r[1] - r[0]) * k as f64 / (n - 1) as f64 }
+        if n <= 1 {
+            r[0]
+        } else {
+            r[0] + (r[1] - r[0]) * k as f64 / (n - 1) as f64
+        }
     };
     [f(i, s.grid[0], s.ranges[0]), f(j, s.grid[1], s.ranges[1])]
 }
@@ -197,10 +210,10 @@ pub fn input_limits(model: &Model, s: &SweepSettings, lambda: &[f64; 2]) -> Opti
             return Some(NodeStatus::LimitStroke);
         }
     }
-    if let Some(g) = s.limits.min_gap {
-        if actuator_gap(model, lambda) < g {
-            return Some(NodeStatus::LimitActuatorGap);
-        }
+    if let Some(g) = s.limits.min_gap
+        && actuator_gap(model, lambda) < g
+    {
+        return Some(NodeStatus::LimitActuatorGap);
     }
     None
 }
@@ -223,9 +236,14 @@ fn tangent(model: &Model, sol: &Solution) -> Vec<f64> {
 
 /// Whether two polylines properly cross.
 fn polylines_cross(a: &[[f64; 2]], b: &[[f64; 2]]) -> bool {
-    let orient = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+    let orient = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+    };
     for sa in a.windows(2) {
-        let (amin, amax) = ([sa[0][0].min(sa[1][0]), sa[0][1].min(sa[1][1])], [sa[0][0].max(sa[1][0]), sa[0][1].max(sa[1][1])]);
+        let (amin, amax) = (
+            [sa[0][0].min(sa[1][0]), sa[0][1].min(sa[1][1])],
+            [sa[0][0].max(sa[1][0]), sa[0][1].max(sa[1][1])],
+        );
         for sb in b.windows(2) {
             if sb[0][0].max(sb[1][0]) < amin[0]
                 || sb[0][0].min(sb[1][0]) > amax[0]
@@ -257,11 +275,13 @@ pub fn accept(
 ) -> Result<NodeData, NodeStatus> {
     let n = model.n_unknowns();
     let cond = linalg::cond2(&sol.eval.jac, n);
-    if !(cond <= s.cond_max) {
+    if cond.is_nan() || cond > s.cond_max {
         return Err(NodeStatus::Singular);
     }
     let det_sign = sol.lu.det_sign();
-    if s.stability == StabilityCheck::DetSign && (det_sign == 0 || parent_det.is_some_and(|p| p != det_sign)) {
+    if s.stability == StabilityCheck::DetSign
+        && (det_sign == 0 || parent_det.is_some_and(|p| p != det_sign))
+    {
         return Err(NodeStatus::Singular);
     }
     let margin = if s.stability == StabilityCheck::Full {
@@ -274,11 +294,14 @@ pub fn accept(
         None
     };
     let d = fk::describe(model, sol, 0, None);
-    let max_stress = d.stresses.iter().try_fold(0.0f64, |m, s| s.map(|s| m.max(s)));
-    if let (Some(lim), Some(st)) = (s.limits.sigma_allow, max_stress) {
-        if st > lim {
-            return Err(NodeStatus::LimitStress);
-        }
+    let max_stress = d
+        .stresses
+        .iter()
+        .try_fold(0.0f64, |m, s| s.map(|s| m.max(s)));
+    if let (Some(lim), Some(st)) = (s.limits.sigma_allow, max_stress)
+        && st > lim
+    {
+        return Err(NodeStatus::LimitStress);
     }
     if s.limits.rod_crossing {
         let lines: Vec<Vec<[f64; 2]>> = (0..model.n_rods())
@@ -286,7 +309,10 @@ pub fn accept(
                 let tr = model.trace(&sol.v, i, sol.steps[i]);
                 let a = model.base_point(i, lambda);
                 let l = model.design.rods[i].length;
-                tr.nodes.iter().map(|z| [l.mul_add(z[0], a[0]), l.mul_add(z[1], a[1])]).collect()
+                tr.nodes
+                    .iter()
+                    .map(|z| [l.mul_add(z[0], a[0]), l.mul_add(z[1], a[1])])
+                    .collect()
             })
             .collect();
         for i in 0..lines.len() {
@@ -317,6 +343,10 @@ enum Attempt {
 }
 
 /// March from an accepted node to the inputs `to` (spec 4.7 step control) and test the result.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "one call site; the arguments are the attempt's context"
+)]
 fn attempt(
     model: &Model,
     base: &Params,
@@ -348,16 +378,33 @@ fn attempt(
         let mut failed = false;
         for k in 1..=nsub {
             let f = k as f64 / nsub as f64;
-            let lam = [from[0] + (to[0] - from[0]) * f, from[1] + (to[1] - from[1]) * f];
+            let lam = [
+                from[0] + (to[0] - from[0]) * f,
+                from[1] + (to[1] - from[1]) * f,
+            ];
             let dl = [lam[0] - lam_prev[0], lam[1] - lam_prev[1]];
             let guess: Vec<f64> = if s.predictor {
-                (0..n).map(|r| v[r] + tan[r * na] * dl[0] + tan[r * na + 1] * dl[1]).collect()
+                (0..n)
+                    .map(|r| v[r] + tan[r * na] * dl[0] + tan[r * na + 1] * dl[1])
+                    .collect()
             } else {
                 v.clone()
             };
-            let guess = if guess.iter().all(|x| x.is_finite()) { guess } else { v.clone() };
-            let params = Params { lambda: lam.to_vec(), force: base.force, moment: base.moment };
-            match newton::solve(model, &params, &guess, opts, budget, counter) {
+            let guess = if guess.iter().all(|x| x.is_finite()) {
+                guess
+            } else {
+                v.clone()
+            };
+            let params = Params {
+                lambda: lam.to_vec(),
+                force: base.force,
+                moment: base.moment,
+            };
+            let capped = NewtonOptions {
+                tol: opts.tol,
+                max_iter: opts.max_iter.min(s.substep_max_iter),
+            };
+            match newton::solve(model, &params, &guess, capped, budget, counter) {
                 Ok(sol) => {
                     let pos = model.position(&sol.v);
                     let th = model.angle(&sol.v);
@@ -387,10 +434,8 @@ fn attempt(
                 }
             }
         }
-        if !failed {
-            if let Some(sol) = ok {
-                return Attempt::Done(accept(model, s, &to, &sol, Some(src.det_sign)));
-            }
+        if !failed && let Some(sol) = ok {
+            return Attempt::Done(accept(model, s, &to, &sol, Some(src.det_sign)));
         }
         if nsub * 2 > s.max_substeps.max(1) {
             return Attempt::Done(Err(last_fail));
@@ -406,10 +451,11 @@ fn neighbours(s: &SweepSettings, i: usize, j: usize) -> Vec<(usize, usize)> {
     let mut out = Vec::with_capacity(8);
     let mut push = |di: isize, dj: isize| {
         let (a, b) = (i.checked_add_signed(di), j.checked_add_signed(dj));
-        if let (Some(a), Some(b)) = (a, b) {
-            if a < n1 && b < n2 {
-                out.push((a, b));
-            }
+        if let (Some(a), Some(b)) = (a, b)
+            && a < n1
+            && b < n2
+        {
+            out.push((a, b));
         }
     };
     push(-1, 0);
@@ -444,12 +490,16 @@ fn run_jobs<T: Sync, R: Send>(jobs: &[T], threads: usize, f: impl Fn(&T) -> R + 
                     local.push((k, f(&jobs[k])));
                 }
                 // A poisoned lock only means another worker panicked; keep its partial results.
-                let mut guard = results.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                let mut guard = results
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
                 guard.extend(local);
             });
         }
     });
-    let mut all = results.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut all = results
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     all.sort_by_key(|(k, _)| *k);
     all.into_iter().map(|(_, r)| r).collect()
 }
@@ -508,7 +558,10 @@ pub fn wave(
                 let c = cursor.get(&t).copied().unwrap_or(0);
                 let list = &sources[&t];
                 if status[t] != NodeStatus::Ok && tries[t] < s.max_tries && c < list.len() {
-                    jobs.push(Job { target: t, source: list[c].2 });
+                    jobs.push(Job {
+                        target: t,
+                        source: list[c].2,
+                    });
                     keys.push((list[c].0, list[c].1));
                 }
             }
@@ -555,5 +608,11 @@ pub fn wave(
         accepted.sort_unstable();
         frontier = accepted.into_iter().map(|(_, _, t)| t).collect();
     }
-    WaveResult { status, nodes, stop, attempts, evaluations }
+    WaveResult {
+        status,
+        nodes,
+        stop,
+        attempts,
+        evaluations,
+    }
 }

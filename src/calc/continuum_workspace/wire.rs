@@ -374,6 +374,12 @@ pub struct WorkspaceRequest {
     #[serde(default)]
     #[schema(minimum = 1, maximum = 8, example = 4)]
     pub max_tries: Option<u32>,
+    /// Newton iterations per sub-step solve, capped by `solver.max_iter` (default 20; extension:
+    /// a sub-step started from the tangent predictor converges in 2-7 iterations, a solve still
+    /// wandering after 20 is abandoned for smaller sub-steps).
+    #[serde(default)]
+    #[schema(minimum = 5, maximum = 200, example = 20)]
+    pub substep_max_iter: Option<u32>,
     /// Jump limits per sub-step.
     #[serde(default)]
     pub jump_limits: Option<JumpLimits>,
