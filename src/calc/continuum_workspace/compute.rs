@@ -181,7 +181,9 @@ fn stop_of(f: &Failed) -> StopReason {
     match f.reason {
         NewtonFailure::Budget(s) => s,
         NewtonFailure::MaxIterations => StopReason::MaxIterations,
-        NewtonFailure::LineSearch | NewtonFailure::NonFinite => StopReason::Stall,
+        NewtonFailure::LineSearch | NewtonFailure::NonFinite | NewtonFailure::Stall => {
+            StopReason::Stall
+        }
     }
 }
 

@@ -764,10 +764,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                 force,
                 moment,
             },
-            newton: NewtonOptions {
-                tol,
-                max_iter: usize_of(max_iter),
-            },
+            newton: NewtonOptions::new(tol, usize_of(max_iter)),
             start,
             continuation_steps,
             stability,

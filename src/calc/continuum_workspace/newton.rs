@@ -17,6 +17,20 @@ pub struct NewtonOptions {
     pub tol: f64,
     /// Newton iterations per solve.
     pub max_iter: usize,
+    /// Give up when the residual 2-norm has not halved over this many iterations (None: never).
+    pub stall_window: Option<usize>,
+}
+
+impl NewtonOptions {
+    /// Settings without the stall exit.
+    #[must_use]
+    pub fn new(tol: f64, max_iter: usize) -> Self {
+        Self {
+            tol,
+            max_iter,
+            stall_window: None,
+        }
+    }
 }
 
 /// Why a Newton solve failed.
@@ -26,6 +40,8 @@ pub enum NewtonFailure {
     MaxIterations,
     /// No step length down to 1e-4 decreased the residual.
     LineSearch,
+    /// The residual did not halve over `stall_window` iterations.
+    Stall,
     /// The starting point already gives a non-finite residual.
     NonFinite,
     /// The request's time or evaluation budget ran out.
@@ -83,6 +99,7 @@ pub fn solve(
     let mut eval = model.evaluate(&v, p, &steps, true);
     counter.evaluations += 1;
     let mut iterations = 0usize;
+    let mut history: Vec<f64> = Vec::with_capacity(opts.max_iter + 1);
     if !eval.norm2().is_finite() {
         return Err(Failed {
             reason: NewtonFailure::NonFinite,
@@ -129,9 +146,21 @@ pub fn solve(
                 iterations,
             });
         }
+        let g0 = eval.norm2();
+        history.push(g0);
+        if let Some(w) = opts.stall_window
+            && history.len() > w
+            && g0 > 0.5 * history[history.len() - 1 - w]
+        {
+            return Err(Failed {
+                reason: NewtonFailure::Stall,
+                v,
+                residual_inf: res,
+                iterations,
+            });
+        }
         let rhs: Vec<f64> = eval.g.iter().map(|x| -x).collect();
         let (dv, _) = linalg::solve(&eval.jac, n, &rhs);
-        let g0 = eval.norm2();
         let mut t = 1.0;
         let mut accepted = None;
         while t >= MIN_STEP {
