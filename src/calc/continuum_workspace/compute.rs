@@ -271,6 +271,7 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                             v: model.home_state([0.0, 0.0]),
                             residual_inf: f64::INFINITY,
                             iterations: 0,
+                            progress: 0.0,
                         })
                     }
                 }
@@ -279,6 +280,15 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
     };
     match result {
         Err(f) => {
+            if input.start == Start::Home
+                && f.progress > 0.0
+                && !matches!(f.reason, NewtonFailure::Budget(_))
+            {
+                warnings.push(format!(
+                    "continuation_stalled: the path from home was followed for {:.1} % of the way; beyond lies a fold (snap-through), taut rods or no equilibrium on this branch",
+                    100.0 * f.progress
+                ));
+            }
             for i in fk::taut_rods(model, target, &f.v) {
                 warnings.push(format!(
                     "taut_rod {i}: chord/L > {} in the last iterate",

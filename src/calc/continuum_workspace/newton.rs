@@ -74,6 +74,8 @@ pub struct Failed {
     pub residual_inf: f64,
     /// Iterations taken.
     pub iterations: usize,
+    /// Fraction of a continuation path completed before the failure (0 outside continuation).
+    pub progress: f64,
 }
 
 /// Counts rod-system evaluations (one residual, with or without Jacobian).
@@ -106,6 +108,7 @@ pub fn solve(
             v,
             residual_inf: f64::INFINITY,
             iterations,
+            progress: 0.0,
         });
     }
     loop {
@@ -136,6 +139,7 @@ pub fn solve(
                 v,
                 residual_inf: res,
                 iterations,
+                progress: 0.0,
             });
         }
         if let Some(stop) = budget.check(counter.evaluations) {
@@ -144,6 +148,7 @@ pub fn solve(
                 v,
                 residual_inf: res,
                 iterations,
+                progress: 0.0,
             });
         }
         let g0 = eval.norm2();
@@ -157,6 +162,7 @@ pub fn solve(
                 v,
                 residual_inf: res,
                 iterations,
+                progress: 0.0,
             });
         }
         let rhs: Vec<f64> = eval.g.iter().map(|x| -x).collect();
@@ -196,6 +202,7 @@ pub fn solve(
                     v,
                     residual_inf: res,
                     iterations,
+                    progress: 0.0,
                 });
             }
         }
@@ -229,7 +236,11 @@ pub struct ContinuationResult {
 
 /// Continuation parameter distance to 1 treated as arrival (round-off of k additions of 1/k).
 const T_SNAP: f64 = 1e-12;
-/// Maximum number of consecutive step halvings (spec 4.3 / 4.7 step control).
+/// Stall window of the predicted continuation steps (see [`NewtonOptions::stall_window`]); the same
+/// value as the sweep sub-steps, which it matches in role.
+pub const CONTINUATION_STALL_WINDOW: usize = 10;
+/// Maximum number of step halvings below the nominal step (spec 4.3 / 4.7 step control): the
+/// continuation fails when a step of nominal / 2^8 does not converge.
 const MAX_HALVINGS: u32 = 8;
 
 #[allow(
@@ -271,6 +282,11 @@ pub fn continuation(
         moment: t.mul_add(dm, from.moment),
     };
     let nominal = 1.0 / k.max(1) as f64;
+    // Predicted steps either converge fast or are halved: give up on creeping solves early.
+    let step_opts = NewtonOptions {
+        stall_window: opts.stall_window.or(Some(CONTINUATION_STALL_WINDOW)),
+        ..opts
+    };
     let mut t = 0.0;
     let mut sol = start;
     let mut accepted = 0usize;
@@ -298,21 +314,23 @@ pub fn continuation(
         } else {
             sol.v.clone()
         };
-        match solve(model, &at(t_new), &guess, opts, budget, counter) {
+        match solve(model, &at(t_new), &guess, step_opts, budget, counter) {
             Ok(s) => {
                 iters += s.iterations;
                 sol = s;
                 t = t_new;
                 accepted += 1;
-                halvings = 0;
-                h = nominal;
+                // Grow back one level per success (resetting to the nominal step at once made
+                // the approach to a fold re-fail every halving level after each success).
+                halvings = halvings.saturating_sub(1);
+                h = nominal / f64::from(1u32 << halvings);
             }
             Err(f) => {
                 if matches!(f.reason, NewtonFailure::Budget(_)) || halvings >= MAX_HALVINGS {
-                    return Err(f);
+                    return Err(Failed { progress: t, ..f });
                 }
                 halvings += 1;
-                h = h_try * 0.5;
+                h = nominal / f64::from(1u32 << halvings);
             }
         }
     }
