@@ -2,6 +2,7 @@
 //! each module exposes `compute(input, budget) -> Result<Output, Error>` and its wire types.
 
 pub mod cam_law;
+pub mod cognates;
 pub mod continuum_workspace;
 pub mod problem;
 

@@ -1,0 +1,402 @@
+//! Validation of an [`EvaluateRequest`] into an [`EvaluateInput`] (spec §2, §8b), collecting every
+//! offending field with its JSON pointer.
+
+use super::catalogue::NamedLaw;
+use super::law::{
+    BoundaryConditions, LawError, MAX_MAGNITUDE, MIN_RELATIVE_INTERVAL, Quantity,
+    normalize_coefficients,
+};
+use super::wire::{AbscissaIn, EvaluateRequest, MAX_POINTS, Units, Warning};
+use crate::calc::{CalcFailure, Validator};
+
+/// Coefficients must sum to 1 within this unless `normalize` is set (spec §2).
+pub const SUM_TOL: f64 = 1e-3;
+
+/// Sums closer to 1 than this are round-off of printed decimals: renormalized without a warning.
+pub const SUM_SILENT_TOL: f64 = 1e-12;
+
+/// Abscissae up to this fraction of Δt outside `[t_a, t_b]` are clamped, farther ones rejected
+/// (spec §2).
+pub const ABSCISSA_TOL: f64 = 1e-9;
+
+/// Longest accepted unit label.
+pub const MAX_UNIT_LABEL: usize = 32;
+
+/// Which law to evaluate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LawChoice {
+    /// The general 7-segment law with these (validated, not yet normalized) coefficients;
+    /// `named` is set when they come from a named law of the class.
+    SevenSegment {
+        /// Coefficients as given (non-negative, both pulses non-empty).
+        coefficients: [f64; 7],
+        /// The named law they stand for, if any.
+        named: Option<NamedLaw>,
+    },
+    /// A named law outside the 7-segment class (closed form, zero end rates).
+    ClosedForm(NamedLaw),
+}
+
+/// A validated evaluate request.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EvaluateInput {
+    /// The law.
+    pub law: LawChoice,
+    /// Boundary conditions, defaults applied.
+    pub bc: BoundaryConditions,
+    /// Abscissae exactly as given (grid materialized); `None` without an `abscissa`.
+    pub xs: Option<Vec<f64>>,
+    /// Requested quantities, deduplicated, in the order s, v, a, j.
+    pub quantities: Vec<Quantity>,
+    /// Warnings raised during validation (`coefficients_renormalized`).
+    pub warnings: Vec<Warning>,
+    /// Unit labels to echo.
+    pub units: Option<Units>,
+}
+
+enum Abscissa {
+    Values(Vec<f64>),
+    Grid { start: f64, end: f64, count: usize },
+}
+
+impl Abscissa {
+    fn first_last(&self) -> Option<(f64, f64)> {
+        match self {
+            Self::Values(v) => Some((*v.first()?, *v.last()?)),
+            Self::Grid { start, end, .. } => Some((*start, *end)),
+        }
+    }
+
+    fn materialize(self) -> Vec<f64> {
+        match self {
+            Self::Values(v) => v,
+            Self::Grid { start, end, count } => {
+                let last = count - 1;
+                // count ≤ 200 000, so the usize → f64 conversions are exact.
+                #[allow(clippy::cast_precision_loss)]
+                let step = (end - start) / last as f64;
+                #[allow(clippy::cast_precision_loss)]
+                let mut xs: Vec<f64> = (0..count).map(|k| start + step * k as f64).collect();
+                xs[last] = end;
+                xs
+            }
+        }
+    }
+}
+
+fn check_abscissa(v: &mut Validator, a: Option<AbscissaIn>) -> Option<Abscissa> {
+    let a = a?;
+    match (a.values, a.grid) {
+        (Some(_), Some(_)) => {
+            v.push(
+                "/abscissa",
+                "give exactly one of `values` or `grid`, got both",
+            );
+            None
+        }
+        (None, None) => {
+            v.push(
+                "/abscissa",
+                "give exactly one of `values` or `grid`, got neither",
+            );
+            None
+        }
+        (Some(values), None) => {
+            let n = values.len();
+            if !(1..=MAX_POINTS).contains(&n) {
+                v.push(
+                    "/abscissa/values",
+                    format!("must hold 1..={MAX_POINTS} values, got {n}"),
+                );
+                return None;
+            }
+            if !v.all_finite("/abscissa/values", &values) {
+                return None;
+            }
+            if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
+                v.push(
+                    format!("/abscissa/values/{}", i + 1),
+                    format!(
+                        "abscissae must be strictly increasing, got {} after {} at index {i}",
+                        values[i + 1],
+                        values[i]
+                    ),
+                );
+                return None;
+            }
+            Some(Abscissa::Values(values))
+        }
+        (None, Some(g)) => {
+            let ok_start = v.finite("/abscissa/grid/start", g.start);
+            let ok_end = v.finite("/abscissa/grid/end", g.end);
+            let count = usize::try_from(g.count)
+                .ok()
+                .filter(|c| (2..=MAX_POINTS).contains(c));
+            if count.is_none() {
+                v.push(
+                    "/abscissa/grid/count",
+                    format!("must be in [2, {MAX_POINTS}], got {}", g.count),
+                );
+            }
+            if ok_start && ok_end && g.end <= g.start {
+                v.push(
+                    "/abscissa/grid/end",
+                    format!("must be > start = {}, got {}", g.start, g.end),
+                );
+                return None;
+            }
+            let count = count?;
+            (ok_start && ok_end).then_some(Abscissa::Grid {
+                start: g.start,
+                end: g.end,
+                count,
+            })
+        }
+    }
+}
+
+/// Validate the coefficients; returns them (as given) and whether a renormalization warning is due.
+fn check_coefficients(v: &mut Validator, c: &[f64], normalize: bool) -> Option<([f64; 7], bool)> {
+    let Ok(arr) = <[f64; 7]>::try_from(c) else {
+        v.push(
+            "/coefficients",
+            format!("must hold exactly 7 numbers c0..c6, got {}", c.len()),
+        );
+        return None;
+    };
+    let mut ok = true;
+    for (i, &x) in arr.iter().enumerate() {
+        let p = format!("/coefficients/{i}");
+        if !v.finite(&p, x) {
+            ok = false;
+        } else if x < 0.0 {
+            v.push(p, format!("coefficient c{i} must be >= 0, got {x}"));
+            ok = false;
+        }
+    }
+    if !ok {
+        return None;
+    }
+    let sum: f64 = arr.iter().sum();
+    if !normalize && (sum - 1.0).abs() > SUM_TOL {
+        v.push(
+            "/coefficients",
+            format!("coefficients must sum to 1 within {SUM_TOL} (or set normalize: true), got sum {sum}"),
+        );
+        return None;
+    }
+    match normalize_coefficients(&arr) {
+        Ok(_) => Some((arr, (sum - 1.0).abs() > SUM_SILENT_TOL)),
+        Err(LawError::EmptyFirstPulse { area }) => {
+            v.push(
+                "/coefficients",
+                format!("the first acceleration pulse (c0, c1, c2) is empty: normalized area {area:e} < 1e-9"),
+            );
+            None
+        }
+        Err(LawError::EmptySecondPulse { area }) => {
+            v.push(
+                "/coefficients",
+                format!("the second acceleration pulse (c4, c5, c6) is empty: normalized area {area:e} < 1e-9"),
+            );
+            None
+        }
+        Err(e) => {
+            v.push("/coefficients", e.to_string());
+            None
+        }
+    }
+}
+
+impl TryFrom<EvaluateRequest> for EvaluateInput {
+    type Error = CalcFailure;
+
+    fn try_from(req: EvaluateRequest) -> Result<Self, CalcFailure> {
+        let mut v = Validator::new();
+        let mut warnings = Vec::new();
+
+        let law = match (&req.coefficients, req.law) {
+            (Some(_), Some(_)) => {
+                v.push(
+                    "/law",
+                    "give exactly one of `coefficients` or `law`, got both",
+                );
+                None
+            }
+            (None, None) => {
+                v.push(
+                    "/coefficients",
+                    "give exactly one of `coefficients` or `law`, got neither",
+                );
+                None
+            }
+            (Some(c), None) => {
+                check_coefficients(&mut v, c, req.normalize).map(|(coefficients, warn)| {
+                    if warn {
+                        warnings.push(Warning::CoefficientsRenormalized);
+                    }
+                    LawChoice::SevenSegment {
+                        coefficients,
+                        named: None,
+                    }
+                })
+            }
+            (None, Some(named)) => Some(match named.seven_segment_coefficients() {
+                Some(coefficients) => LawChoice::SevenSegment {
+                    coefficients,
+                    named: Some(named),
+                },
+                None => LawChoice::ClosedForm(named),
+            }),
+        };
+
+        let abscissa = check_abscissa(&mut v, req.abscissa);
+        let ends = abscissa.as_ref().and_then(Abscissa::first_last);
+
+        let c = req.constraints;
+        let bc = BoundaryConditions {
+            t_a: c.t_a.or(ends.map(|e| e.0)).unwrap_or(0.0),
+            t_b: c.t_b.or(ends.map(|e| e.1)).unwrap_or(1.0),
+            s_a: c.s_a.unwrap_or(0.0),
+            s_b: c.s_b.unwrap_or(1.0),
+            v_a: c.v_a.unwrap_or(0.0),
+            v_b: c.v_b.unwrap_or(0.0),
+            a_a: c.a_a.unwrap_or(0.0),
+            a_b: c.a_b.unwrap_or(0.0),
+        };
+        let mut bc_ok = true;
+        for (name, value) in bc.named_values() {
+            let p = format!("/constraints/{name}");
+            if !v.finite(&p, value) {
+                bc_ok = false;
+            } else if value.abs() > MAX_MAGNITUDE {
+                v.push(
+                    p,
+                    format!("|{name}| must be <= {MAX_MAGNITUDE:e}, got {value}"),
+                );
+                bc_ok = false;
+            }
+        }
+        if bc_ok {
+            let defaulted = |given: Option<f64>, what: &str| {
+                if given.is_some() {
+                    String::new()
+                } else {
+                    format!(" (defaulted to the {what})")
+                }
+            };
+            if bc.t_b <= bc.t_a {
+                v.push(
+                    "/constraints/t_b",
+                    format!(
+                        "t_b must be > t_a = {}{}, got {}{}",
+                        bc.t_a,
+                        defaulted(c.t_a, "first abscissa"),
+                        bc.t_b,
+                        defaulted(c.t_b, "last abscissa")
+                    ),
+                );
+                bc_ok = false;
+            } else if bc.t_b - bc.t_a <= MIN_RELATIVE_INTERVAL * bc.t_a.abs().max(bc.t_b.abs()) {
+                v.push(
+                    "/constraints/t_b",
+                    format!(
+                        "t_b - t_a = {:e} is too short to resolve knots at this offset (must exceed {MIN_RELATIVE_INTERVAL:e}·max(|t_a|, |t_b|))",
+                        bc.t_b - bc.t_a
+                    ),
+                );
+                bc_ok = false;
+            }
+        }
+
+        if let Some(LawChoice::ClosedForm(named)) = law {
+            for (name, value) in [
+                ("v_a", bc.v_a),
+                ("v_b", bc.v_b),
+                ("a_a", bc.a_a),
+                ("a_b", bc.a_b),
+            ] {
+                v.ensure(value == 0.0 || !value.is_finite(), format!("/constraints/{name}"), || {
+                    format!(
+                        "must be 0 for the named law `{}`, which is outside the 7-segment class (only zero end rates), got {value}",
+                        named.wire_name()
+                    )
+                });
+            }
+        }
+
+        if let (true, Some(a)) = (bc_ok, &abscissa) {
+            let tol = ABSCISSA_TOL * (bc.t_b - bc.t_a);
+            let (lo, hi) = (bc.t_a - tol, bc.t_b + tol);
+            let range = || format!("[t_a, t_b] = [{}, {}] (tolerance {tol:e})", bc.t_a, bc.t_b);
+            match a {
+                Abscissa::Values(xs) => {
+                    let mut bad = xs
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, x)| !(lo..=hi).contains(*x));
+                    if let Some((i, x)) = bad.next() {
+                        let more = bad.count();
+                        let tail = if more > 0 {
+                            format!(" ({more} more outside)")
+                        } else {
+                            String::new()
+                        };
+                        v.push(
+                            format!("/abscissa/values/{i}"),
+                            format!("abscissa {x} lies outside {}{tail}", range()),
+                        );
+                    }
+                }
+                Abscissa::Grid { start, end, .. } => {
+                    v.ensure(*start >= lo, "/abscissa/grid/start", || {
+                        format!("grid start {start} lies outside {}", range())
+                    });
+                    v.ensure(*end <= hi, "/abscissa/grid/end", || {
+                        format!("grid end {end} lies outside {}", range())
+                    });
+                }
+            }
+        }
+
+        if let Some(u) = &req.units {
+            for (name, label) in [("x", &u.x), ("s", &u.s)] {
+                if let Some(l) = label {
+                    v.ensure(
+                        l.chars().count() <= MAX_UNIT_LABEL,
+                        format!("/units/{name}"),
+                        || {
+                            format!(
+                                "unit label must have at most {MAX_UNIT_LABEL} characters, got {}",
+                                l.chars().count()
+                            )
+                        },
+                    );
+                }
+            }
+        }
+
+        v.finish()?;
+        // `finish` succeeded, so `law` was set (every `None` branch above pushed an issue).
+        let Some(law) = law else {
+            return Err(CalcFailure::general(
+                crate::calc::ProblemClass::InvalidInput,
+                "INVALID_INPUT",
+                "no law given",
+            ));
+        };
+        let requested = req.quantities.unwrap_or_else(|| Quantity::ALL.to_vec());
+        let quantities = Quantity::ALL
+            .into_iter()
+            .filter(|q| requested.contains(q))
+            .collect();
+        Ok(Self {
+            law,
+            bc,
+            xs: abscissa.map(Abscissa::materialize),
+            quantities,
+            warnings,
+            units: req.units,
+        })
+    }
+}

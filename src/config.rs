@@ -1,0 +1,87 @@
+//! Service configuration: command-line flags, each with an environment-variable fallback.
+
+use std::net::SocketAddr;
+use std::time::Duration;
+
+use clap::Parser;
+
+/// mechcalc HTTP service configuration. Every flag can also be set through its environment
+/// variable; flags win.
+#[derive(Debug, Clone, Parser)]
+#[command(
+    name = "mechcalc",
+    version,
+    about = "Machine-design calculations over HTTP/JSON"
+)]
+pub struct ServiceConfig {
+    /// Address and port to listen on.
+    #[arg(long = "bind", env = "MECHCALC_BIND", default_value = "127.0.0.1:8080")]
+    pub bind: SocketAddr,
+
+    /// Maximum number of compute jobs running at once (0 = number of CPU cores).
+    #[arg(
+        long = "compute-slots",
+        env = "MECHCALC_COMPUTE_SLOTS",
+        default_value_t = 0
+    )]
+    pub compute_slots: usize,
+
+    /// Maximum number of compute jobs waiting for a slot before requests get 503.
+    #[arg(
+        long = "queue-depth",
+        env = "MECHCALC_QUEUE_DEPTH",
+        default_value_t = 16
+    )]
+    pub queue_depth: usize,
+
+    /// Maximum request body size in bytes.
+    #[arg(long = "max-body-bytes", env = "MECHCALC_MAX_BODY_BYTES", default_value_t = 16 * 1024 * 1024)]
+    pub max_body_bytes: usize,
+
+    /// Upper bound on any request's time budget, in milliseconds; requests may ask for less.
+    #[arg(
+        long = "max-time-budget-ms",
+        env = "MECHCALC_MAX_TIME_BUDGET_MS",
+        default_value_t = 600_000
+    )]
+    pub max_time_budget_ms: u64,
+
+    /// Log format: `text` or `json`.
+    #[arg(
+        long = "log-format",
+        env = "MECHCALC_LOG_FORMAT",
+        default_value = "text"
+    )]
+    pub log_format: String,
+}
+
+impl Default for ServiceConfig {
+    fn default() -> Self {
+        Self {
+            bind: SocketAddr::from(([127, 0, 0, 1], 8080)),
+            compute_slots: 0,
+            queue_depth: 16,
+            max_body_bytes: 16 * 1024 * 1024,
+            max_time_budget_ms: 600_000,
+            log_format: "text".to_owned(),
+        }
+    }
+}
+
+impl ServiceConfig {
+    /// Effective number of concurrent compute jobs.
+    #[must_use]
+    pub fn effective_compute_slots(&self) -> usize {
+        if self.compute_slots > 0 {
+            self.compute_slots
+        } else {
+            std::thread::available_parallelism().map_or(2, std::num::NonZeroUsize::get)
+        }
+    }
+
+    /// The server-wide cap on a request's time budget.
+    #[must_use]
+    pub fn max_time_budget(&self) -> Duration {
+        Duration::from_millis(self.max_time_budget_ms.max(1))
+    }
+}
