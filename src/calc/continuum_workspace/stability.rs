@@ -4,12 +4,13 @@
 //! Each rod is cut into `M` segments with angles `t_ij` at the segment mid-points. The reduced
 //! Hessian `Z^T H Z` is taken against the mass `Z^T Mm Z` (`Mm = h_i` on the angles, 0 on the
 //! platform pose), so the eigenvalue converges with `M` (error ~ M^-2) and, scaled by
-//! `L_ref^2 / EI_ref`, is the nondimensional **stability margin**.
+//! `L_ref^2 / EI_ref`, is the nondimensional **stability margin**. See [`margin`] for how the
+//! generalised problem is reduced to a standard one.
 
 // Without a target FMA unit `f64::mul_add` is a libm call; plain arithmetic in the inner loops.
 #![allow(clippy::suboptimal_flops)]
 
-use nalgebra::{DMatrix, linalg::Cholesky};
+use nalgebra::DMatrix;
 
 use super::model::{drot, rot};
 
@@ -50,16 +51,28 @@ pub enum Tips<'a> {
 }
 
 /// Smallest generalised eigenvalue of `(Z^T H Z, Z^T Mm Z)` scaled by `l_ref^2 / ei_ref`.
-/// Returns `None` if the reduced mass matrix is not positive definite (platform rotation not
-/// determined by the rods).
+#[allow(
+    clippy::needless_range_loop,
+    reason = "Householder QR on a ragged row block reads clearest with indices"
+)]
+/// Returns `None` when the platform rotation is not determined by the rods (coincident
+/// attachments), where the reduced mass matrix is singular.
+///
+/// Computation: the zero-mass pose variables are eliminated first (a QR of the pose columns of
+/// the constraint Jacobian expresses `(dp, dtheta)` through the angles and leaves `2N - 3`
+/// constraints on the angles alone; the platform's `H[theta, theta]` becomes a rank-1 term), the
+/// angles are scaled by `sqrt(h_i)` so that the mass is the identity, and the remaining
+/// constraints are removed by Householder reflections. What is left is a standard symmetric
+/// eigenproblem of size `NM - (2N - 3)`: no Cholesky factor and no generalised solve.
 #[must_use]
 pub fn margin(rods: &[RodDisc], tips: Tips<'_>, l_ref: f64, ei_ref: f64) -> Option<f64> {
     let nt: usize = rods.iter().map(|r| r.angles.len()).sum();
-    let platform = matches!(tips, Tips::Platform { .. });
-    let nv = nt + if platform { 3 } else { 0 };
-    // Hessian of the Lagrangian.
-    let mut h = DMatrix::<f64>::zeros(nv, nv);
-    let mut mass = vec![0.0; nv];
+    if nt == 0 {
+        return None;
+    }
+    // Scaled Hessian H_u = D^-1/2 H_tt D^-1/2 (column-major, dense), D = diag(h_i).
+    let mut a = vec![0.0; nt * nt];
+    let mut sqrt_h = vec![0.0; nt];
     let mut off = 0usize;
     for r in rods {
         let m = r.angles.len();
@@ -67,7 +80,7 @@ pub fn margin(rods: &[RodDisc], tips: Tips<'_>, l_ref: f64, ei_ref: f64) -> Opti
         let kk = r.ei / hs;
         for (j, &t) in r.angles.iter().enumerate() {
             let diag = if m == 1 {
-                3.0 - 1.0
+                2.0
             } else if j == 0 {
                 3.0
             } else if j + 1 == m {
@@ -76,87 +89,108 @@ pub fn margin(rods: &[RodDisc], tips: Tips<'_>, l_ref: f64, ei_ref: f64) -> Opti
                 2.0
             };
             let (s, c) = t.sin_cos();
-            h[(off + j, off + j)] = kk.mul_add(diag, hs * r.force[0].mul_add(c, r.force[1] * s));
+            let k = off + j;
+            a[k * nt + k] = (kk * diag + hs * (r.force[0] * c + r.force[1] * s)) / hs;
             if j + 1 < m {
-                h[(off + j, off + j + 1)] = -kk;
-                h[(off + j + 1, off + j)] = -kk;
+                a[(k + 1) * nt + k] = -kk / hs;
+                a[k * nt + k + 1] = -kk / hs;
             }
-            mass[off + j] = hs;
+            sqrt_h[k] = hs.sqrt();
         }
         off += m;
     }
-    // Constraint gradients as columns of C^T.
-    let mut cols: Vec<Vec<f64>> = Vec::new();
-    match tips {
-        Tips::Platform { theta, attach } => {
-            let mut hth = 0.0;
-            for (r, a) in rods.iter().zip(attach) {
-                let ra = rot(theta, *a);
-                hth -= r.force[0].mul_add(ra[0], r.force[1] * ra[1]);
+    // Constraint rows on the angles (scaled by D^-1/2), two per rod.
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    if !matches!(tips, Tips::Free) {
+        let mut off = 0usize;
+        for r in rods {
+            let m = r.angles.len();
+            let hs = r.length / m as f64;
+            let mut cx = vec![0.0; nt];
+            let mut cy = vec![0.0; nt];
+            for (j, &t) in r.angles.iter().enumerate() {
+                let (s, c) = t.sin_cos();
+                cx[off + j] = -hs * s / sqrt_h[off + j];
+                cy[off + j] = hs * c / sqrt_h[off + j];
             }
-            h[(nt + 2, nt + 2)] = hth;
-            let mut off = 0usize;
-            for (r, a) in rods.iter().zip(attach) {
-                let m = r.angles.len();
-                let hs = r.length / m as f64;
-                let dr = drot(theta, *a);
-                let mut cx = vec![0.0; nv];
-                let mut cy = vec![0.0; nv];
-                for (j, &t) in r.angles.iter().enumerate() {
-                    let (s, c) = t.sin_cos();
-                    cx[off + j] = -hs * s;
-                    cy[off + j] = hs * c;
-                }
-                cx[nt] = -1.0;
-                cy[nt + 1] = -1.0;
-                cx[nt + 2] = -dr[0];
-                cy[nt + 2] = -dr[1];
-                cols.push(cx);
-                cols.push(cy);
-                off += m;
-            }
+            rows.push(cx);
+            rows.push(cy);
+            off += m;
         }
-        Tips::Pinned => {
-            let mut off = 0usize;
-            for r in rods {
-                let m = r.angles.len();
-                let hs = r.length / m as f64;
-                let mut cx = vec![0.0; nv];
-                let mut cy = vec![0.0; nv];
-                for (j, &t) in r.angles.iter().enumerate() {
-                    let (s, c) = t.sin_cos();
-                    cx[off + j] = -hs * s;
-                    cy[off + j] = hs * c;
-                }
-                cols.push(cx);
-                cols.push(cy);
-                off += m;
-            }
-        }
-        Tips::Free => {}
     }
-    let reflectors = householder_pivoted(&mut cols, nv);
-    let rank = reflectors.len();
-    // Q^T A Q for A = H and A = Mm, applying the reflectors on both sides.
-    let mut mm = DMatrix::<f64>::from_diagonal(&nalgebra::DVector::from_vec(mass));
+    if let Tips::Platform { theta, attach } = tips {
+        let nc = rows.len();
+        // Pose columns of C per constraint row: [-1, 0, -dr_x] and [0, -1, -dr_y].
+        let mut cp = vec![[0.0f64; 3]; nc];
+        let mut hth = 0.0;
+        for (i, (r, at)) in rods.iter().zip(attach).enumerate() {
+            let dr = drot(theta, *at);
+            cp[2 * i] = [-1.0, 0.0, -dr[0]];
+            cp[2 * i + 1] = [0.0, -1.0, -dr[1]];
+            let ra = rot(theta, *at);
+            hth -= r.force[0] * ra[0] + r.force[1] * ra[1];
+        }
+        // Householder QR of the nc x 3 pose block, applied to the angle rows as well.
+        let scale = cp.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let mut diag_r = [0.0f64; 3];
+        for k in 0..3 {
+            let norm = (k..nc).map(|i| cp[i][k] * cp[i][k]).sum::<f64>().sqrt();
+            if norm.is_nan() || norm <= RANK_REL_TOL * scale.max(f64::MIN_POSITIVE) {
+                return None;
+            }
+            let alpha = if cp[k][k] >= 0.0 { -norm } else { norm };
+            let mut v = vec![0.0; nc];
+            for i in k..nc {
+                v[i] = cp[i][k];
+            }
+            v[k] -= alpha;
+            let vv: f64 = v.iter().map(|x| x * x).sum();
+            let beta = 2.0 / vv;
+            for col in k..3 {
+                let d: f64 = (k..nc).map(|i| v[i] * cp[i][col]).sum();
+                for i in k..nc {
+                    cp[i][col] -= beta * d * v[i];
+                }
+            }
+            for c in 0..nt {
+                let d: f64 = (k..nc).map(|i| v[i] * rows[i][c]).sum();
+                if d != 0.0 {
+                    for i in k..nc {
+                        rows[i][c] -= beta * d * v[i];
+                    }
+                }
+            }
+            diag_r[k] = cp[k][k];
+        }
+        // dtheta = -(Q^T C_t)[2] / R[2][2] (last row of the triangular solve): the platform term
+        // H[theta, theta] dtheta^2 becomes the rank-1 update hth * w w^T.
+        let w: Vec<f64> = rows[2].iter().map(|x| -x / diag_r[2]).collect();
+        if hth != 0.0 {
+            for c in 0..nt {
+                let f = hth * w[c];
+                if f != 0.0 {
+                    for (r, wr) in w.iter().enumerate() {
+                        a[c * nt + r] += f * wr;
+                    }
+                }
+            }
+        }
+        rows.drain(0..3);
+    }
+    // Remove the remaining constraints: Householder QR with column pivoting of C_u^T, then
+    // A <- P A P per reflector; the trailing block is the reduced operator.
+    let reflectors = householder_pivoted(&mut rows, nt);
     for (v, beta) in &reflectors {
-        reflect_both(&mut h, v, *beta);
-        reflect_both(&mut mm, v, *beta);
+        reflect_sym(&mut a, nt, v, *beta);
     }
-    let nz = nv - rank;
+    let r = reflectors.len();
+    let nz = nt - r;
     if nz == 0 {
         return Some(f64::INFINITY);
     }
-    let hz = h.view((rank, rank), (nz, nz)).into_owned();
-    let bz = mm.view((rank, rank), (nz, nz)).into_owned();
-    let chol = Cholesky::new(bz)?;
-    let l = chol.l();
-    // G = L^-1 Hz L^-T (symmetric).
-    let y = l.solve_lower_triangular(&hz)?;
-    let g = l.solve_lower_triangular(&y.transpose())?;
-    let g = (&g + g.transpose()) * 0.5;
-    let eig = g.symmetric_eigenvalues();
-    let min = eig.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    let z = DMatrix::<f64>::from_fn(nz, nz, |rr, c| a[(c + r) * nt + rr + r]);
+    let eig = z.symmetric_eigenvalues();
+    let min = eig.iter().fold(f64::INFINITY, |m, &b| m.min(b));
     Some(min * l_ref * l_ref / ei_ref)
 }
 
@@ -209,38 +243,38 @@ fn householder_pivoted(cols: &mut [Vec<f64>], nv: usize) -> Vec<(Vec<f64>, f64)>
     out
 }
 
-/// `A <- P A P` with `P = I - beta v v^T` (A symmetric).
-fn reflect_both(a: &mut DMatrix<f64>, v: &[f64], beta: f64) {
-    let n = a.nrows();
+/// `A <- P A P` with `P = I - beta v v^T` for a symmetric column-major `n x n` matrix:
+/// `p = beta A v`, `w = p - (beta v^T p / 2) v`, `A <- A - v w^T - w v^T` (one product and one
+/// rank-2 update).
+fn reflect_sym(a: &mut [f64], n: usize, v: &[f64], beta: f64) {
     let first = v.iter().position(|x| *x != 0.0).unwrap_or(n);
-    // A <- A - beta (A v) v^T
-    let mut av = vec![0.0; n];
-    for (r, avr) in av.iter_mut().enumerate() {
-        let mut s = 0.0;
-        for c in first..n {
-            s += a[(r, c)] * v[c];
-        }
-        *avr = s;
-    }
+    let mut p = vec![0.0; n];
     for c in first..n {
-        let f = beta * v[c];
-        for r in 0..n {
-            a[(r, c)] -= av[r] * f;
+        let vc = v[c];
+        if vc == 0.0 {
+            continue;
+        }
+        let col = &a[c * n..(c + 1) * n];
+        for (pr, ar) in p.iter_mut().zip(col) {
+            *pr += ar * vc;
         }
     }
-    // A <- A - beta v (v^T A)
-    let mut va = vec![0.0; n];
-    for (c, vac) in va.iter_mut().enumerate() {
-        let mut s = 0.0;
-        for r in first..n {
-            s += v[r] * a[(r, c)];
-        }
-        *vac = s;
+    for x in &mut p {
+        *x *= beta;
     }
-    for r in first..n {
-        let f = beta * v[r];
-        for c in 0..n {
-            a[(r, c)] -= f * va[c];
+    let k = 0.5
+        * beta
+        * v[first..]
+            .iter()
+            .zip(&p[first..])
+            .map(|(x, y)| x * y)
+            .sum::<f64>();
+    let w: Vec<f64> = p.iter().zip(v).map(|(pi, vi)| pi - k * vi).collect();
+    for c in 0..n {
+        let (vc, wc) = (v[c], w[c]);
+        let col = &mut a[c * n..(c + 1) * n];
+        for ((ar, vr), wr) in col.iter_mut().zip(v).zip(&w) {
+            *ar -= vr * wc + wr * vc;
         }
     }
 }
