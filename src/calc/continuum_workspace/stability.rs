@@ -51,10 +51,6 @@ pub enum Tips<'a> {
 }
 
 /// Smallest generalised eigenvalue of `(Z^T H Z, Z^T Mm Z)` scaled by `l_ref^2 / ei_ref`.
-#[allow(
-    clippy::needless_range_loop,
-    reason = "Householder QR on a ragged row block reads clearest with indices"
-)]
 /// Returns `None` when the platform rotation is not determined by the rods (coincident
 /// attachments), where the reduced mass matrix is singular.
 ///
@@ -64,6 +60,10 @@ pub enum Tips<'a> {
 /// angles are scaled by `sqrt(h_i)` so that the mass is the identity, and the remaining
 /// constraints are removed by Householder reflections. What is left is a standard symmetric
 /// eigenproblem of size `NM - (2N - 3)`: no Cholesky factor and no generalised solve.
+#[allow(
+    clippy::needless_range_loop,
+    reason = "Householder QR on a ragged row block reads clearest with indices"
+)]
 #[must_use]
 pub fn margin(rods: &[RodDisc], tips: Tips<'_>, l_ref: f64, ei_ref: f64) -> Option<f64> {
     let nt: usize = rods.iter().map(|r| r.angles.len()).sum();
