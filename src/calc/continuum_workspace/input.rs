@@ -14,6 +14,20 @@ use super::wire::{
 };
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
+/// Largest accepted coordinate, stroke or length magnitude [m]: the scales the service is
+/// tested at run from 1e-6 m to 1e6 m; beyond, products such as EI or B x n leave the range
+/// where the scaled residual is meaningful.
+const MAX_COORD_M: f64 = 1e6;
+/// Smallest rod length [m] (see `MAX_COORD_M`).
+const MIN_LENGTH_M: f64 = 1e-7;
+/// Smallest rod diameter [m] (EI ~ d^4 must stay a normal float).
+const MIN_DIAMETER_M: f64 = 1e-9;
+/// Accepted Young's modulus range [Pa] (gels to beyond diamond).
+const E_RANGE_PA: [f64; 2] = [1.0, 1e13];
+/// Accepted bending stiffness range [N m^2] when given directly.
+const EI_RANGE: [f64; 2] = [1e-30, 1e20];
+/// Largest allowable stress [Pa].
+const MAX_SIGMA_PA: f64 = 1e15;
 /// Default Young's modulus (steel) [Pa] (spec 3.1).
 const DEFAULT_E: f64 = 2.1e11;
 /// Rods with L/d below this are rejected (spec 3.1).
@@ -146,6 +160,24 @@ fn f64_in(v: &mut Validator, ptr: &str, x: Option<f64>, lo: f64, hi: f64, defaul
     }
 }
 
+/// Require every element finite and within `+/- MAX_COORD_M`.
+fn coords(v: &mut Validator, ptr: &str, values: &[f64]) -> bool {
+    if !v.all_finite(ptr, values) {
+        return false;
+    }
+    let mut ok = true;
+    for (i, x) in values.iter().enumerate() {
+        if x.abs() > MAX_COORD_M {
+            v.push(
+                format!("{ptr}/{i}"),
+                format!("must be within +/-{MAX_COORD_M:e} m, got {x}"),
+            );
+            ok = false;
+        }
+    }
+    ok
+}
+
 fn usize_of(x: u32) -> usize {
     usize::try_from(x).unwrap_or(usize::MAX)
 }
@@ -174,7 +206,7 @@ fn design_of(
         let mut design = preset.design();
         design.sigma_allow = d.sigma_allow_pa;
         if let Some(s) = d.sigma_allow_pa {
-            v.greater_than("/design/sigma_allow_pa", s, 0.0);
+            v.in_range("/design/sigma_allow_pa", s, f64::MIN_POSITIVE, MAX_SIGMA_PA);
         }
         return (design, Some(preset));
     }
@@ -190,7 +222,7 @@ fn design_of(
             }
             for (j, a) in acts.iter().enumerate() {
                 let p = format!("/design/actuators/{j}");
-                v.all_finite(&format!("{p}/origin_m"), &a.origin_m);
+                coords(v, &format!("{p}/origin_m"), &a.origin_m);
                 let mut dir = [1.0, 0.0];
                 if v.all_finite(&format!("{p}/direction"), &a.direction) {
                     let nrm = a.direction[0].hypot(a.direction[1]);
@@ -203,7 +235,7 @@ fn design_of(
                         );
                     }
                 }
-                if v.all_finite(&format!("{p}/stroke_m"), &a.stroke_m)
+                if coords(v, &format!("{p}/stroke_m"), &a.stroke_m)
                     && a.stroke_m[0] >= a.stroke_m[1]
                 {
                     v.push(
@@ -245,15 +277,25 @@ fn design_of(
                     );
                 }
                 let offset = r.offset_m.unwrap_or([0.0, 0.0]);
-                v.all_finite(&format!("{p}/offset_m"), &offset);
+                coords(v, &format!("{p}/offset_m"), &offset);
                 v.finite(&format!("{p}/clamp_angle_deg"), r.clamp_angle_deg);
-                let len_ok = v.greater_than(&format!("{p}/length_m"), r.length_m, 0.0);
-                v.all_finite(&format!("{p}/attach_m"), &r.attach_m);
+                let len_ok = v.in_range(
+                    &format!("{p}/length_m"),
+                    r.length_m,
+                    MIN_LENGTH_M,
+                    MAX_COORD_M,
+                );
+                coords(v, &format!("{p}/attach_m"), &r.attach_m);
                 let e = r.youngs_modulus_pa.unwrap_or(DEFAULT_E);
-                let e_ok = v.greater_than(&format!("{p}/youngs_modulus_pa"), e, 0.0);
+                let e_ok = v.in_range(
+                    &format!("{p}/youngs_modulus_pa"),
+                    e,
+                    E_RANGE_PA[0],
+                    E_RANGE_PA[1],
+                );
                 let mut diameter = None;
                 if let Some(dm) = r.diameter_m
-                    && v.greater_than(&format!("{p}/diameter_m"), dm, 0.0)
+                    && v.in_range(&format!("{p}/diameter_m"), dm, MIN_DIAMETER_M, MAX_COORD_M)
                 {
                     diameter = Some(dm);
                     {
@@ -275,7 +317,7 @@ fn design_of(
                     }
                 }
                 if let Some(ei) = r.ei_nm2 {
-                    v.greater_than(&format!("{p}/ei_nm2"), ei, 0.0);
+                    v.in_range(&format!("{p}/ei_nm2"), ei, EI_RANGE[0], EI_RANGE[1]);
                 }
                 if r.diameter_m.is_none() && r.ei_nm2.is_none() {
                     v.push(format!("{p}/diameter_m"), "required unless ei_nm2 is given");
@@ -324,7 +366,7 @@ fn design_of(
         }
     }
     if let Some(s) = d.sigma_allow_pa {
-        v.greater_than("/design/sigma_allow_pa", s, 0.0);
+        v.in_range("/design/sigma_allow_pa", s, f64::MIN_POSITIVE, MAX_SIGMA_PA);
     }
     if let Some(h) = &d.home_inputs_m {
         if h.len() != n_act {
@@ -336,7 +378,7 @@ fn design_of(
                 ),
             );
         } else {
-            v.all_finite("/design/home_inputs_m", h);
+            coords(v, "/design/home_inputs_m", h);
         }
     }
     let design = Design {
@@ -574,7 +616,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             };
             let ranges = w.ranges_m.unwrap_or(strokes);
             for (k, r) in ranges.iter().enumerate() {
-                if v.all_finite(&format!("/workspace/ranges_m/{k}"), r) && r[0] >= r[1] {
+                if coords(&mut v, &format!("/workspace/ranges_m/{k}"), r) && r[0] >= r[1] {
                     v.push(
                         format!("/workspace/ranges_m/{k}"),
                         format!("min must be < max, got [{}, {}]", r[0], r[1]),
@@ -637,10 +679,20 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             );
             let lim = w.limits.clone().unwrap_or_default();
             if let Some(g) = lim.min_actuator_gap_m {
-                v.finite("/workspace/limits/min_actuator_gap_m", g);
+                v.in_range(
+                    "/workspace/limits/min_actuator_gap_m",
+                    g,
+                    -MAX_COORD_M,
+                    MAX_COORD_M,
+                );
             }
             if let Some(s) = lim.sigma_allow_pa {
-                v.greater_than("/workspace/limits/sigma_allow_pa", s, 0.0);
+                v.in_range(
+                    "/workspace/limits/sigma_allow_pa",
+                    s,
+                    f64::MIN_POSITIVE,
+                    MAX_SIGMA_PA,
+                );
             }
             let qt = f64_in(
                 &mut v,
@@ -659,7 +711,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                 },
                 Some(s) => {
                     if let Some(i) = &s.inputs_m {
-                        v.all_finite("/workspace/seed/inputs_m", i);
+                        coords(&mut v, "/workspace/seed/inputs_m", i);
                     }
                     let state = match (s.kind, &s.state) {
                         (SeedKind::Guess, None) => {
