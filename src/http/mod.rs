@@ -5,8 +5,11 @@
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
 //! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
+pub mod bus_fuel_economy;
 pub mod cam_law;
+pub mod cam_law_fit;
 pub mod cognates;
+pub mod component_importance;
 pub mod json;
 pub mod meta;
 pub mod pool;
@@ -95,6 +98,8 @@ JSON pointers to the offending fields.",
         (name = "service", description = "Health and discovery"),
         (name = "cam-law", description = "Cam motion laws: evaluation and identification"),
         (name = "linkages", description = "Planar linkages: Roberts–Chebyshev cognates of a four-bar"),
+        (name = "reliability", description = "Reliability and maintenance: component importance under fault propagation"),
+        (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -106,7 +111,11 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(meta::healthz))
         .routes(routes!(meta::index))
         .routes(routes!(cam_law::evaluate))
+        .routes(routes!(cam_law_fit::fit))
         .routes(routes!(cognates::construct))
+        .routes(routes!(component_importance::rank))
+        .routes(routes!(bus_fuel_economy::compute))
+        .routes(routes!(bus_fuel_economy::motor_map))
 }
 
 /// The OpenAPI document of the service, generated from the handlers and wire types.

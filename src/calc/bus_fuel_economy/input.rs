@@ -1,0 +1,1131 @@
+//! Validation of the wire request into SI domain inputs (spec §3, §3.7), collecting every issue.
+
+use super::ac_factor::{AcFactor, Dowell};
+use super::battery::{Battery, Ecm};
+use super::cycles::{self, Cycle};
+use super::ipmsm::{Ipmsm, IpmsmParams, psi_from_back_emf, rpm_to_rad_s};
+use super::maps::{Envelope, Grid2, efficiency_to_loss};
+use super::motor::{MotorInput, MotorKind};
+use super::sim::Vehicle;
+use super::wire::{
+    AcFactorSpec, BatteryModel, BatterySpec, BusFuelEconomyRequest, CycleSpec, EnvelopeTable,
+    GridSpec, IpmsmMotor, Mode, MotorEval, MotorSpec, OutputKind, PowerConvention, VehicleSpec,
+};
+use crate::calc::{CalcFailure, ProblemClass, Validator};
+
+/// Most motors per request (spec §3.5).
+pub const MAX_MOTORS: usize = 8;
+/// Most cycles per request (spec §3.4).
+pub const MAX_CYCLES: usize = 16;
+/// Most samples of one custom cycle (spec §3.4).
+pub const MAX_CYCLE_SAMPLES: usize = 200_000;
+/// Most intervals over all cycles after sub-stepping (spec §3.7, §8 item 10).
+pub const MAX_TOTAL_INTERVALS: usize = 1_000_000;
+/// Largest custom-cycle time step [s] (spec §3.4).
+pub const MAX_TIME_STEP_S: f64 = 60.0;
+/// Smallest custom-cycle time step [s] (1 kHz sampling): a service limit that bounds the
+/// acceleration (≤ 2·10⁵ m/s²) and so keeps every force, torque and power finite.
+pub const MIN_TIME_STEP_S: f64 = 1e-3;
+/// Smallest efficiency of the gear, inverter, battery and a constant motor [-]: a service limit
+/// (the spec allows (0, 1]) that keeps P/η finite; real drivetrains are far above it.
+pub const MIN_EFFICIENCY: f64 = 0.01;
+/// Smallest value of an efficiency map [-]: keeps the converted loss |P|(1/η − 1) finite.
+pub const MIN_MAP_EFFICIENCY: f64 = 1e-6;
+/// Smallest gear ratio [-]: a service limit (spec (0, 50]) that keeps T_w/(η_T i_g) finite.
+pub const MIN_GEAR_RATIO: f64 = 0.01;
+/// Largest trace speed [m/s] (720 km/h): a service limit that keeps v² and the road load finite.
+pub const MAX_SPEED_MPS: f64 = 200.0;
+/// Largest |time| of a custom trace [s] (about 30 years): keeps Δt well resolved.
+pub const MAX_TIME_S: f64 = 1e9;
+/// Relative slack of the cycle-speed vs n_max check (rounding of the rpm conversion).
+const SPEED_CHECK_SLACK: f64 = 1e-12;
+/// Longest id / cycle name.
+const MAX_NAME_LEN: usize = 64;
+
+/// Default envelope of constant / map motors (spec §3.5).
+const DEFAULT_T_PEAK: f64 = 800.0;
+const DEFAULT_P_PEAK: f64 = 130_000.0;
+const DEFAULT_N_MAX: f64 = 5200.0;
+
+/// Validated options.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Envelope policy.
+    pub mode: Mode,
+    /// Power convention.
+    pub convention: PowerConvention,
+    /// Substeps k.
+    pub substeps: usize,
+    /// Regeneration allowed.
+    pub regen: bool,
+    /// Regeneration limited by the envelope.
+    pub regen_limit: bool,
+    /// ipmsm evaluation.
+    pub motor_eval: MotorEval,
+    /// Map grid: speed step [rpm], torque step [N·m].
+    pub grid: (f64, f64),
+    /// Loss breakdown requested.
+    pub breakdown: bool,
+    /// Histogram requested.
+    pub histogram: bool,
+    /// Traces requested.
+    pub traces: bool,
+    /// Efficiency maps requested.
+    pub efficiency_map: bool,
+    /// Histogram bins: speed [rpm], torque [N·m].
+    pub hist_bins: (f64, f64),
+    /// Normalised desirability weights per cycle.
+    pub weights: Vec<f64>,
+}
+
+/// A validated request in SI units.
+#[derive(Debug, Clone)]
+pub struct BusFuelEconomyInput {
+    /// Vehicle.
+    pub vehicle: Vehicle,
+    /// Constant road slope of the vehicle.
+    pub grade: f64,
+    /// η_Inv.
+    pub inverter_eff: f64,
+    /// Battery.
+    pub battery: Battery,
+    /// Cycles.
+    pub cycles: Vec<Cycle>,
+    /// Motors.
+    pub motors: Vec<MotorInput>,
+    /// Options.
+    pub options: Options,
+}
+
+/// `lo < x ≤ hi`.
+fn open_closed(v: &mut Validator, ptr: &str, x: f64, lo: f64, hi: f64) -> bool {
+    if !v.finite(ptr, x) {
+        return false;
+    }
+    let ok = x > lo && x <= hi;
+    if !ok {
+        v.push(ptr, format!("must be in ({lo}, {hi}], got {x}"));
+    }
+    ok
+}
+
+/// Strictly increasing, finite, ≥ `min_len` points, first ≥ `first_min`, all ≤ `max`.
+fn axis(
+    v: &mut Validator,
+    ptr: &str,
+    xs: &[f64],
+    min_len: usize,
+    first_min: f64,
+    max: f64,
+) -> bool {
+    if xs.len() < min_len {
+        v.push(
+            ptr,
+            format!("needs at least {min_len} points, got {}", xs.len()),
+        );
+        return false;
+    }
+    if !v.all_finite(ptr, xs) {
+        return false;
+    }
+    if xs[0] < first_min {
+        v.push(
+            format!("{ptr}/0"),
+            format!("must be ≥ {first_min}, got {}", xs[0]),
+        );
+        return false;
+    }
+    if let Some(i) = (1..xs.len()).find(|&i| xs[i] <= xs[i - 1]) {
+        v.push(
+            format!("{ptr}/{i}"),
+            format!(
+                "axis must be strictly increasing: {} after {}",
+                xs[i],
+                xs[i - 1]
+            ),
+        );
+        return false;
+    }
+    if let Some(i) = xs.iter().position(|x| x.abs() > max) {
+        v.push(
+            format!("{ptr}/{i}"),
+            format!("magnitude must be ≤ {max}, got {}", xs[i]),
+        );
+        return false;
+    }
+    true
+}
+
+/// A table `[rows][cols]` of finite values in [lo, hi] (or (lo, hi] when `open_lo`).
+fn table(
+    v: &mut Validator,
+    ptr: &str,
+    t: &[Vec<f64>],
+    (rows, cols): (usize, usize),
+    (lo, hi, open_lo): (f64, f64, bool),
+) -> bool {
+    if t.len() != rows {
+        v.push(
+            ptr,
+            format!("must have {rows} rows (one per speed), got {}", t.len()),
+        );
+        return false;
+    }
+    for (i, row) in t.iter().enumerate() {
+        let p = format!("{ptr}/{i}");
+        if row.len() != cols {
+            v.push(
+                p,
+                format!(
+                    "must have {cols} values (one per torque), got {}",
+                    row.len()
+                ),
+            );
+            return false;
+        }
+        if !v.all_finite(&p, row) {
+            return false;
+        }
+        let bad = row
+            .iter()
+            .position(|&x| x > hi || x < lo || (open_lo && x <= lo));
+        if let Some(j) = bad {
+            let lb = if open_lo { "(" } else { "[" };
+            v.push(
+                format!("{p}/{j}"),
+                format!("must be in {lb}{lo}, {hi}], got {}", row[j]),
+            );
+            return false;
+        }
+    }
+    true
+}
+
+fn name_ok(v: &mut Validator, ptr: &str, name: &str, what: &str) {
+    let n = name.chars().count();
+    if n == 0 || n > MAX_NAME_LEN {
+        v.push(
+            ptr,
+            format!("{what} must have 1..{MAX_NAME_LEN} characters, got {n}"),
+        );
+    }
+}
+
+fn vehicle(v: &mut Validator, s: &VehicleSpec) -> Vehicle {
+    open_closed(v, "/vehicle/curb_mass_kg", s.curb_mass_kg, 0.0, 1e5);
+    if s.passengers > 500 {
+        v.push(
+            "/vehicle/passengers",
+            format!("must be in [0, 500], got {}", s.passengers),
+        );
+    }
+    v.in_range(
+        "/vehicle/mass_per_passenger_kg",
+        s.mass_per_passenger_kg,
+        0.0,
+        200.0,
+    );
+    open_closed(v, "/vehicle/frontal_area_m2", s.frontal_area_m2, 0.0, 30.0);
+    open_closed(v, "/vehicle/drag_coeff", s.drag_coeff, 0.0, 3.0);
+    v.in_range("/vehicle/rolling_coeff", s.rolling_coeff, 0.0, 0.1);
+    open_closed(v, "/vehicle/air_density", s.air_density, 0.0, 2.0);
+    open_closed(v, "/vehicle/gravity", s.gravity, 9.0, 10.5);
+    open_closed(v, "/vehicle/wheel_radius_m", s.wheel_radius_m, 0.1, 2.0);
+    v.in_range("/vehicle/gear_ratio", s.gear_ratio, MIN_GEAR_RATIO, 50.0);
+    v.in_range(
+        "/vehicle/gear_efficiency",
+        s.gear_efficiency,
+        MIN_EFFICIENCY,
+        1.0,
+    );
+    v.in_range(
+        "/vehicle/rotational_inertia_factor",
+        s.rotational_inertia_factor,
+        0.0,
+        1.0,
+    );
+    v.in_range("/vehicle/grade", s.grade, -0.3, 0.3);
+    v.in_range("/vehicle/aux_power_w", s.aux_power_w, 0.0, 1e5);
+    let mass = f64::from(s.passengers).mul_add(s.mass_per_passenger_kg, s.curb_mass_kg);
+    Vehicle {
+        mass,
+        mass_eff: mass * (1.0 + s.rotational_inertia_factor),
+        gravity: s.gravity,
+        rolling: s.rolling_coeff,
+        aero: 0.5 * s.air_density * s.drag_coeff * s.frontal_area_m2,
+        wheel_radius: s.wheel_radius_m,
+        gear_ratio: s.gear_ratio,
+        gear_eff: s.gear_efficiency,
+        aux_w: s.aux_power_w,
+    }
+}
+
+fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
+    let ecm_fields: [(&str, bool); 10] = [
+        ("nominal_voltage", b.nominal_voltage.is_some()),
+        ("capacity_kwh", b.capacity_kwh.is_some()),
+        ("soc_initial", b.soc_initial.is_some()),
+        ("ocv_soc", b.ocv_soc.is_some()),
+        ("ocv_v", b.ocv_v.is_some()),
+        ("r0_ohm", b.r0_ohm.is_some()),
+        ("r1_ohm", b.r1_ohm.is_some()),
+        ("c1_f", b.c1_f.is_some()),
+        ("r2_ohm", b.r2_ohm.is_some()),
+        ("c2_f", b.c2_f.is_some()),
+    ];
+    match b.model {
+        BatteryModel::Constant => {
+            for (name, present) in ecm_fields {
+                if present {
+                    v.push(
+                        format!("/battery/{name}"),
+                        "is an ecm_2rc field; not allowed with model \"constant\"".to_owned(),
+                    );
+                }
+            }
+            let eta = b.efficiency.unwrap_or(1.0);
+            v.in_range("/battery/efficiency", eta, MIN_EFFICIENCY, 1.0);
+            Battery::Constant { eta }
+        }
+        BatteryModel::Ecm2rc => {
+            if b.efficiency.is_some() {
+                v.push(
+                    "/battery/efficiency",
+                    "is a constant-model field; not allowed with model \"ecm_2rc\"".to_owned(),
+                );
+            }
+            // Required field in (lo, hi] (`lo_open`) or [lo, hi]; NaN placeholder when missing.
+            let mut need = |name: &str, x: Option<f64>, lo: f64, hi: f64, lo_open: bool| -> f64 {
+                let ptr = format!("/battery/{name}");
+                match x {
+                    None => {
+                        v.push(ptr, "is required for model \"ecm_2rc\"".to_owned());
+                        f64::NAN
+                    }
+                    Some(x) => {
+                        if lo_open {
+                            open_closed(v, &ptr, x, lo, hi);
+                        } else {
+                            v.in_range(&ptr, x, lo, hi);
+                        }
+                        x
+                    }
+                }
+            };
+            let soc0 = need("soc_initial", b.soc_initial, 0.0, 1.0, true);
+            let r0 = need("r0_ohm", b.r0_ohm, 0.0, 100.0, true);
+            let r1 = need("r1_ohm", b.r1_ohm, 0.0, 100.0, false);
+            let c1 = need("c1_f", b.c1_f, 0.0, 1e9, true);
+            let r2 = need("r2_ohm", b.r2_ohm, 0.0, 100.0, false);
+            let c2 = need("c2_f", b.c2_f, 0.0, 1e9, true);
+            let vn = b.nominal_voltage.unwrap_or(360.0);
+            let cap = b.capacity_kwh.unwrap_or(256.0);
+            open_closed(v, "/battery/nominal_voltage", vn, 0.0, 5000.0);
+            open_closed(v, "/battery/capacity_kwh", cap, 0.0, 1e4);
+            let (soc_t, ocv_t) = match (&b.ocv_soc, &b.ocv_v) {
+                (Some(s), Some(o)) => {
+                    let ok_s = axis(v, "/battery/ocv_soc", s, 2, 0.0, 1.0);
+                    if ok_s && s.last().is_some_and(|&x| x > 1.0) {
+                        v.push(
+                            "/battery/ocv_soc",
+                            "SOC points must lie in [0, 1]".to_owned(),
+                        );
+                    }
+                    if o.len() != s.len() {
+                        v.push(
+                            "/battery/ocv_v",
+                            format!("must have {} values like ocv_soc, got {}", s.len(), o.len()),
+                        );
+                    } else if v.all_finite("/battery/ocv_v", o)
+                        && let Some(i) = o.iter().position(|&x| x <= 0.0 || x > 1e5)
+                    {
+                        v.push(
+                            format!("/battery/ocv_v/{i}"),
+                            format!("must be in (0, 100000] V, got {}", o[i]),
+                        );
+                    }
+                    (s.clone(), o.clone())
+                }
+                _ => {
+                    if b.ocv_soc.is_none() {
+                        v.push(
+                            "/battery/ocv_soc",
+                            "is required for model \"ecm_2rc\"".to_owned(),
+                        );
+                    }
+                    if b.ocv_v.is_none() {
+                        v.push(
+                            "/battery/ocv_v",
+                            "is required for model \"ecm_2rc\"".to_owned(),
+                        );
+                    }
+                    (Vec::new(), Vec::new())
+                }
+            };
+            Battery::Ecm(Ecm {
+                ocv_soc: soc_t,
+                ocv_v: ocv_t,
+                r0,
+                r1,
+                c1,
+                r2,
+                c2,
+                soc0,
+                q_coulomb: cap * 3.6e6 / vn,
+            })
+        }
+    }
+}
+
+fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
+    let base = format!("/cycles/{j}");
+    match c {
+        CycleSpec::Builtin(name) => {
+            let cy = cycles::builtin(name);
+            if cy.is_none() {
+                v.push(
+                    &base,
+                    format!("unknown built-in cycle '{name}' (known: manhattan, hwfet, hdudds)"),
+                );
+            }
+            cy
+        }
+        CycleSpec::Custom(cc) => {
+            name_ok(v, &format!("{base}/name"), &cc.name, "cycle name");
+            let n = cc.time_s.len();
+            let mut ok = true;
+            if !(2..=MAX_CYCLE_SAMPLES).contains(&n) {
+                v.push(
+                    format!("{base}/time_s"),
+                    format!("must have 2..{MAX_CYCLE_SAMPLES} samples, got {n}"),
+                );
+                ok = false;
+            }
+            let (speeds, sp_ptr, factor) = match (&cc.speed_kmh, &cc.speed_mps) {
+                (Some(s), None) => (s, format!("{base}/speed_kmh"), 1.0 / 3.6),
+                (None, Some(s)) => (s, format!("{base}/speed_mps"), 1.0),
+                (Some(_), Some(_)) => {
+                    v.push(
+                        &base,
+                        "give exactly one of speed_kmh and speed_mps, not both".to_owned(),
+                    );
+                    return None;
+                }
+                (None, None) => {
+                    v.push(&base, "needs speed_kmh or speed_mps".to_owned());
+                    return None;
+                }
+            };
+            if speeds.len() != n {
+                v.push(
+                    &sp_ptr,
+                    format!("must have {n} samples like time_s, got {}", speeds.len()),
+                );
+                ok = false;
+            }
+            let tp = format!("{base}/time_s");
+            ok &= v.all_finite(&tp, &cc.time_s);
+            ok &= v.all_finite(&sp_ptr, speeds);
+            if !ok {
+                return None;
+            }
+            if let Some(i) = cc.time_s.iter().position(|t| t.abs() > MAX_TIME_S) {
+                v.push(
+                    format!("{tp}/{i}"),
+                    format!("|time| must be ≤ {MAX_TIME_S} s, got {}", cc.time_s[i]),
+                );
+                ok = false;
+            }
+            if let Some(i) = (1..n).find(|&i| cc.time_s[i] <= cc.time_s[i - 1]) {
+                v.push(
+                    format!("{tp}/{i}"),
+                    format!(
+                        "time must be strictly increasing: {} after {}",
+                        cc.time_s[i],
+                        cc.time_s[i - 1]
+                    ),
+                );
+                ok = false;
+            } else if let Some(i) = (1..n).find(|&i| {
+                let dt = cc.time_s[i] - cc.time_s[i - 1];
+                // 1e-6 relative slack: 10.001 − 10.0 is 0.000999999… in binary.
+                !(MIN_TIME_STEP_S * (1.0 - 1e-6)..=MAX_TIME_STEP_S).contains(&dt)
+            }) {
+                v.push(
+                    format!("{tp}/{i}"),
+                    format!(
+                        "time step must be in [{MIN_TIME_STEP_S}, {MAX_TIME_STEP_S}] s, got {} s",
+                        cc.time_s[i] - cc.time_s[i - 1]
+                    ),
+                );
+                ok = false;
+            }
+            let mps: Vec<f64> = speeds.iter().map(|s| s * factor).collect();
+            if let Some(i) = mps
+                .iter()
+                .position(|&s| !(0.0..=MAX_SPEED_MPS).contains(&s))
+            {
+                v.push(
+                    format!("{sp_ptr}/{i}"),
+                    format!(
+                        "speed must be in [0, {MAX_SPEED_MPS}] m/s, got {} m/s",
+                        mps[i]
+                    ),
+                );
+                ok = false;
+            }
+            if let Some(g) = &cc.grade {
+                let gp = format!("{base}/grade");
+                if g.len() != n {
+                    v.push(
+                        &gp,
+                        format!("must have {n} samples like time_s, got {}", g.len()),
+                    );
+                    ok = false;
+                } else if !v.all_finite(&gp, g) {
+                    ok = false;
+                } else if let Some(i) = g.iter().position(|x| !(-0.3..=0.3).contains(x)) {
+                    v.push(
+                        format!("{gp}/{i}"),
+                        format!("grade must be in [-0.3, 0.3], got {}", g[i]),
+                    );
+                    ok = false;
+                }
+            }
+            ok.then(|| Cycle {
+                name: cc.name.clone(),
+                time_s: cc.time_s.clone(),
+                speed_mps: mps,
+                grade: cc.grade.clone(),
+            })
+        }
+    }
+}
+
+/// Envelope fields shared by constant and map motors.
+fn envelope(
+    v: &mut Validator,
+    base: &str,
+    t_peak: Option<f64>,
+    p_peak: Option<f64>,
+    n_max: Option<f64>,
+    table: Option<&EnvelopeTable>,
+) -> (Envelope, f64) {
+    let n_max = n_max.unwrap_or(DEFAULT_N_MAX);
+    open_closed(v, &format!("{base}/n_max_rpm"), n_max, 0.0, 1e5);
+    let env = match table {
+        Some(t) => {
+            if t_peak.is_some() || p_peak.is_some() {
+                v.push(
+                    format!("{base}/envelope"),
+                    "give either envelope or t_peak_nm/p_peak_w, not both".to_owned(),
+                );
+            }
+            let p = format!("{base}/envelope");
+            let ok = axis(v, &format!("{p}/speed_rpm"), &t.speed_rpm, 2, 0.0, 1e5);
+            if t.t_max_nm.len() != t.speed_rpm.len() {
+                v.push(
+                    format!("{p}/t_max_nm"),
+                    format!(
+                        "must have {} values like speed_rpm, got {}",
+                        t.speed_rpm.len(),
+                        t.t_max_nm.len()
+                    ),
+                );
+            } else if v.all_finite(&format!("{p}/t_max_nm"), &t.t_max_nm)
+                && let Some(i) = t.t_max_nm.iter().position(|&x| x <= 0.0 || x > 1e6)
+            {
+                v.push(
+                    format!("{p}/t_max_nm/{i}"),
+                    format!("must be in (0, 1000000] N·m, got {}", t.t_max_nm[i]),
+                );
+            }
+            let _ = ok;
+            Envelope::Table {
+                speed: t.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
+                t_max: t.t_max_nm.clone(),
+            }
+        }
+        None => {
+            let tp = t_peak.unwrap_or(DEFAULT_T_PEAK);
+            let pp = p_peak.unwrap_or(DEFAULT_P_PEAK);
+            open_closed(v, &format!("{base}/t_peak_nm"), tp, 0.0, 1e6);
+            open_closed(v, &format!("{base}/p_peak_w"), pp, 0.0, 1e9);
+            Envelope::TorquePower {
+                t_peak: tp,
+                p_peak: pp,
+            }
+        }
+    };
+    (env, rpm_to_rad_s(n_max))
+}
+
+fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
+    let p = format!("{base}/");
+    if !(1..=32).contains(&m.pole_pairs) {
+        v.push(
+            format!("{p}pole_pairs"),
+            format!("must be in [1, 32], got {}", m.pole_pairs),
+        );
+    }
+    let pp = f64::from(m.pole_pairs.clamp(1, 32));
+    let psi = match (m.psi_m_wb, &m.back_emf) {
+        (Some(psi), None) => {
+            open_closed(v, &format!("{p}psi_m_wb"), psi, 0.0, 100.0);
+            psi
+        }
+        (None, Some(b)) => {
+            let a = open_closed(
+                v,
+                &format!("{p}back_emf/v_peak_phase"),
+                b.v_peak_phase,
+                0.0,
+                1e5,
+            );
+            let c = open_closed(v, &format!("{p}back_emf/at_rpm"), b.at_rpm, 0.0, 1e5);
+            let psi = psi_from_back_emf(b.v_peak_phase, b.at_rpm, pp);
+            if a && c && !(psi > 0.0 && psi <= 100.0) {
+                v.push(
+                    format!("{p}back_emf"),
+                    format!("implies ψ_m = {psi} Wb, outside (0, 100]"),
+                );
+            }
+            psi
+        }
+        (Some(_), Some(_)) => {
+            v.push(
+                base,
+                "give exactly one of psi_m_wb and back_emf, not both".to_owned(),
+            );
+            f64::NAN
+        }
+        (None, None) => {
+            v.push(base, "needs psi_m_wb or back_emf".to_owned());
+            f64::NAN
+        }
+    };
+    let ld_ok = open_closed(v, &format!("{p}ld_h"), m.ld_h, 0.0, 1.0);
+    let lq_ok = open_closed(v, &format!("{p}lq_h"), m.lq_h, 0.0, 1.0);
+    if ld_ok && lq_ok && m.lq_h < m.ld_h {
+        v.push(
+            format!("{p}lq_h"),
+            format!("must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}", m.ld_h, m.lq_h),
+        );
+    }
+    open_closed(
+        v,
+        &format!("{p}r_phase_20c_ohm"),
+        m.r_phase_20c_ohm,
+        0.0,
+        100.0,
+    );
+    let temp = m.winding_temp_c.unwrap_or(100.0);
+    v.in_range(&format!("{p}winding_temp_c"), temp, -40.0, 250.0);
+    open_closed(v, &format!("{p}i_max_arms"), m.i_max_arms, 0.0, 1e5);
+    open_closed(v, &format!("{p}v_dc"), m.v_dc, 0.0, 1e5);
+    let util = m.voltage_utilization.unwrap_or(1.0);
+    open_closed(v, &format!("{p}voltage_utilization"), util, 0.0, 1.155);
+    open_closed(v, &format!("{p}n_max_rpm"), m.n_max_rpm, 0.0, 1e5);
+    let t_cap = m.t_cap_nm.unwrap_or(f64::INFINITY);
+    if m.t_cap_nm.is_some() {
+        open_closed(v, &format!("{p}t_cap_nm"), t_cap, 0.0, 1e6);
+    }
+    let p_cap = m.p_cap_w.unwrap_or(f64::INFINITY);
+    if m.p_cap_w.is_some() {
+        open_closed(v, &format!("{p}p_cap_w"), p_cap, 0.0, 1e9);
+    }
+    let ac = match &m.ac_factor {
+        None | Some(AcFactorSpec::NoAc(_)) => AcFactor::None,
+        Some(AcFactorSpec::Table(t)) => {
+            let ap = format!("{p}ac_factor");
+            axis(v, &format!("{ap}/freq_hz"), &t.freq_hz, 1, 0.0, 1e7);
+            if t.k_ac.len() != t.freq_hz.len() {
+                v.push(
+                    format!("{ap}/k_ac"),
+                    format!(
+                        "must have {} values like freq_hz, got {}",
+                        t.freq_hz.len(),
+                        t.k_ac.len()
+                    ),
+                );
+            } else if v.all_finite(&format!("{ap}/k_ac"), &t.k_ac)
+                && let Some(i) = t.k_ac.iter().position(|&k| !(1.0..=1000.0).contains(&k))
+            {
+                v.push(
+                    format!("{ap}/k_ac/{i}"),
+                    format!("k_AC must be in [1, 1000], got {}", t.k_ac[i]),
+                );
+            }
+            AcFactor::Table {
+                freq_hz: t.freq_hz.clone(),
+                k_ac: t.k_ac.clone(),
+            }
+        }
+        Some(AcFactorSpec::Dowell(d)) => {
+            let ap = format!("{p}ac_factor");
+            open_closed(
+                v,
+                &format!("{ap}/conductor_height_m"),
+                d.conductor_height_m,
+                0.0,
+                0.1,
+            );
+            if !(1..=100).contains(&d.layers) {
+                v.push(
+                    format!("{ap}/layers"),
+                    format!("must be in [1, 100], got {}", d.layers),
+                );
+            }
+            open_closed(v, &format!("{ap}/porosity"), d.porosity, 0.0, 1.0);
+            open_closed(
+                v,
+                &format!("{ap}/stack_length_m"),
+                d.stack_length_m,
+                0.0,
+                10.0,
+            );
+            v.in_range(&format!("{ap}/end_length_m"), d.end_length_m, 0.0, 10.0);
+            AcFactor::Dowell(Dowell {
+                conductor_height_m: d.conductor_height_m,
+                layers: f64::from(d.layers),
+                porosity: d.porosity,
+                stack_length_m: d.stack_length_m,
+                end_length_m: d.end_length_m,
+            })
+        }
+    };
+    let iron = m.iron.clone().unwrap_or_default();
+    v.in_range(&format!("{p}iron/k_h"), iron.k_h, 0.0, 1e6);
+    v.in_range(&format!("{p}iron/k_e"), iron.k_e, 0.0, 1e6);
+    let mech = m.mech.clone().unwrap_or_default();
+    v.in_range(&format!("{p}mech/c_fric_nm"), mech.c_fric_nm, 0.0, 1e6);
+    v.in_range(&format!("{p}mech/c_wind"), mech.c_wind, 0.0, 1e6);
+    let scale = m.stack_scale.unwrap_or(1.0);
+    if m.stack_scale.is_some() {
+        open_closed(v, &format!("{p}stack_scale"), scale, 0.0, 10.0);
+        if !matches!(ac, AcFactor::Dowell(_)) {
+            v.push(
+                format!("{p}stack_scale"),
+                "needs ac_factor model \"dowell\" (its stack/end lengths split the resistance)"
+                    .to_owned(),
+            );
+        }
+    }
+    Ipmsm::new(&IpmsmParams {
+        pole_pairs: pp,
+        psi_m_wb: psi,
+        ld_h: m.ld_h,
+        lq_h: m.lq_h,
+        r_20_ohm: m.r_phase_20c_ohm,
+        winding_temp_c: temp,
+        i_max_arms: m.i_max_arms,
+        v_dc: m.v_dc,
+        voltage_utilization: util,
+        n_max_rpm: m.n_max_rpm,
+        t_cap_nm: t_cap,
+        p_cap_w: p_cap,
+        ac,
+        k_h: iron.k_h,
+        k_e: iron.k_e,
+        c_fric: mech.c_fric_nm,
+        c_wind: mech.c_wind,
+        stack_scale: scale,
+    })
+}
+
+/// Warn when the envelope reaches beyond a map's torque axis (lookups are held at the edge).
+fn map_axis_warning(loss: &Grid2, env: &Envelope, warnings: &mut Vec<String>) {
+    let (lo, hi) = loss.torque_range();
+    let peak = env.peak();
+    if peak > hi || -peak < lo {
+        warnings.push(format!(
+            "envelope torque ±{peak:.1} N·m exceeds the map torque axis [{lo:.1}, {hi:.1}] N·m: losses are held at the axis edge (no extrapolation)"
+        ));
+    }
+}
+
+fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
+    let base = format!("/motors/{i}");
+    name_ok(v, &format!("{base}/id"), spec.id(), "motor id");
+    let mut warnings = Vec::new();
+    // The second element (admissible speed in rad/s) is recomputed below from the rpm values.
+    let (kind, _) = match spec {
+        MotorSpec::Constant(m) => {
+            v.in_range(
+                &format!("{base}/efficiency"),
+                m.efficiency,
+                MIN_EFFICIENCY,
+                1.0,
+            );
+            let (env, w) = envelope(
+                v,
+                &base,
+                m.t_peak_nm,
+                m.p_peak_w,
+                m.n_max_rpm,
+                m.envelope.as_ref(),
+            );
+            (
+                MotorKind::Constant {
+                    eta: m.efficiency,
+                    envelope: env,
+                },
+                w,
+            )
+        }
+        MotorSpec::EfficiencyMap(m) => {
+            let (env, w) = envelope(
+                v,
+                &base,
+                m.t_peak_nm,
+                m.p_peak_w,
+                m.n_max_rpm,
+                m.envelope.as_ref(),
+            );
+            let ok_s = axis(v, &format!("{base}/speed_rpm"), &m.speed_rpm, 2, 0.0, 1e5);
+            let ok_t = axis(v, &format!("{base}/torque_nm"), &m.torque_nm, 2, 0.0, 1e6);
+            let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
+            let mut ok = ok_s && ok_t;
+            if ok {
+                ok &= table(
+                    v,
+                    &format!("{base}/efficiency"),
+                    &m.efficiency,
+                    (ns, nt),
+                    (MIN_MAP_EFFICIENCY, 1.0, false),
+                );
+                if let Some(g) = &m.efficiency_gen {
+                    ok &= table(
+                        v,
+                        &format!("{base}/efficiency_gen"),
+                        g,
+                        (ns, nt),
+                        (MIN_MAP_EFFICIENCY, 1.0, false),
+                    );
+                }
+            }
+            let loss = if ok {
+                let speed: Vec<f64> = m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect();
+                let conv = efficiency_to_loss(
+                    &speed,
+                    &m.torque_nm,
+                    &m.efficiency,
+                    m.efficiency_gen.as_deref(),
+                );
+                warnings.extend(conv.warnings);
+                conv.loss
+            } else {
+                Grid2 {
+                    speed: vec![],
+                    torque: vec![],
+                    values: vec![],
+                }
+            };
+            if ok {
+                map_axis_warning(&loss, &env, &mut warnings);
+            }
+            let w_map = m.speed_rpm.last().map_or(0.0, |&n| rpm_to_rad_s(n));
+            (
+                MotorKind::Map {
+                    loss,
+                    envelope: env,
+                },
+                w.min(w_map),
+            )
+        }
+        MotorSpec::LossMap(m) => {
+            let (env, w) = envelope(
+                v,
+                &base,
+                m.t_peak_nm,
+                m.p_peak_w,
+                m.n_max_rpm,
+                m.envelope.as_ref(),
+            );
+            let ok_s = axis(v, &format!("{base}/speed_rpm"), &m.speed_rpm, 2, 0.0, 1e5);
+            let ok_t = axis(
+                v,
+                &format!("{base}/torque_nm"),
+                &m.torque_nm,
+                2,
+                f64::NEG_INFINITY,
+                1e6,
+            );
+            if ok_t && !m.torque_nm.iter().any(|&t| t.abs() <= 0.0) {
+                v.push(
+                    format!("{base}/torque_nm"),
+                    "signed torque axis must contain 0".to_owned(),
+                );
+            }
+            let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
+            let ok = ok_s
+                && ok_t
+                && table(
+                    v,
+                    &format!("{base}/loss_w"),
+                    &m.loss_w,
+                    (ns, nt),
+                    (0.0, 1e9, false),
+                );
+            let loss = Grid2 {
+                speed: m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
+                torque: m.torque_nm.clone(),
+                values: if ok {
+                    m.loss_w.iter().flatten().copied().collect()
+                } else {
+                    vec![]
+                },
+            };
+            if ok {
+                map_axis_warning(&loss, &env, &mut warnings);
+            }
+            let w_map = m.speed_rpm.last().map_or(0.0, |&n| rpm_to_rad_s(n));
+            (
+                MotorKind::Map {
+                    loss,
+                    envelope: env,
+                },
+                w.min(w_map),
+            )
+        }
+        MotorSpec::Ipmsm(m) => {
+            let im = ipmsm(v, &base, m);
+            let w = im.omega_max;
+            (MotorKind::Ipmsm(Box::new(im)), w)
+        }
+    };
+    // The admissible speed in rpm as given (axes of maps are built from it without a round trip).
+    let n_max_rpm = match spec {
+        MotorSpec::Constant(m) => m.n_max_rpm.unwrap_or(DEFAULT_N_MAX),
+        MotorSpec::EfficiencyMap(m) => m
+            .n_max_rpm
+            .unwrap_or(DEFAULT_N_MAX)
+            .min(m.speed_rpm.last().copied().unwrap_or(0.0)),
+        MotorSpec::LossMap(m) => m
+            .n_max_rpm
+            .unwrap_or(DEFAULT_N_MAX)
+            .min(m.speed_rpm.last().copied().unwrap_or(0.0)),
+        MotorSpec::Ipmsm(m) => m.n_max_rpm,
+    };
+    MotorInput {
+        id: spec.id().to_owned(),
+        kind,
+        omega_max: rpm_to_rad_s(n_max_rpm),
+        n_max_rpm,
+        warnings,
+    }
+}
+
+fn grid(v: &mut Validator, ptr: &str, g: &GridSpec) -> (f64, f64) {
+    v.in_range(&format!("{ptr}/speed_step_rpm"), g.speed_step_rpm, 1.0, 1e4);
+    v.in_range(&format!("{ptr}/torque_step_nm"), g.torque_step_nm, 0.1, 1e4);
+    (g.speed_step_rpm, g.torque_step_nm)
+}
+
+/// Validate a motor on its own (motor-map endpoint).
+///
+/// # Errors
+/// Every offending field, as one [`CalcFailure`].
+pub fn validate_motor(
+    spec: &MotorSpec,
+    g: &GridSpec,
+) -> Result<(MotorInput, (f64, f64)), CalcFailure> {
+    let mut v = Validator::new();
+    let m = motor(&mut v, 0, spec);
+    let gr = grid(&mut v, "/grid", g);
+    v.finish().map_err(|mut e| {
+        for issue in &mut e.errors {
+            issue.pointer = issue.pointer.replacen("/motors/0", "/motor", 1);
+        }
+        e.detail = e.detail.replacen("/motors/0", "/motor", 1);
+        e
+    })?;
+    Ok((m, gr))
+}
+
+impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
+    type Error = CalcFailure;
+
+    fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
+        let mut v = Validator::new();
+        let veh = vehicle(&mut v, &req.vehicle);
+        v.in_range(
+            "/inverter/efficiency",
+            req.inverter.efficiency,
+            MIN_EFFICIENCY,
+            1.0,
+        );
+        let bat = battery(&mut v, &req.battery);
+
+        // Cycles.
+        if req.cycles.is_empty() || req.cycles.len() > MAX_CYCLES {
+            v.push(
+                "/cycles",
+                format!(
+                    "must have 1..{MAX_CYCLES} entries, got {}",
+                    req.cycles.len()
+                ),
+            );
+        }
+        let mut cycles_ok: Vec<(usize, Cycle)> = Vec::new();
+        for (j, c) in req.cycles.iter().enumerate().take(MAX_CYCLES) {
+            if let Some(cy) = cycle(&mut v, j, c) {
+                if cy.distance_m() <= 0.0 {
+                    v.push(
+                        format!("/cycles/{j}"),
+                        format!(
+                            "cycle '{}' has zero distance (fuel economy undefined)",
+                            cy.name
+                        ),
+                    );
+                } else if let Some((k, _)) = cycles_ok.iter().find(|(_, o)| o.name == cy.name) {
+                    v.push(
+                        format!("/cycles/{j}"),
+                        format!("duplicate cycle name '{}' (also /cycles/{k})", cy.name),
+                    );
+                }
+                cycles_ok.push((j, cy));
+            }
+        }
+
+        // Motors.
+        if req.motors.is_empty() || req.motors.len() > MAX_MOTORS {
+            v.push(
+                "/motors",
+                format!(
+                    "must have 1..{MAX_MOTORS} entries, got {}",
+                    req.motors.len()
+                ),
+            );
+        }
+        let mut motors = Vec::new();
+        for (i, m) in req.motors.iter().enumerate().take(MAX_MOTORS) {
+            if let Some(k) = req.motors[..i].iter().position(|o| o.id() == m.id()) {
+                v.push(
+                    format!("/motors/{i}/id"),
+                    format!("duplicate motor id '{}' (also /motors/{k})", m.id()),
+                );
+            }
+            motors.push(motor(&mut v, i, m));
+        }
+
+        // Options.
+        let o = &req.options;
+        if !(1..=32).contains(&o.substeps) {
+            v.push(
+                "/options/substeps",
+                format!("must be in [1, 32], got {}", o.substeps),
+            );
+        }
+        let gr = grid(&mut v, "/options/loss_map_grid", &o.loss_map_grid);
+        v.in_range(
+            "/options/op_histogram/speed_bin_rpm",
+            o.op_histogram.speed_bin_rpm,
+            1.0,
+            1e5,
+        );
+        v.in_range(
+            "/options/op_histogram/torque_bin_nm",
+            o.op_histogram.torque_bin_nm,
+            0.1,
+            1e5,
+        );
+        let n_cyc = req.cycles.len().max(1);
+        let weights = match &o.desirability_weights {
+            None => vec![1.0 / n_cyc as f64; n_cyc],
+            Some(w) => {
+                let p = "/options/desirability_weights";
+                if w.len() != req.cycles.len() {
+                    v.push(
+                        p,
+                        format!(
+                            "must have one weight per cycle ({}), got {}",
+                            req.cycles.len(),
+                            w.len()
+                        ),
+                    );
+                    vec![1.0 / n_cyc as f64; n_cyc]
+                } else if !v.all_finite(p, w) {
+                    vec![1.0 / n_cyc as f64; n_cyc]
+                } else if let Some(i) = w.iter().position(|&x| !(0.0..=1e6).contains(&x)) {
+                    v.push(
+                        format!("{p}/{i}"),
+                        format!("must be in [0, 1000000], got {}", w[i]),
+                    );
+                    vec![1.0 / n_cyc as f64; n_cyc]
+                } else {
+                    let s: f64 = w.iter().sum();
+                    if s > 0.0 {
+                        w.iter().map(|x| x / s).collect()
+                    } else {
+                        v.push(p, "weights must not all be 0".to_owned());
+                        vec![1.0 / n_cyc as f64; n_cyc]
+                    }
+                }
+            }
+        };
+
+        // Cycle speed vs motor speed limit (spec §3.7, §8 item 4).
+        for (i, m) in motors.iter().enumerate() {
+            for (j, c) in &cycles_ok {
+                let w_need = veh.motor_speed(c.max_speed_mps());
+                if w_need.is_finite() && w_need > m.omega_max * (1.0 + SPEED_CHECK_SLACK) {
+                    let field = match req.motors.get(i) {
+                        Some(MotorSpec::EfficiencyMap(_) | MotorSpec::LossMap(_)) => {
+                            "n_max_rpm (or the map's last speed_rpm)"
+                        }
+                        _ => "n_max_rpm",
+                    };
+                    v.push(
+                        format!("/motors/{i}/n_max_rpm"),
+                        format!(
+                            "cycle '{}' (/cycles/{j}) needs {:.1} rpm at its top speed {:.3} km/h, above the motor's {field} {:.1} rpm",
+                            c.name,
+                            super::ipmsm::rad_s_to_rpm(w_need),
+                            c.max_speed_mps() * 3.6,
+                            super::ipmsm::rad_s_to_rpm(m.omega_max)
+                        ),
+                    );
+                }
+            }
+        }
+        v.finish()?;
+
+        let substeps = usize::try_from(o.substeps).unwrap_or(1);
+        let total: usize = cycles_ok.iter().map(|(_, c)| c.intervals(substeps)).sum();
+        if total > MAX_TOTAL_INTERVALS {
+            return Err(CalcFailure::field(
+                ProblemClass::TooLarge,
+                "TOO_MANY_SAMPLES",
+                "/options/substeps",
+                format!(
+                    "{total} intervals after sub-stepping exceed the limit {MAX_TOTAL_INTERVALS}"
+                ),
+            ));
+        }
+        let has = |k: OutputKind| o.outputs.contains(&k);
+        Ok(Self {
+            vehicle: veh,
+            grade: req.vehicle.grade,
+            inverter_eff: req.inverter.efficiency,
+            battery: bat,
+            cycles: cycles_ok.into_iter().map(|(_, c)| c).collect(),
+            motors,
+            options: Options {
+                mode: o.mode,
+                convention: o.power_convention,
+                substeps,
+                regen: o.regen,
+                regen_limit: o.regen_limit,
+                motor_eval: o.motor_eval.unwrap_or(MotorEval::LossMap),
+                grid: gr,
+                breakdown: has(OutputKind::LossBreakdown),
+                histogram: has(OutputKind::OpHistogram),
+                traces: has(OutputKind::Traces),
+                efficiency_map: has(OutputKind::EfficiencyMap),
+                hist_bins: (o.op_histogram.speed_bin_rpm, o.op_histogram.torque_bin_nm),
+                weights,
+            },
+        })
+    }
+}

@@ -1,0 +1,899 @@
+//! Wire types of `POST /v1/bus-fuel-economy` and `POST /v1/bus-fuel-economy/motor-map`
+//! (spec §3, §6 and §10; the JSON example of §10 is the contract).
+//!
+//! Deviations from the §10 example, all additive: every result also carries `n_intervals`,
+//! `max_speed_kmh`, `n_regen_limited` and `n_envelope_fallback`; the response carries a solver
+//! `report`; `comparison` names its `reference_motor`, the cycle order of `d` and the weights.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::numerics::SolverReport;
+
+// ---------------------------------------------------------------------------------------------
+// Request
+// ---------------------------------------------------------------------------------------------
+
+/// Drive-cycle energy and fuel economy of a battery-electric bus for 1..8 motors over 1..16 cycles.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BusFuelEconomyRequest {
+    /// Vehicle (defaults: the paper's 12 m bus, Tables 2-3).
+    #[serde(default)]
+    pub vehicle: VehicleSpec,
+    /// Inverter (η_Inv).
+    #[serde(default)]
+    pub inverter: InverterSpec,
+    /// Battery model (default: constant efficiency 1).
+    #[serde(default)]
+    pub battery: BatterySpec,
+    /// Drive cycles: built-in names `manhattan`, `hwfet`, `hdudds` or custom traces (1..16).
+    pub cycles: Vec<CycleSpec>,
+    /// Traction motors to compare (1..8); the first is the reference of `fe_change_pct`.
+    pub motors: Vec<MotorSpec>,
+    /// Simulation options.
+    #[serde(default)]
+    pub options: OptionsSpec,
+}
+
+/// Vehicle of the backward longitudinal model (§3.1, paper eq. 4-5).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct VehicleSpec {
+    /// Curb mass [kg].
+    #[schema(minimum = 0.0, maximum = 100000.0, example = 12500.0)]
+    pub curb_mass_kg: f64,
+    /// Number of passengers [-] (0..500).
+    #[schema(minimum = 0, maximum = 500, example = 40)]
+    pub passengers: u32,
+    /// Mass per passenger [kg].
+    #[schema(minimum = 0.0, maximum = 200.0, example = 65.0)]
+    pub mass_per_passenger_kg: f64,
+    /// Frontal area A_F [m²].
+    #[schema(minimum = 0.0, maximum = 30.0, example = 6.72)]
+    pub frontal_area_m2: f64,
+    /// Aerodynamic drag coefficient C_d [-].
+    #[schema(minimum = 0.0, maximum = 3.0, example = 0.7)]
+    pub drag_coeff: f64,
+    /// Rolling resistance coefficient f_R [-].
+    #[schema(minimum = 0.0, maximum = 0.1, example = 0.007)]
+    pub rolling_coeff: f64,
+    /// Air density ρ_air [kg/m³].
+    #[schema(minimum = 0.0, maximum = 2.0, example = 1.28)]
+    pub air_density: f64,
+    /// Gravitational acceleration g [m/s²].
+    #[schema(minimum = 9.0, maximum = 10.5, example = 9.81)]
+    pub gravity: f64,
+    /// Wheel radius r [m].
+    #[schema(minimum = 0.1, maximum = 2.0, example = 0.48)]
+    pub wheel_radius_m: f64,
+    /// Single fixed reduction ratio i_g [-] (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 50.0, example = 9.5)]
+    pub gear_ratio: f64,
+    /// Gear efficiency η_T [-], applied in both power directions (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 0.95)]
+    pub gear_efficiency: f64,
+    /// Rotational inertia factor δ [-]: effective mass m(1+δ).
+    #[schema(minimum = 0.0, maximum = 1.0, example = 0.0)]
+    pub rotational_inertia_factor: f64,
+    /// Constant road slope tanθ [-] (a custom cycle's own `grade` array replaces it).
+    #[schema(minimum = -0.3, maximum = 0.3, example = 0.0)]
+    pub grade: f64,
+    /// Constant auxiliary DC load [W].
+    #[schema(minimum = 0.0, maximum = 100000.0, example = 0.0)]
+    pub aux_power_w: f64,
+}
+
+impl Default for VehicleSpec {
+    fn default() -> Self {
+        Self {
+            curb_mass_kg: 12_500.0,
+            passengers: 40,
+            mass_per_passenger_kg: 65.0,
+            frontal_area_m2: 6.72,
+            drag_coeff: 0.7,
+            rolling_coeff: 0.007,
+            air_density: 1.28,
+            gravity: 9.81,
+            wheel_radius_m: 0.48,
+            gear_ratio: 9.5,
+            gear_efficiency: 0.95,
+            rotational_inertia_factor: 0.0,
+            grade: 0.0,
+            aux_power_w: 0.0,
+        }
+    }
+}
+
+/// Inverter (§3.2).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct InverterSpec {
+    /// Inverter efficiency η_Inv [-], applied in both power directions (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 0.95)]
+    pub efficiency: f64,
+}
+
+impl Default for InverterSpec {
+    fn default() -> Self {
+        Self { efficiency: 0.95 }
+    }
+}
+
+/// Battery model selector (§3.3).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum BatteryModel {
+    /// Constant efficiency η_Bat in both directions.
+    #[default]
+    Constant,
+    /// Two-RC equivalent circuit (paper eq. 7-10, discharge-positive current).
+    #[serde(rename = "ecm_2rc")]
+    Ecm2rc,
+}
+
+/// Battery (§3.3). Fields of the other model are rejected.
+#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BatterySpec {
+    /// `constant` (default) or `ecm_2rc`.
+    #[serde(default)]
+    pub model: BatteryModel,
+    /// constant: battery efficiency η_Bat [-] (default 1.0, service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 1.0)]
+    pub efficiency: Option<f64>,
+    /// ecm_2rc: nominal voltage [V] (default 360), used for the charge capacity Q.
+    #[schema(minimum = 0.0, maximum = 5000.0, example = 360.0)]
+    pub nominal_voltage: Option<f64>,
+    /// ecm_2rc: energy capacity [kWh] (default 256).
+    #[schema(minimum = 0.0, maximum = 10000.0, example = 256.0)]
+    pub capacity_kwh: Option<f64>,
+    /// ecm_2rc: initial state of charge (0, 1] [-].
+    #[schema(minimum = 0.0, maximum = 1.0, example = 0.9)]
+    pub soc_initial: Option<f64>,
+    /// ecm_2rc: SOC points of the open-circuit-voltage table, strictly increasing in [0, 1].
+    pub ocv_soc: Option<Vec<f64>>,
+    /// ecm_2rc: open-circuit voltage at `ocv_soc` [V] (> 0).
+    pub ocv_v: Option<Vec<f64>>,
+    /// ecm_2rc: series resistance R0 [Ω] (> 0).
+    #[schema(minimum = 0.0, maximum = 100.0, example = 0.03)]
+    pub r0_ohm: Option<f64>,
+    /// ecm_2rc: first RC branch resistance R1 [Ω] (≥ 0).
+    #[schema(minimum = 0.0, maximum = 100.0, example = 0.01)]
+    pub r1_ohm: Option<f64>,
+    /// ecm_2rc: first RC branch capacitance C1 [F] (> 0).
+    #[schema(minimum = 0.0, example = 3000.0)]
+    pub c1_f: Option<f64>,
+    /// ecm_2rc: second RC branch resistance R2 [Ω] (≥ 0).
+    #[schema(minimum = 0.0, maximum = 100.0, example = 0.01)]
+    pub r2_ohm: Option<f64>,
+    /// ecm_2rc: second RC branch capacitance C2 [F] (> 0).
+    #[schema(minimum = 0.0, example = 30000.0)]
+    pub c2_f: Option<f64>,
+}
+
+/// A drive cycle: a built-in name or a custom trace (§3.4).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(untagged)]
+pub enum CycleSpec {
+    /// Built-in cycle: `manhattan`, `hwfet` or `hdudds`.
+    Builtin(String),
+    /// Custom speed-vs-time trace.
+    Custom(CustomCycle),
+}
+
+/// A custom speed trace: 2..200 000 samples, time steps in [0.001, 60] s, speeds in [0, 200] m/s.
+/// Give exactly one of `speed_kmh` and `speed_mps`.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CustomCycle {
+    /// Cycle name (unique in the request, 1..64 characters).
+    pub name: String,
+    /// Sample times [s].
+    pub time_s: Vec<f64>,
+    /// Sample speeds [km/h].
+    pub speed_kmh: Option<Vec<f64>>,
+    /// Sample speeds [m/s].
+    pub speed_mps: Option<Vec<f64>>,
+    /// Road slope tanθ per sample [-] in [-0.3, 0.3] (replaces the vehicle's `grade`).
+    pub grade: Option<Vec<f64>>,
+}
+
+/// Torque envelope given as a table: T_max linear in speed, held constant outside the table.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EnvelopeTable {
+    /// Speeds [rpm], strictly increasing, first ≥ 0.
+    pub speed_rpm: Vec<f64>,
+    /// Maximum motor torque at `speed_rpm` [N·m] (> 0).
+    pub t_max_nm: Vec<f64>,
+}
+
+/// Traction motor (§3.5), selected by `model`.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(tag = "model", rename_all = "snake_case")]
+pub enum MotorSpec {
+    /// Constant efficiency η_M.
+    Constant(ConstantMotor),
+    /// Efficiency map η(n, T); converted to a loss map at its own grid points (§8 item 2).
+    EfficiencyMap(EfficiencyMapMotor),
+    /// Total loss map P_loss(n, T) (recommended map form).
+    LossMap(LossMapMotor),
+    /// Parametric dq interior-PM synchronous motor (§5.5 item 4).
+    Ipmsm(IpmsmMotor),
+}
+
+impl MotorSpec {
+    /// The motor's `id`.
+    #[must_use]
+    pub fn id(&self) -> &str {
+        match self {
+            Self::Constant(m) => &m.id,
+            Self::EfficiencyMap(m) => &m.id,
+            Self::LossMap(m) => &m.id,
+            Self::Ipmsm(m) => &m.id,
+        }
+    }
+}
+
+/// Constant-efficiency motor with a torque/power envelope.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantMotor {
+    /// Motor name (unique in the request, 1..64 characters).
+    pub id: String,
+    /// Motor efficiency η_M [-], both directions (service minimum 0.01).
+    #[schema(minimum = 0.01, maximum = 1.0, example = 0.93)]
+    pub efficiency: f64,
+    /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
+    #[schema(minimum = 0.0, example = 800.0)]
+    pub t_peak_nm: Option<f64>,
+    /// Peak power [W] (default 130 000; ignored when `envelope` is given).
+    #[schema(minimum = 0.0, example = 130000.0)]
+    pub p_peak_w: Option<f64>,
+    /// Maximum speed [rpm] (default 5200); a cycle needing more is rejected.
+    #[schema(minimum = 0.0, maximum = 100000.0, example = 5200.0)]
+    pub n_max_rpm: Option<f64>,
+    /// Explicit torque envelope (replaces `t_peak_nm` / `p_peak_w`).
+    #[schema(nullable = false)]
+    pub envelope: Option<EnvelopeTable>,
+}
+
+/// Motor given by an efficiency map (motoring, optional generating table).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EfficiencyMapMotor {
+    /// Motor name (unique in the request, 1..64 characters).
+    pub id: String,
+    /// Speed axis [rpm]: strictly increasing, ≥ 2 points, first ≥ 0.
+    pub speed_rpm: Vec<f64>,
+    /// Torque axis [N·m]: strictly increasing, ≥ 2 points, first ≥ 0.
+    pub torque_nm: Vec<f64>,
+    /// Efficiency η[speed][torque] in [1e-6, 1] (motoring).
+    pub efficiency: Vec<Vec<f64>>,
+    /// Generating efficiency at −torque_nm, same shape (default: mirror of `efficiency`).
+    pub efficiency_gen: Option<Vec<Vec<f64>>>,
+    /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
+    pub t_peak_nm: Option<f64>,
+    /// Peak power [W] (default 130 000; ignored when `envelope` is given).
+    pub p_peak_w: Option<f64>,
+    /// Maximum speed [rpm] (default 5200).
+    pub n_max_rpm: Option<f64>,
+    /// Explicit torque envelope.
+    #[schema(nullable = false)]
+    pub envelope: Option<EnvelopeTable>,
+}
+
+/// Motor given by a total-loss map.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LossMapMotor {
+    /// Motor name (unique in the request, 1..64 characters).
+    pub id: String,
+    /// Speed axis [rpm]: strictly increasing, ≥ 2 points, first ≥ 0.
+    pub speed_rpm: Vec<f64>,
+    /// Signed torque axis [N·m]: strictly increasing, ≥ 2 points, must contain 0.
+    pub torque_nm: Vec<f64>,
+    /// Total motor loss P_loss[speed][torque] [W] (≥ 0).
+    pub loss_w: Vec<Vec<f64>>,
+    /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
+    pub t_peak_nm: Option<f64>,
+    /// Peak power [W] (default 130 000; ignored when `envelope` is given).
+    pub p_peak_w: Option<f64>,
+    /// Maximum speed [rpm] (default 5200).
+    pub n_max_rpm: Option<f64>,
+    /// Explicit torque envelope.
+    #[schema(nullable = false)]
+    pub envelope: Option<EnvelopeTable>,
+}
+
+/// Back-EMF measurement from which ψ_m is derived: ψ_m = V_peak_phase / (p·2π·at_rpm/60).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BackEmf {
+    /// Peak phase back-EMF [V].
+    #[schema(minimum = 0.0, example = 83.3)]
+    pub v_peak_phase: f64,
+    /// Speed of the measurement [rpm].
+    #[schema(minimum = 0.0, example = 1000.0)]
+    pub at_rpm: f64,
+}
+
+/// AC resistance factor k_AC(f_e, T_w) of the winding (§5.5 item 4).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(tag = "model", rename_all = "snake_case")]
+pub enum AcFactorSpec {
+    /// k_AC = 1.
+    #[serde(rename = "none")]
+    NoAc(NoAcFactor),
+    /// Measured or FEA k_AC(f), linear in f, clamped at the ends.
+    Table(AcFactorTable),
+    /// Layer-averaged Dowell factor of the slot part; end winding free of AC effect.
+    Dowell(DowellSpec),
+}
+
+/// No AC effect (k_AC = 1).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct NoAcFactor {}
+
+/// k_AC table.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AcFactorTable {
+    /// Electrical frequencies [Hz], strictly increasing, ≥ 0.
+    pub freq_hz: Vec<f64>,
+    /// k_AC at `freq_hz` [-] (≥ 1).
+    pub k_ac: Vec<f64>,
+}
+
+/// Dowell parameters (rectangular conductors in layers).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DowellSpec {
+    /// Conductor height h in the slot-depth direction [m].
+    #[schema(minimum = 0.0, maximum = 0.1, example = 0.0035)]
+    pub conductor_height_m: f64,
+    /// Number of conductor layers m in the slot [-] (1..100).
+    #[schema(minimum = 1, maximum = 100, example = 6)]
+    pub layers: u32,
+    /// Layer porosity factor (0, 1] [-].
+    #[schema(minimum = 0.0, maximum = 1.0, example = 0.9)]
+    pub porosity: f64,
+    /// Active (slot) length of the winding per side L_stack [m].
+    #[schema(minimum = 0.0, maximum = 10.0, example = 0.083)]
+    pub stack_length_m: f64,
+    /// End-winding length per side L_end [m] (≥ 0).
+    #[schema(minimum = 0.0, maximum = 10.0, example = 0.05)]
+    pub end_length_m: f64,
+}
+
+/// Iron loss P_fe = (k_h ω_e + k_e ω_e²)·|ψ|².
+#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct IronSpec {
+    /// Hysteresis coefficient k_h [W/(Wb²·rad/s)] (≥ 0).
+    #[schema(minimum = 0.0, example = 3.0)]
+    pub k_h: f64,
+    /// Eddy-current coefficient k_e [W/(Wb²·(rad/s)²)] (≥ 0).
+    #[schema(minimum = 0.0, example = 0.03)]
+    pub k_e: f64,
+}
+
+/// Mechanical loss P_mech = c_fric ω_m + c_wind ω_m³.
+#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct MechSpec {
+    /// Friction torque [N·m] (≥ 0).
+    #[schema(minimum = 0.0, example = 0.0)]
+    pub c_fric_nm: f64,
+    /// Windage coefficient [W·s³/rad³] (≥ 0).
+    #[schema(minimum = 0.0, example = 0.0)]
+    pub c_wind: f64,
+}
+
+/// Parametric IPMSM (amplitude-invariant dq model, peak values; §5.5 item 4).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct IpmsmMotor {
+    /// Motor name (unique in the request, 1..64 characters).
+    pub id: String,
+    /// Pole pairs p (1..32).
+    #[schema(minimum = 1, maximum = 32, example = 4)]
+    pub pole_pairs: u32,
+    /// Peak phase PM flux linkage ψ_m [Wb] (give this or `back_emf`).
+    #[schema(minimum = 0.0, maximum = 100.0, example = 0.198864)]
+    pub psi_m_wb: Option<f64>,
+    /// Back-EMF from which ψ_m is derived (give this or `psi_m_wb`).
+    #[schema(nullable = false)]
+    pub back_emf: Option<BackEmf>,
+    /// d-axis inductance L_d [H] (> 0).
+    #[schema(minimum = 0.0, maximum = 1.0, example = 0.00035)]
+    pub ld_h: f64,
+    /// q-axis inductance L_q [H] (≥ L_d).
+    #[schema(minimum = 0.0, maximum = 1.0, example = 0.00055)]
+    pub lq_h: f64,
+    /// Phase resistance at 20 °C R_20 [Ω] (> 0).
+    #[schema(minimum = 0.0, maximum = 100.0, example = 0.006)]
+    pub r_phase_20c_ohm: f64,
+    /// Winding temperature T_w [°C] (default 100).
+    #[schema(minimum = -40.0, maximum = 250.0, example = 100.0)]
+    pub winding_temp_c: Option<f64>,
+    /// Current limit [A rms] (I_pk = √2·i_max_arms).
+    #[schema(minimum = 0.0, maximum = 100000.0, example = 500.0)]
+    pub i_max_arms: f64,
+    /// DC-link voltage V_dc [V].
+    #[schema(minimum = 0.0, maximum = 100000.0, example = 360.0)]
+    pub v_dc: f64,
+    /// Voltage utilisation (0, 1.155] [-] (default 1.0 → V_max = V_dc/√3).
+    #[schema(minimum = 0.0, maximum = 1.155, example = 1.0)]
+    pub voltage_utilization: Option<f64>,
+    /// Maximum speed [rpm]; a cycle needing more is rejected.
+    #[schema(minimum = 0.0, maximum = 100000.0, example = 5200.0)]
+    pub n_max_rpm: f64,
+    /// Torque cap [N·m] (default none).
+    #[schema(minimum = 0.0, example = 800.0)]
+    pub t_cap_nm: Option<f64>,
+    /// Power cap [W] (default none).
+    #[schema(minimum = 0.0, example = 130000.0)]
+    pub p_cap_w: Option<f64>,
+    /// AC resistance factor model (default `none`).
+    #[schema(nullable = false)]
+    pub ac_factor: Option<AcFactorSpec>,
+    /// Iron-loss coefficients (default 0).
+    #[schema(nullable = false)]
+    pub iron: Option<IronSpec>,
+    /// Mechanical-loss coefficients (default 0).
+    #[schema(nullable = false)]
+    pub mech: Option<MechSpec>,
+    /// Stack-length scale s (paper §3.2; needs the `dowell` AC model for the slot/end split).
+    /// Not validated against data.
+    #[schema(minimum = 0.0, maximum = 10.0, example = 1.0)]
+    pub stack_scale: Option<f64>,
+}
+
+/// Handling of traction demand above the motor envelope (§5.4).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Follow the trace exactly; losses evaluated at the envelope; exceedances counted.
+    #[default]
+    Backward,
+    /// Clip the motor torque to the envelope (missing traction dropped; energy-optimistic).
+    Clip,
+    /// Trace miss: the bus accelerates at the envelope and falls behind (FASTSim-like).
+    Forward,
+}
+
+/// Motor terminal power convention (§5.6).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PowerConvention {
+    /// Paper eq. 2-3: P_el = P_m/η motoring, P_m·η generating, 0 at zero power.
+    #[default]
+    Paper,
+    /// Additive losses: P_el = P_m + P_loss in both directions.
+    Loss,
+}
+
+/// How an `ipmsm` motor's loss is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum MotorEval {
+    /// Solve the dq operating point at every interval (accuracy reference).
+    Direct,
+    /// Precompute a loss map on `loss_map_grid`, interpolate bilinearly (default).
+    LossMap,
+}
+
+/// Optional, costly outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum OutputKind {
+    /// Energy per loss mechanism and mean motor efficiency.
+    LossBreakdown,
+    /// Time share per speed × torque bin over moving intervals (Fig. 15 style).
+    OpHistogram,
+    /// Per-interval traces (large).
+    Traces,
+    /// Per-motor efficiency map on `loss_map_grid`.
+    EfficiencyMap,
+}
+
+/// Grid of a precomputed loss / efficiency map.
+#[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GridSpec {
+    /// Speed step [rpm].
+    #[schema(minimum = 1.0, maximum = 10000.0, example = 250.0)]
+    pub speed_step_rpm: f64,
+    /// Torque step [N·m].
+    #[schema(minimum = 0.1, maximum = 10000.0, example = 50.0)]
+    pub torque_step_nm: f64,
+}
+
+impl Default for GridSpec {
+    fn default() -> Self {
+        Self {
+            speed_step_rpm: 250.0,
+            torque_step_nm: 50.0,
+        }
+    }
+}
+
+/// Bins of the operating-point histogram.
+#[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HistogramSpec {
+    /// Speed bin width [rpm].
+    #[schema(minimum = 1.0, maximum = 100000.0, example = 500.0)]
+    pub speed_bin_rpm: f64,
+    /// Torque bin width [N·m].
+    #[schema(minimum = 0.1, maximum = 100000.0, example = 100.0)]
+    pub torque_bin_nm: f64,
+}
+
+impl Default for HistogramSpec {
+    fn default() -> Self {
+        Self {
+            speed_bin_rpm: 500.0,
+            torque_bin_nm: 100.0,
+        }
+    }
+}
+
+/// Simulation options (§3.6).
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OptionsSpec {
+    /// Envelope policy: `backward` (default), `clip` or `forward`.
+    #[serde(default)]
+    pub mode: Mode,
+    /// `paper` (default, eq. 2-3) or `loss` (additive losses).
+    #[serde(default)]
+    pub power_convention: PowerConvention,
+    /// Split each cycle interval into k equal pieces (1..32; accuracy knob; default 1).
+    #[serde(default = "default_substeps")]
+    #[schema(minimum = 1, maximum = 32, example = 1)]
+    pub substeps: u32,
+    /// Allow regenerative braking (default true).
+    #[serde(default = "default_true")]
+    pub regen: bool,
+    /// Clip generating torque to −T_max(ω); the rest goes to the friction brakes (default true).
+    #[serde(default = "default_true")]
+    pub regen_limit: bool,
+    /// `direct` or `loss_map` (default) evaluation of `ipmsm` motors.
+    #[serde(default)]
+    #[schema(nullable = false)]
+    pub motor_eval: Option<MotorEval>,
+    /// Grid of the precomputed ipmsm loss map and of the `efficiency_map` output
+    /// (default 250 rpm × 50 N·m).
+    #[serde(default)]
+    pub loss_map_grid: GridSpec,
+    /// Optional outputs: `loss_breakdown`, `op_histogram`, `traces`, `efficiency_map`.
+    #[serde(default)]
+    pub outputs: Vec<OutputKind>,
+    /// Bins of the `op_histogram` output (default 500 rpm × 100 N·m).
+    #[serde(default)]
+    pub op_histogram: HistogramSpec,
+    /// Desirability weights per cycle (≥ 0, normalised; default equal, paper w1 = w2 = w3).
+    #[serde(default)]
+    pub desirability_weights: Option<Vec<f64>>,
+}
+
+fn default_substeps() -> u32 {
+    1
+}
+
+fn default_true() -> bool {
+    true
+}
+
+impl Default for OptionsSpec {
+    fn default() -> Self {
+        Self {
+            mode: Mode::Backward,
+            power_convention: PowerConvention::Paper,
+            substeps: 1,
+            regen: true,
+            regen_limit: true,
+            motor_eval: None,
+            loss_map_grid: GridSpec::default(),
+            outputs: Vec::new(),
+            op_histogram: HistogramSpec::default(),
+            desirability_weights: None,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Response
+// ---------------------------------------------------------------------------------------------
+
+/// Result of `POST /v1/bus-fuel-economy`.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct BusFuelEconomyResponse {
+    /// One entry per motor × cycle (motor-major, request order).
+    pub results: Vec<CycleResult>,
+    /// Relative FE change and desirability (only with ≥ 2 motors).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub comparison: Option<Comparison>,
+    /// Efficiency maps per motor (only with `outputs: ["efficiency_map"]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub motor_maps: Option<Vec<MotorMapData>>,
+    /// Settings used.
+    pub echo: Echo,
+    /// Work done and how the run stopped.
+    pub report: SolverReport,
+}
+
+/// Result of one motor over one cycle (§6).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct CycleResult {
+    /// Motor id.
+    pub motor: String,
+    /// Cycle name.
+    pub cycle: String,
+    /// Distance driven D [km] (achieved distance in `forward` mode).
+    pub distance_km: f64,
+    /// Cycle duration [s].
+    pub duration_s: f64,
+    /// Highest trace speed [km/h].
+    pub max_speed_kmh: f64,
+    /// Number of simulated intervals (after sub-stepping).
+    pub n_intervals: u64,
+    /// Energy drawn from the battery E_in (net; chemical side for `ecm_2rc`) [kWh].
+    pub energy_in_kwh: f64,
+    /// Σ of positive battery power × Δt [kWh].
+    pub energy_traction_kwh: f64,
+    /// Σ of negative battery power × Δt (≤ 0) [kWh].
+    pub energy_regen_kwh: f64,
+    /// Fuel economy FE = D / E_in [km/kWh] (paper eq. 1); null when E_in ≤ 0.
+    pub fe_km_per_kwh: Option<f64>,
+    /// Consumption E_in / D [kWh/km].
+    pub consumption_kwh_per_km: f64,
+    /// Intervals whose motoring torque demand exceeds the envelope T_max(ω) + 1e-9.
+    pub n_over_envelope: u64,
+    /// n_over_envelope / n_intervals.
+    pub frac_over_envelope: f64,
+    /// Intervals whose generating torque was limited to −T_max(ω) (`regen_limit`).
+    pub n_regen_limited: u64,
+    /// Intervals where the dq operating point could not be solved inside the envelope and the
+    /// envelope point's loss was used (ipmsm only; normally 0).
+    pub n_envelope_fallback: u64,
+    /// Largest motor torque demand T_M [N·m].
+    pub max_motor_torque_demand_nm: f64,
+    /// Largest motor speed over the (achieved) samples [rpm].
+    pub max_motor_speed_rpm: f64,
+    /// Energy dissipated in the friction brakes, at the wheel [kWh].
+    pub friction_brake_kwh: f64,
+    /// Cycle distance − achieved distance [km] (`forward` mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trace_miss_km: Option<f64>,
+    /// State of charge at the end (`ecm_2rc` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub battery_soc_end: Option<f64>,
+    /// Battery flags (`ecm_2rc` only): `battery_power_infeasible`, `soc_out_of_range`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub battery_flags: Option<Vec<String>>,
+    /// Energy per loss mechanism (only with `outputs: ["loss_breakdown"]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub loss_breakdown: Option<LossBreakdown>,
+    /// Operating-point histogram (only with `outputs: ["op_histogram"]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub op_histogram: Option<OpHistogram>,
+    /// Per-interval traces (only with `outputs: ["traces"]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub traces: Option<Traces>,
+    /// Human-readable warnings (envelope exceedance, trace miss, conventions used, ...).
+    pub warnings: Vec<String>,
+}
+
+/// Energy per mechanism over the cycle [kWh]. Closure: energy_in = wheel + gear + friction brakes
+/// + motor_charged + inverter + battery + aux (to rounding).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct LossBreakdown {
+    /// Net energy at the wheels Σ F·v̄·Δt (road load plus net kinetic/potential change) [kWh].
+    pub wheel_kwh: f64,
+    /// Gear loss [kWh].
+    pub gear_kwh: f64,
+    /// Friction-brake energy at the wheel [kWh].
+    pub friction_brake_kwh: f64,
+    /// Motor loss charged by the power convention Σ(P_el − P_m)Δt [kWh].
+    pub motor_charged_kwh: f64,
+    /// Motor model loss at the evaluated operating points Σ P_loss Δt [kWh] (equals
+    /// `motor_charged_kwh` for the `loss` convention).
+    pub motor_model_kwh: f64,
+    /// DC copper loss part of the model loss (ipmsm only) [kWh].
+    pub motor_cu_dc_kwh: Option<f64>,
+    /// Extra AC copper loss (k_AC − 1)·P_cu,DC (ipmsm only) [kWh].
+    pub motor_cu_ac_extra_kwh: Option<f64>,
+    /// Iron loss (ipmsm only) [kWh].
+    pub motor_iron_kwh: Option<f64>,
+    /// Mechanical loss (ipmsm only) [kWh].
+    pub motor_mech_kwh: Option<f64>,
+    /// Inverter loss [kWh].
+    pub inverter_kwh: f64,
+    /// Battery loss (P_in − P_dc) [kWh].
+    pub battery_kwh: f64,
+    /// Auxiliary load [kWh].
+    pub aux_kwh: f64,
+    /// Wheel traction demanded but dropped by `mode: clip` [kWh] (not part of the closure).
+    pub clipped_traction_kwh: f64,
+    /// Energy-weighted mean motor efficiency Σ|P_m|Δt / Σ(|P_m| + P_loss)Δt [-].
+    pub mean_motor_efficiency: Option<f64>,
+}
+
+/// Time share of moving intervals per (speed, torque) bin, Fig. 15 style.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct OpHistogram {
+    /// Speed bin edges [rpm] (from 0).
+    pub speed_edges_rpm: Vec<f64>,
+    /// Torque bin edges [N·m] (multiples of the bin width).
+    pub torque_edges_nm: Vec<f64>,
+    /// share[speed bin][torque bin] of the moving time (sums to 1).
+    pub share: Vec<Vec<f64>>,
+    /// Bin with the largest share (absent if the bus never moves).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub modal_bin: Option<ModalBin>,
+}
+
+/// The histogram's modal bin.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct ModalBin {
+    /// Speed range [rpm].
+    pub rpm: [f64; 2],
+    /// Torque range [N·m].
+    pub nm: [f64; 2],
+    /// Time share of the bin.
+    pub share: f64,
+}
+
+/// Per-interval traces (arrays of equal length).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Traces {
+    /// Interval start time [s].
+    pub t_s: Vec<f64>,
+    /// Mean (achieved) speed v̄ [m/s].
+    pub v_mps: Vec<f64>,
+    /// Motor speed ω_m [rad/s].
+    pub omega_rad_s: Vec<f64>,
+    /// Motor torque demand T_M [N·m].
+    pub torque_demand_nm: Vec<f64>,
+    /// Motor torque delivered (after clip / regen limit) [N·m].
+    pub torque_motor_nm: Vec<f64>,
+    /// Motor shaft power P_m [W].
+    pub p_mech_w: Vec<f64>,
+    /// Motor model loss P_loss [W].
+    pub p_loss_w: Vec<f64>,
+    /// Battery internal power P_in [W].
+    pub p_in_w: Vec<f64>,
+}
+
+/// Efficiency map of one motor (η on the grid; null outside the envelope, 0 at zero power).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct MotorMapData {
+    /// Motor id.
+    pub motor: String,
+    /// Speed axis [rpm].
+    pub speed_rpm: Vec<f64>,
+    /// Torque axis [N·m].
+    pub torque_nm: Vec<f64>,
+    /// Envelope T_max at `speed_rpm` [N·m].
+    pub t_max_nm: Vec<f64>,
+    /// η[speed][torque] [-].
+    pub efficiency: Vec<Vec<Option<f64>>>,
+}
+
+/// Comparison of the motors (paper eq. 11-13).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Comparison {
+    /// The first motor, reference of `fe_change_pct`.
+    pub reference_motor: String,
+    /// Cycle order of the `d` arrays.
+    pub cycles: Vec<String>,
+    /// Normalised desirability weights w_i per cycle.
+    pub weights: Vec<f64>,
+    /// (FE_motor / FE_reference − 1)·100 per motor (except the reference) and cycle [%].
+    pub fe_change_pct: BTreeMap<String, BTreeMap<String, Option<f64>>>,
+    /// Desirability per motor.
+    pub desirability: BTreeMap<String, Desirability>,
+}
+
+/// Desirability of one motor (eq. 12-13).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Desirability {
+    /// d_i per cycle (in `comparison.cycles` order) [-].
+    pub d: Vec<f64>,
+    /// Overall D = Π d_i^{w_i} [-].
+    pub overall: f64,
+}
+
+/// Settings used for the run.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Echo {
+    /// Envelope policy.
+    pub mode: Mode,
+    /// Power convention.
+    pub power_convention: PowerConvention,
+    /// Substeps per cycle interval.
+    pub substeps: u32,
+    /// ipmsm evaluation.
+    pub motor_eval: MotorEval,
+    /// Regeneration allowed.
+    pub regen: bool,
+    /// Regeneration limited by the envelope.
+    pub regen_limit: bool,
+    /// Version of the built-in cycle data.
+    pub cycle_data_version: String,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Motor-map endpoint
+// ---------------------------------------------------------------------------------------------
+
+/// `POST /v1/bus-fuel-economy/motor-map`: envelope, loss and efficiency maps of one motor.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MotorMapRequest {
+    /// The motor (any model of the main endpoint).
+    pub motor: MotorSpec,
+    /// Grid (default 250 rpm × 50 N·m); speeds 0..n_max, torques ±T_max(0) at multiples of the step.
+    #[serde(default)]
+    pub grid: GridSpec,
+    /// Also return the ipmsm loss components and operating modes.
+    #[serde(default)]
+    pub include_components: bool,
+}
+
+/// Maps of one motor; values outside the envelope are null.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct MotorMapResponse {
+    /// Motor id.
+    pub motor: String,
+    /// Speed axis [rpm].
+    pub speed_rpm: Vec<f64>,
+    /// Torque axis [N·m] (signed, contains 0).
+    pub torque_nm: Vec<f64>,
+    /// Envelope T_max at `speed_rpm` [N·m].
+    pub t_max_nm: Vec<f64>,
+    /// Total motor loss [W], loss_w[speed][torque].
+    pub loss_w: Vec<Vec<Option<f64>>>,
+    /// Efficiency |P_m| / (|P_m| + P_loss) [-] (0 at zero power, spec §5.5).
+    pub efficiency: Vec<Vec<Option<f64>>>,
+    /// ipmsm loss components (only with `include_components`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub components: Option<LossComponentMaps>,
+    /// Warnings (map conversions, extrapolations).
+    pub warnings: Vec<String>,
+    /// Work done.
+    pub report: SolverReport,
+}
+
+/// ipmsm loss components on the grid [W] (null outside the envelope).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct LossComponentMaps {
+    /// DC copper loss 1.5 R (i_d² + i_q²).
+    pub cu_dc_w: Vec<Vec<Option<f64>>>,
+    /// Extra AC copper loss (k_AC − 1) P_cu,DC.
+    pub cu_ac_extra_w: Vec<Vec<Option<f64>>>,
+    /// Iron loss.
+    pub iron_w: Vec<Vec<Option<f64>>>,
+    /// Mechanical loss.
+    pub mech_w: Vec<Vec<Option<f64>>>,
+    /// d-axis current [A peak].
+    pub i_d_a: Vec<Vec<Option<f64>>>,
+    /// q-axis current [A peak].
+    pub i_q_a: Vec<Vec<Option<f64>>>,
+    /// Operating mode: `mtpa`, `fw` or `envelope`.
+    pub mode: Vec<Vec<Option<String>>>,
+}

@@ -1,0 +1,765 @@
+//! Validation of a fit request into a [`FitInput`] (spec §2 "Reject with 422", §3.3 data
+//! preparation). Every offending field is collected with its JSON pointer before failing once.
+
+use crate::calc::cam_law::law::{
+    BoundaryConditions, K1, LawError, MAX_MAGNITUDE, Quantity, SevenSegmentLaw,
+};
+use crate::calc::cam_law::wire::{Units, Warning};
+use crate::calc::{CalcFailure, ProblemClass, Validator};
+
+use super::optim::ga::GaParams;
+use super::prep;
+use super::wire::{
+    FitCamLawRequest, FitQuantity, MAX_CURVE_COUNT, MAX_SAMPLES, MIN_SAMPLES, Method, MetricName,
+};
+
+/// Samples may lie this fraction of Δt outside `[t_a, t_b]` (they are clamped), spec §2.
+pub const ABSCISSA_TOL: f64 = 1e-9;
+/// Largest accepted cost estimate `max_evaluations × N × (2w+1)` in cell operations (spec §2:
+/// a request beyond it would run for minutes).
+pub const MAX_COST: f64 = 2e10;
+/// Default evaluation cap (spec §2).
+pub const DEFAULT_MAX_EVALUATIONS: u64 = 50_000;
+/// Largest accepted evaluation cap (spec §2).
+pub const MAX_EVALUATIONS: u64 = 10_000_000;
+/// Default time limit [ms] (spec §2).
+pub const DEFAULT_TIME_LIMIT_MS: u64 = 10_000;
+/// Largest accepted time limit [ms] (spec §2).
+pub const MAX_TIME_LIMIT_MS: u64 = 600_000;
+/// Default zero-snap threshold (spec §3.5.2 step 4).
+pub const DEFAULT_SNAP_TOL: f64 = 2e-3;
+/// Largest accepted zero-snap threshold (spec §2).
+pub const MAX_SNAP_TOL: f64 = 0.05;
+/// Default IPOP restarts for DTW in `auto` (spec §2).
+pub const DEFAULT_DTW_RESTARTS: u32 = 3;
+/// Largest accepted IPOP restart count (spec §2).
+pub const MAX_DTW_RESTARTS: u32 = 9;
+/// Longest accepted unit label (characters).
+pub const MAX_UNIT_LABEL: usize = 32;
+
+/// A validated fit request (SI is not imposed: units are the caller's, spec §2).
+#[derive(Debug, Clone)]
+pub struct FitInput {
+    /// Sample abscissae as given (strictly increasing).
+    pub xs: Vec<f64>,
+    /// Abscissae clamped into `[t_a, t_b]` (where the model is sampled).
+    pub xs_model: Vec<f64>,
+    /// Channels s, v, a (supplied or derived), indexed by [`channel_index`].
+    pub channels: [Option<Vec<f64>>; 3],
+    /// Which channels were derived numerically.
+    pub derived: [bool; 3],
+    /// The quantity the objective compares.
+    pub fit_on: FitQuantity,
+    /// Boundary conditions.
+    pub bc: BoundaryConditions,
+    /// Objective metric.
+    pub metric: MetricName,
+    /// DTW band radius (the request's, or 1 for the error table of Euclidean fits).
+    pub dtw_window: usize,
+    /// Optimizer.
+    pub method: Method,
+    /// RNG seed.
+    pub seed: u64,
+    /// Evaluation cap.
+    pub max_evaluations: u64,
+    /// GA settings.
+    pub ga: GaParams,
+    /// IPOP restarts (DTW, `auto`).
+    pub dtw_global_restarts: u32,
+    /// Least-squares + snap polish after the stochastic methods.
+    pub polish: bool,
+    /// Zero-snap threshold.
+    pub snap_tol: f64,
+    /// Initial coefficients, normalized, fixed genes zeroed.
+    pub initial: [f64; 7],
+    /// Segments held at zero length.
+    pub fixed_zero: [bool; 7],
+    /// Dense-curve point count (0 = none).
+    pub curve_count: usize,
+    /// Dense-curve quantities.
+    pub curve_quantities: Vec<Quantity>,
+    /// Compute the error table.
+    pub error_table: bool,
+    /// Record the history.
+    pub history: bool,
+    /// Classify against the catalogue.
+    pub classify: bool,
+    /// Unit labels to echo.
+    pub units: Option<Units>,
+    /// Warnings found during validation.
+    pub warnings: Vec<Warning>,
+}
+
+/// Index of a channel in [`FitInput::channels`]: s = 0, v = 1, a = 2.
+#[must_use]
+pub fn channel_index(q: FitQuantity) -> usize {
+    match q {
+        FitQuantity::Displacement => 0,
+        FitQuantity::Velocity => 1,
+        FitQuantity::Acceleration => 2,
+    }
+}
+
+/// The law quantity of a channel.
+#[must_use]
+pub fn law_quantity(q: FitQuantity) -> Quantity {
+    match q {
+        FitQuantity::Displacement => Quantity::S,
+        FitQuantity::Velocity => Quantity::V,
+        FitQuantity::Acceleration => Quantity::A,
+    }
+}
+
+/// Wire name of a channel.
+#[must_use]
+pub fn channel_name(q: FitQuantity) -> &'static str {
+    match q {
+        FitQuantity::Displacement => "displacement",
+        FitQuantity::Velocity => "velocity",
+        FitQuantity::Acceleration => "acceleration",
+    }
+}
+
+const CHANNELS: [FitQuantity; 3] = [
+    FitQuantity::Displacement,
+    FitQuantity::Velocity,
+    FitQuantity::Acceleration,
+];
+
+fn check_magnitudes(v: &mut Validator, pointer: &str, values: &[f64]) {
+    if let Some((i, x)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, x)| x.abs() > MAX_MAGNITUDE)
+    {
+        v.push(
+            format!("{pointer}/{i}"),
+            format!("|value| must be <= {MAX_MAGNITUDE:e} (rescale the unit), got {x:e}"),
+        );
+    }
+}
+
+fn uint_in(v: &mut Validator, pointer: &str, value: u64, lo: u64, hi: u64) -> bool {
+    let ok = (lo..=hi).contains(&value);
+    v.ensure(ok, pointer, || {
+        format!("must be in [{lo}, {hi}], got {value}")
+    });
+    ok
+}
+
+/// Validate the abscissa; returns the sample abscissae when valid.
+fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
+    match (&req.abscissa.values, &req.abscissa.grid) {
+        (Some(_), Some(_)) => {
+            v.push(
+                "/abscissa",
+                "give exactly one of `values` or `grid`, not both",
+            );
+            None
+        }
+        (None, None) => {
+            v.push(
+                "/abscissa",
+                "give one of `values` (sample abscissae) or `grid` {start, end, count}",
+            );
+            None
+        }
+        (Some(values), None) => {
+            let n = values.len();
+            if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&n) {
+                v.push(
+                    "/abscissa/values",
+                    format!(
+                        "must hold {MIN_SAMPLES}..{MAX_SAMPLES} samples (7 unknowns need at least 8), got {n}"
+                    ),
+                );
+                return None;
+            }
+            if !v.all_finite("/abscissa/values", values) {
+                return None;
+            }
+            if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
+                v.push(
+                    format!("/abscissa/values/{}", i + 1),
+                    format!(
+                        "abscissae must be strictly increasing, got {} after {}",
+                        values[i + 1],
+                        values[i]
+                    ),
+                );
+                return None;
+            }
+            Some(values.clone())
+        }
+        (None, Some(g)) => {
+            let ok_start = v.finite("/abscissa/grid/start", g.start);
+            let ok_end = v.finite("/abscissa/grid/end", g.end);
+            let ok_count = uint_in(
+                v,
+                "/abscissa/grid/count",
+                g.count,
+                MIN_SAMPLES as u64,
+                MAX_SAMPLES as u64,
+            );
+            if ok_start && ok_end && g.end <= g.start {
+                v.push(
+                    "/abscissa/grid/end",
+                    format!("must be > start = {}, got {}", g.start, g.end),
+                );
+                return None;
+            }
+            if !(ok_start && ok_end && ok_count) {
+                return None;
+            }
+            // count ≤ 200 000 was just checked: the conversion cannot fail.
+            let count = usize::try_from(g.count).ok()?;
+            let xs = prep::grid(g.start, g.end, count);
+            if xs.windows(2).any(|w| w[1] <= w[0]) {
+                v.push(
+                    "/abscissa/grid",
+                    format!(
+                        "the grid [{}, {}] with {count} points is too fine to be strictly increasing in f64",
+                        g.start, g.end
+                    ),
+                );
+                return None;
+            }
+            Some(xs)
+        }
+    }
+}
+
+/// Validate a request into a [`FitInput`].
+///
+/// # Errors
+/// [`ProblemClass::InvalidInput`] listing every offending field; [`ProblemClass::TooLarge`]
+/// when the cost estimate exceeds [`MAX_COST`]; [`ProblemClass::Infeasible`] when the boundary
+/// conditions admit no representable law of this duration (the initial law overflows f64).
+#[allow(clippy::too_many_lines)]
+pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
+    let mut v = Validator::new();
+    let xs = abscissa(&req, &mut v);
+    let n = xs.as_ref().map(Vec::len);
+
+    // Channels.
+    let supplied = [
+        req.channels.displacement.as_ref(),
+        req.channels.velocity.as_ref(),
+        req.channels.acceleration.as_ref(),
+    ];
+    if supplied.iter().all(Option::is_none) {
+        v.push(
+            "/channels",
+            "supply at least one of displacement, velocity, acceleration",
+        );
+    }
+    let mut channels_ok = true;
+    for (q, ch) in CHANNELS.iter().zip(supplied) {
+        if let Some(values) = ch {
+            let p = format!("/channels/{}", channel_name(*q));
+            if let Some(n) = n
+                && values.len() != n
+            {
+                v.push(
+                    &p,
+                    format!(
+                        "must have one value per abscissa ({n}), got {}",
+                        values.len()
+                    ),
+                );
+                channels_ok = false;
+                continue;
+            }
+            if v.all_finite(&p, values) {
+                check_magnitudes(&mut v, &p, values);
+            } else {
+                channels_ok = false;
+            }
+        }
+    }
+    let fit_on = req.fit_on.unwrap_or(FitQuantity::Acceleration);
+    let fit_idx = channel_index(fit_on);
+    if supplied[fit_idx].is_none() && !supplied.iter().all(Option::is_none) {
+        if !req.derive_missing {
+            v.push(
+                "/fit_on",
+                format!(
+                    "the {} channel is not supplied: supply it, fit on a supplied channel, or set derive_missing: true",
+                    channel_name(fit_on)
+                ),
+            );
+        } else if supplied[..fit_idx].iter().all(Option::is_none) {
+            v.push(
+                "/fit_on",
+                format!(
+                    "cannot derive {} from the supplied channels: only differentiation s → v → a is offered (no integration); fit on a supplied channel",
+                    channel_name(fit_on)
+                ),
+            );
+        }
+    }
+
+    // Constraints.
+    let c = req.constraints;
+    let named = [
+        ("t_a", c.t_a),
+        ("t_b", c.t_b),
+        ("s_a", c.s_a),
+        ("s_b", c.s_b),
+        ("v_a", c.v_a),
+        ("v_b", c.v_b),
+        ("a_a", c.a_a),
+        ("a_b", c.a_b),
+    ];
+    let mut bc_ok = true;
+    for (name, value) in named {
+        if let Some(x) = value {
+            let p = format!("/constraints/{name}");
+            if !v.finite(&p, x) {
+                bc_ok = false;
+            } else if x.abs() > MAX_MAGNITUDE {
+                v.push(
+                    p,
+                    format!("|{name}| must be <= {MAX_MAGNITUDE:e} (rescale the unit), got {x:e}"),
+                );
+                bc_ok = false;
+            }
+        }
+    }
+    let first = xs.as_ref().and_then(|x| x.first().copied());
+    let last = xs.as_ref().and_then(|x| x.last().copied());
+    let t_a = c.t_a.or(first);
+    let t_b = c.t_b.or(last);
+    let s_data = supplied[0];
+    let s_a = c.s_a.or_else(|| s_data.and_then(|s| s.first().copied()));
+    let s_b = c.s_b.or_else(|| s_data.and_then(|s| s.last().copied()));
+    // (With no channel at all, `/channels` already says what is missing.)
+    let any_channel = supplied.iter().any(Option::is_some);
+    if s_a.is_none() && s_data.is_none() && any_channel {
+        v.push(
+            "/constraints/s_a",
+            "required when no displacement channel is supplied (the start displacement)",
+        );
+    }
+    if s_b.is_none() && s_data.is_none() && any_channel {
+        v.push(
+            "/constraints/s_b",
+            "required when no displacement channel is supplied (the end displacement)",
+        );
+    }
+    let mut bc = None;
+    if let (Some(t_a), Some(t_b), Some(s_a), Some(s_b)) = (t_a, t_b, s_a, s_b)
+        && bc_ok
+        && t_a.is_finite()
+        && t_b.is_finite()
+    {
+        let cand = BoundaryConditions {
+            t_a,
+            t_b,
+            s_a,
+            s_b,
+            v_a: c.v_a.unwrap_or(0.0),
+            v_b: c.v_b.unwrap_or(0.0),
+            a_a: c.a_a.unwrap_or(0.0),
+            a_b: c.a_b.unwrap_or(0.0),
+        };
+        match cand.check() {
+            Ok(()) => bc = Some(cand),
+            Err(LawError::IntervalNotIncreasing { .. }) => v.push(
+                "/constraints/t_b",
+                format!("t_b must be greater than t_a = {t_a}, got {t_b}"),
+            ),
+            Err(e @ LawError::IntervalTooShort { .. }) => v.push("/constraints/t_b", e.to_string()),
+            Err(LawError::MagnitudeTooLarge { name, value, limit }) => v.push(
+                format!("/constraints/{name}"),
+                format!("|{name}| must be <= {limit:e} (rescale the unit), got {value:e}"),
+            ),
+            Err(e) => v.push("/constraints", e.to_string()),
+        }
+    }
+    // Samples inside [t_a, t_b] up to the tolerance.
+    if let (Some(bc), Some(xs)) = (bc.as_ref(), xs.as_ref()) {
+        let tol = ABSCISSA_TOL * (bc.t_b - bc.t_a);
+        let pointer_base = if req.abscissa.values.is_some() {
+            "/abscissa/values"
+        } else {
+            "/abscissa/grid"
+        };
+        if let Some((i, x)) = xs
+            .iter()
+            .enumerate()
+            .find(|(_, x)| **x < bc.t_a - tol || **x > bc.t_b + tol)
+        {
+            let p = if req.abscissa.values.is_some() {
+                format!("{pointer_base}/{i}")
+            } else {
+                pointer_base.to_owned()
+            };
+            v.push(
+                p,
+                format!(
+                    "sample x = {x} lies outside the segment [t_a, t_b] = [{}, {}]: set constraints t_a/t_b to cover every sample, or drop the samples outside",
+                    bc.t_a, bc.t_b
+                ),
+            );
+        }
+    }
+
+    // Objective.
+    let metric = req.objective.metric;
+    let mut dtw_window = 1usize;
+    if let Some(w) = req.objective.dtw_window {
+        let max = n.unwrap_or(MAX_SAMPLES);
+        match usize::try_from(w) {
+            Ok(wu) if wu <= max => dtw_window = wu,
+            _ => v.push(
+                "/objective/dtw_window",
+                format!("must be in [0, N = {max}] samples, got {w}"),
+            ),
+        }
+    }
+
+    // Optimizer.
+    let o = req.optimizer;
+    let method = o.method;
+    if metric == MetricName::Dtw && method == Method::Lsq {
+        v.push(
+            "/optimizer/method",
+            "`lsq` minimizes a sum of squares and cannot fit the DTW metric: use `auto`, `cmaes`, `de` or `ga`",
+        );
+    }
+    let max_evaluations = o.max_evaluations.unwrap_or(DEFAULT_MAX_EVALUATIONS);
+    uint_in(
+        &mut v,
+        "/optimizer/max_evaluations",
+        max_evaluations,
+        1,
+        MAX_EVALUATIONS,
+    );
+    if let Some(t) = o.time_limit_ms {
+        uint_in(&mut v, "/optimizer/time_limit_ms", t, 1, MAX_TIME_LIMIT_MS);
+    }
+    let dtw_global_restarts = o.dtw_global_restarts.unwrap_or(DEFAULT_DTW_RESTARTS);
+    uint_in(
+        &mut v,
+        "/optimizer/dtw_global_restarts",
+        u64::from(dtw_global_restarts),
+        0,
+        u64::from(MAX_DTW_RESTARTS),
+    );
+    let snap_tol = o.snap_tol.unwrap_or(DEFAULT_SNAP_TOL);
+    v.in_range("/optimizer/snap_tol", snap_tol, 0.0, MAX_SNAP_TOL);
+    let mut ga = GaParams::default();
+    if let Some(g) = o.ga {
+        let pg = "/optimizer/ga";
+        if let Some(p) = g.population
+            && uint_in(&mut v, &format!("{pg}/population"), p, 4, 10_000)
+        {
+            ga.population = usize::try_from(p).unwrap_or(100);
+        }
+        if let Some(p) = g.generations
+            && uint_in(&mut v, &format!("{pg}/generations"), p, 1, 100_000)
+        {
+            ga.generations = p;
+        }
+        if let Some(p) = g.range_every
+            && uint_in(&mut v, &format!("{pg}/range_every"), p, 1, 100_000)
+        {
+            ga.range_every = p;
+        }
+        if let Some(p) = g.stall_generations
+            && uint_in(&mut v, &format!("{pg}/stall_generations"), p, 1, 100_000)
+        {
+            ga.stall_generations = p;
+        }
+        let probs = [
+            ("p_crossover", g.p_crossover, &mut ga.p_crossover),
+            ("p_inversion", g.p_inversion, &mut ga.p_inversion),
+            (
+                "p_range_mutation",
+                g.p_range_mutation,
+                &mut ga.p_range_mutation,
+            ),
+            ("range0", g.range0, &mut ga.range0),
+            ("range_factor", g.range_factor, &mut ga.range_factor),
+            ("p_mutation", g.p_mutation, &mut ga.p_mutation),
+        ];
+        for (name, value, slot) in probs {
+            if let Some(x) = value
+                && v.in_range(&format!("{pg}/{name}"), x, 0.0, 1.0)
+            {
+                *slot = x;
+            }
+        }
+    }
+
+    // Initial coefficients and fixed zeros.
+    let mut fixed_zero = [false; 7];
+    if let Some(fz) = &req.fixed_zero {
+        if fz.len() == 7 {
+            fixed_zero.copy_from_slice(fz);
+            if fixed_zero[..3].iter().all(|z| *z) {
+                v.push(
+                    "/fixed_zero",
+                    "fixes all of c0, c1, c2: the first acceleration pulse would be empty; free at least one of them",
+                );
+            }
+            if fixed_zero[4..].iter().all(|z| *z) {
+                v.push(
+                    "/fixed_zero",
+                    "fixes all of c4, c5, c6: the second acceleration pulse would be empty; free at least one of them",
+                );
+            }
+        } else {
+            v.push(
+                "/fixed_zero",
+                format!("must hold 7 flags (one per segment), got {}", fz.len()),
+            );
+        }
+    }
+    let mut initial = [1.0 / 7.0; 7];
+    let mut initial_pointer = None;
+    match (&req.initial_coefficients, req.initial_law) {
+        (Some(_), Some(_)) => v.push(
+            "/initial_law",
+            "give at most one of initial_coefficients and initial_law",
+        ),
+        (Some(ic), None) => {
+            initial_pointer = Some("/initial_coefficients");
+            if ic.len() == 7 {
+                let mut ok = v.all_finite("/initial_coefficients", ic);
+                for (k, x) in ic.iter().enumerate() {
+                    if ok && *x < 0.0 {
+                        v.push(
+                            format!("/initial_coefficients/{k}"),
+                            format!("coefficients must be >= 0, got {x}"),
+                        );
+                        ok = false;
+                    }
+                }
+                if ok {
+                    initial.copy_from_slice(ic);
+                }
+            } else {
+                v.push(
+                    "/initial_coefficients",
+                    format!("must hold 7 coefficients, got {}", ic.len()),
+                );
+            }
+        }
+        (None, Some(law)) => {
+            initial_pointer = Some("/initial_law");
+            match law.seven_segment_coefficients() {
+                Some(cv) => initial = cv,
+                None => v.push(
+                    "/initial_law",
+                    format!(
+                        "{} is not a 7-segment law: use constant_acceleration, simple_harmonic, cycloidal, modified_trapezoid or modified_sine, or give initial_coefficients",
+                        law.wire_name()
+                    ),
+                ),
+            }
+        }
+        (None, None) => {}
+    }
+    for (c, z) in initial.iter_mut().zip(fixed_zero) {
+        if z {
+            *c = 0.0;
+        }
+    }
+    let sum: f64 = initial.iter().sum();
+    let pulse1 = K1.mul_add(initial[0], K1.mul_add(initial[2], initial[1]));
+    let pulse2 = K1.mul_add(initial[4], K1.mul_add(initial[6], initial[5]));
+    let p = initial_pointer.unwrap_or("/fixed_zero");
+    if sum.is_finite() && sum > 0.0 {
+        initial.iter_mut().for_each(|c| *c /= sum);
+        if pulse1 <= 0.0 {
+            v.push(
+                p,
+                "c0, c1, c2 (after fixed_zero) are all zero: the first acceleration pulse is empty; give at least one of them a positive value",
+            );
+        }
+        if pulse2 <= 0.0 {
+            v.push(
+                p,
+                "c4, c5, c6 (after fixed_zero) are all zero: the second acceleration pulse is empty; give at least one of them a positive value",
+            );
+        }
+    } else if sum.is_finite() {
+        v.push(
+            p,
+            "the coefficients (after fixed_zero) are all zero: both acceleration pulses are empty",
+        );
+    }
+
+    // Outputs.
+    let (curve_count, curve_quantities) = match &req.outputs.curves {
+        Some(cv) => {
+            uint_in(
+                &mut v,
+                "/outputs/curves/count",
+                cv.count,
+                0,
+                MAX_CURVE_COUNT,
+            );
+            let mut qs: Vec<Quantity> = Vec::new();
+            for q in cv
+                .quantities
+                .clone()
+                .unwrap_or_else(|| Quantity::ALL.to_vec())
+            {
+                if !qs.contains(&q) {
+                    qs.push(q);
+                }
+            }
+            (
+                usize::try_from(cv.count.min(MAX_CURVE_COUNT)).unwrap_or(0),
+                qs,
+            )
+        }
+        None => (0, Vec::new()),
+    };
+    if let Some(u) = &req.units {
+        for (name, label) in [("x", &u.x), ("s", &u.s)] {
+            if let Some(l) = label {
+                v.ensure(
+                    l.chars().count() <= MAX_UNIT_LABEL,
+                    format!("/units/{name}"),
+                    || {
+                        format!(
+                            "unit label must have at most {MAX_UNIT_LABEL} characters, got {}",
+                            l.chars().count()
+                        )
+                    },
+                );
+            }
+        }
+    }
+
+    v.finish()?;
+    // Every `None` below was reported above, so `finish` has failed already; these are
+    // unreachable but handled without panicking.
+    let (Some(xs), Some(bc)) = (xs, bc) else {
+        return Err(CalcFailure::general(
+            ProblemClass::InvalidInput,
+            "INVALID_INPUT",
+            "abscissa or constraints are invalid",
+        ));
+    };
+    if !channels_ok {
+        return Err(CalcFailure::general(
+            ProblemClass::InvalidInput,
+            "INVALID_INPUT",
+            "a channel is invalid",
+        ));
+    }
+    let n = xs.len();
+
+    // Cost guard (spec §2).
+    #[allow(clippy::cast_precision_loss)]
+    let cost = {
+        let w = if metric == MetricName::Dtw {
+            2.0f64.mul_add(dtw_window.min(n - 1) as f64, 1.0)
+        } else {
+            1.0
+        };
+        max_evaluations as f64 * n as f64 * w
+    };
+    if cost > MAX_COST {
+        return Err(CalcFailure::field(
+            ProblemClass::TooLarge,
+            "FIT_TOO_EXPENSIVE",
+            "/optimizer/max_evaluations",
+            format!(
+                "estimated cost max_evaluations × N × (2w+1) = {cost:.3e} cell operations exceeds {MAX_COST:e}: lower max_evaluations, decimate the samples or narrow dtw_window"
+            ),
+        ));
+    }
+
+    // Infeasible boundary conditions: the initial law must exist in f64.
+    match SevenSegmentLaw::try_new(&initial, &bc) {
+        Ok(_) => {}
+        Err(e @ (LawError::EmptyFirstPulse { .. } | LawError::EmptySecondPulse { .. })) => {
+            return Err(CalcFailure::field(
+                ProblemClass::InvalidInput,
+                "EMPTY_PULSE",
+                initial_pointer.unwrap_or("/fixed_zero"),
+                format!("{e}: give the segments of that pulse a longer initial duration"),
+            ));
+        }
+        Err(e) => {
+            let (class, code) = match e {
+                LawError::Overflow { .. } => (ProblemClass::Infeasible, "INFEASIBLE_CONSTRAINTS"),
+                _ => (ProblemClass::InvalidInput, "INVALID_INPUT"),
+            };
+            return Err(CalcFailure::field(
+                class,
+                code,
+                "/constraints",
+                format!(
+                    "no 7-segment law over Δt = {} can meet these end conditions in f64 ({e}): widen [t_a, t_b], reduce the end rates or rescale the units",
+                    bc.t_b - bc.t_a
+                ),
+            ));
+        }
+    }
+
+    // Channels, derived ones included (spec §3.3).
+    let mut channels: [Option<Vec<f64>>; 3] = [
+        req.channels.displacement,
+        req.channels.velocity,
+        req.channels.acceleration,
+    ];
+    let mut derived = [false; 3];
+    let mut warnings = Vec::new();
+    if req.derive_missing {
+        // Only the channels the fit needs are derived (s → v → a up to `fit_on`).
+        for k in 1..=fit_idx {
+            if channels[k].is_none()
+                && let Some(lower) = channels[k - 1].as_ref()
+            {
+                channels[k] = Some(prep::gradient(lower, &xs));
+                derived[k] = true;
+            }
+        }
+        if derived[fit_idx] {
+            warnings.push(Warning::DerivedChannelNoiseGain);
+        }
+    }
+    if bc.s_b - bc.s_a == 0.0 && bc.zero_end_rates() {
+        warnings.push(Warning::NonIdentifiable);
+    }
+    let xs_model = xs.iter().map(|x| x.clamp(bc.t_a, bc.t_b)).collect();
+    let dtw_window = if metric == MetricName::Dtw {
+        dtw_window.min(n)
+    } else {
+        1
+    };
+
+    Ok(FitInput {
+        xs,
+        xs_model,
+        channels,
+        derived,
+        fit_on,
+        bc,
+        metric,
+        dtw_window,
+        method,
+        seed: o.seed.unwrap_or(0),
+        max_evaluations,
+        ga,
+        dtw_global_restarts,
+        polish: o.polish.unwrap_or(true),
+        snap_tol,
+        initial,
+        fixed_zero,
+        curve_count,
+        curve_quantities,
+        error_table: req.outputs.error_table.unwrap_or(true),
+        history: req.outputs.history.unwrap_or(false),
+        classify: req.outputs.classify.unwrap_or(true),
+        units: req.units,
+        warnings,
+    })
+}

@@ -1,0 +1,529 @@
+//! Validation of a [`ComponentImportanceRequest`] into a [`ComponentImportanceInput`]
+//! (spec §2): every offending field is collected with its JSON pointer, then the request fails
+//! once. Units stay as on the wire (hours, 1/h): the method is not unit-invariant (spec §6 H4).
+
+use std::collections::HashMap;
+
+use super::graph::Digraph;
+use super::structure::LevelMode;
+use super::wire::{
+    BetweennessMode, ComponentImportanceRequest, ConstantWeights, Outputs, PathMethod, Warning,
+};
+use crate::calc::{CalcFailure, Validator};
+
+/// Minimum number of components (one edge needs two).
+pub const MIN_COMPONENTS: usize = 2;
+/// Maximum number of components (spec §2).
+pub const MAX_COMPONENTS: usize = 2000;
+/// Maximum id length in characters (spec §2).
+pub const MAX_ID_CHARS: usize = 64;
+/// Maximum number of evaluation times (spec §2).
+pub const MAX_TIMES: usize = 1000;
+/// Weibull shape range (spec §2).
+pub const BETA_RANGE: (f64, f64) = (0.05, 20.0);
+/// Q + O = 1 and Σω_c = 1 are checked to this absolute tolerance (spec §2).
+pub const SUM_TOL: f64 = 1e-9;
+/// Σα of a component may differ from 1 by this much before a warning (spec §2).
+pub const ALPHA_SUM_WARN_TOL: f64 = 1e-3;
+/// An override or entropy time matches a requested time when equal to this relative tolerance
+/// (both come from the same JSON text; the tolerance only absorbs decimal round trips).
+pub const TIME_MATCH_REL_TOL: f64 = 1e-12;
+/// Path cap K range (spec §2).
+pub const PATH_CAP_RANGE: (u32, u32) = (1, 8);
+/// Enumeration budget range (spec §2).
+pub const MAX_SIMPLE_PATHS_RANGE: (f64, f64) = (1e3, 1e8);
+
+/// How ω_c is obtained.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WeightSpec {
+    /// Given directly.
+    Fixed([f64; 2]),
+    /// ½(subjective + entropy weights of the indices at time index `time_index`).
+    Entropy {
+        /// Subjective weights.
+        subjective: [f64; 2],
+        /// Index into `times_h`.
+        time_index: usize,
+    },
+}
+
+/// A validated request (domain form).
+#[derive(Debug, Clone)]
+pub struct ComponentImportanceInput {
+    /// Component ids in input order.
+    pub ids: Vec<String>,
+    /// The fault graph.
+    pub graph: Digraph,
+    /// For every request edge, its CSR edge index in `graph`.
+    pub edge_csr: Vec<usize>,
+    /// Weibull (η [h], β) per component, if given.
+    pub weibull: Vec<Option<(f64, f64)>>,
+    /// S_i = Σ α·impact per component, if given.
+    pub mode_sum: Vec<Option<f64>>,
+    /// `efficiency_override` per component.
+    pub efficiency_override: Vec<Option<f64>>,
+    /// `level_override` per component.
+    pub level_override: Vec<Option<u32>>,
+    /// Evaluation times [h].
+    pub times_h: Vec<f64>,
+    /// Per time: F overrides per component (`None` for times without overrides).
+    pub f_override: Vec<Option<Vec<Option<f64>>>>,
+    /// Per time: RI overrides [1/h] per component.
+    pub ri_override: Vec<Option<Vec<Option<f64>>>>,
+    /// Q.
+    pub q_in: f64,
+    /// O.
+    pub o_out: f64,
+    /// Constant weights.
+    pub weights: WeightSpec,
+    /// K.
+    pub path_cap: usize,
+    /// Simple paths or walks.
+    pub path_method: PathMethod,
+    /// Level mode.
+    pub levels: LevelMode,
+    /// Betweenness definition.
+    pub betweenness: BetweennessMode,
+    /// Enumeration budget.
+    pub max_simple_paths: u64,
+    /// Output flags.
+    pub outputs: Outputs,
+    /// Warnings found during validation.
+    pub warnings: Vec<Warning>,
+}
+
+/// Escape a string for use as a JSON-pointer token (RFC 6901).
+fn pointer_token(s: &str) -> String {
+    s.replace('~', "~0").replace('/', "~1")
+}
+
+fn times_match(a: f64, b: f64) -> bool {
+    (a - b).abs() <= TIME_MATCH_REL_TOL * a.abs().max(b.abs())
+}
+
+fn weight_pair(v: &mut Validator, pointer: &str, w: &[f64]) -> Option<[f64; 2]> {
+    if w.len() != 2 {
+        v.push(
+            pointer,
+            format!(
+                "constant weights must be 2 numbers (probability, risk), got {}",
+                w.len()
+            ),
+        );
+        return None;
+    }
+    let mut ok = true;
+    for (k, &x) in w.iter().enumerate() {
+        let p = format!("{pointer}/{k}");
+        if v.finite(&p, x) && x <= 0.0 {
+            v.push(p, format!("weight must be > 0, got {x}"));
+            ok = false;
+        } else if !x.is_finite() {
+            ok = false;
+        }
+    }
+    if ok && (w[0] + w[1] - 1.0).abs() > SUM_TOL {
+        v.push(
+            pointer,
+            format!(
+                "weights must sum to 1 (±{SUM_TOL:e}), got {} + {} = {}",
+                w[0],
+                w[1],
+                w[0] + w[1]
+            ),
+        );
+        ok = false;
+    }
+    ok.then(|| [w[0], w[1]])
+}
+
+impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
+    type Error = CalcFailure;
+
+    #[allow(clippy::too_many_lines)]
+    fn try_from(req: ComponentImportanceRequest) -> Result<Self, CalcFailure> {
+        let mut v = Validator::new();
+        let mut warnings = Vec::new();
+        let n = req.components.len();
+        v.ensure(
+            (MIN_COMPONENTS..=MAX_COMPONENTS).contains(&n),
+            "/components",
+            || format!("needs {MIN_COMPONENTS} to {MAX_COMPONENTS} components, got {n}"),
+        );
+
+        // Ids.
+        let mut index_of: HashMap<&str, usize> = HashMap::with_capacity(n);
+        for (i, c) in req.components.iter().enumerate() {
+            let p = format!("/components/{i}/id");
+            let len = c.id.chars().count();
+            if len == 0 || len > MAX_ID_CHARS {
+                v.push(
+                    &p,
+                    format!("id must have 1 to {MAX_ID_CHARS} characters, got {len}"),
+                );
+            } else if let Some(&j) = index_of.get(c.id.as_str()) {
+                v.push(
+                    &p,
+                    format!("duplicate id \"{}\" (first at /components/{j}/id)", c.id),
+                );
+            } else {
+                index_of.insert(c.id.as_str(), i);
+            }
+        }
+
+        // Times.
+        let nt = req.times_h.len();
+        v.ensure((1..=MAX_TIMES).contains(&nt), "/times_h", || {
+            format!("needs 1 to {MAX_TIMES} times, got {nt}")
+        });
+        for (k, &t) in req.times_h.iter().enumerate() {
+            // t = 0 makes F = 0 (every index 0) and λ infinite for β < 1 (spec §6 H1).
+            v.greater_than(&format!("/times_h/{k}"), t, 0.0);
+        }
+        let find_time = |t: f64| -> Vec<usize> {
+            req.times_h
+                .iter()
+                .enumerate()
+                .filter(|&(_, &x)| x.is_finite() && times_match(x, t))
+                .map(|(k, _)| k)
+                .collect()
+        };
+
+        // Overrides.
+        let mut f_override: Vec<Option<Vec<Option<f64>>>> = vec![None; nt];
+        let mut ri_override: Vec<Option<Vec<Option<f64>>>> = vec![None; nt];
+        let mut override_of_time: Vec<Option<usize>> = vec![None; nt];
+        for (k, o) in req.overrides.iter().enumerate() {
+            let pt = format!("/overrides/{k}/time_h");
+            if !v.finite(&pt, o.time_h) {
+                continue;
+            }
+            let ts = find_time(o.time_h);
+            if ts.is_empty() {
+                v.push(
+                    &pt,
+                    format!("override time {} h is not one of times_h", o.time_h),
+                );
+                continue;
+            }
+            if let Some(prev) = override_of_time[ts[0]] {
+                v.push(
+                    &pt,
+                    format!(
+                        "second override for time {} h (first at /overrides/{prev})",
+                        o.time_h
+                    ),
+                );
+                continue;
+            }
+            let mut fo = vec![None; n];
+            let mut ro = vec![None; n];
+            for (id, &x) in &o.f {
+                let p = format!("/overrides/{k}/F/{}", pointer_token(id));
+                match index_of.get(id.as_str()) {
+                    None => v.push(p, format!("unknown component id \"{id}\"")),
+                    Some(&i) => {
+                        if v.in_range(&p, x, 0.0, 1.0) {
+                            fo[i] = Some(x);
+                        }
+                    }
+                }
+            }
+            for (id, &x) in &o.ri {
+                let p = format!("/overrides/{k}/RI/{}", pointer_token(id));
+                match index_of.get(id.as_str()) {
+                    None => v.push(p, format!("unknown component id \"{id}\"")),
+                    Some(&i) => {
+                        if v.finite(&p, x) {
+                            if x < 0.0 {
+                                v.push(p, format!("RI must be >= 0 [1/h], got {x}"));
+                            } else {
+                                ro[i] = Some(x);
+                            }
+                        }
+                    }
+                }
+            }
+            for &t in &ts {
+                override_of_time[t] = Some(k);
+                f_override[t] = Some(fo.clone());
+                ri_override[t] = Some(ro.clone());
+            }
+        }
+        let all_times = |ov: &[Option<Vec<Option<f64>>>], i: usize| {
+            ov.iter()
+                .all(|t| t.as_ref().is_some_and(|row| row[i].is_some()))
+        };
+
+        // Component data.
+        let mut weibull = vec![None; n];
+        let mut mode_sum = vec![None; n];
+        let mut efficiency_override = vec![None; n];
+        let mut level_override = vec![None; n];
+        for (i, c) in req.components.iter().enumerate() {
+            let base = format!("/components/{i}");
+            let f_all = all_times(&f_override, i);
+            let ri_all = all_times(&ri_override, i);
+            match c.weibull {
+                Some(w) => {
+                    let ok_eta = v.greater_than(&format!("{base}/weibull/eta_h"), w.eta_h, 0.0);
+                    let ok_beta = v.in_range(
+                        &format!("{base}/weibull/beta"),
+                        w.beta,
+                        BETA_RANGE.0,
+                        BETA_RANGE.1,
+                    );
+                    if ok_eta && ok_beta {
+                        weibull[i] = Some((w.eta_h, w.beta));
+                    }
+                }
+                None if f_all && ri_all => {}
+                None => v.push(
+                    format!("{base}/weibull"),
+                    format!(
+                        "component \"{}\" needs Weibull data (eta_h, beta) unless overrides give \
+                         both F and RI at every time",
+                        c.id
+                    ),
+                ),
+            }
+            match (&c.failure_modes, c.mode_sum) {
+                (Some(_), Some(_)) => v.push(
+                    format!("{base}/mode_sum"),
+                    "give either failure_modes or mode_sum, not both".to_owned(),
+                ),
+                (None, Some(s)) => {
+                    let p = format!("{base}/mode_sum");
+                    if v.finite(&p, s) {
+                        if s < 0.0 {
+                            v.push(p, format!("mode_sum must be >= 0, got {s}"));
+                        } else {
+                            mode_sum[i] = Some(s);
+                        }
+                    }
+                }
+                (Some(modes), None) => {
+                    let p = format!("{base}/failure_modes");
+                    if modes.is_empty() {
+                        v.push(&p, "needs at least one failure mode".to_owned());
+                    }
+                    let mut ok = !modes.is_empty();
+                    let (mut sum_alpha, mut s) = (0.0, 0.0);
+                    for (m, fm) in modes.iter().enumerate() {
+                        ok &= v.in_range(&format!("{p}/{m}/alpha"), fm.alpha, 0.0, 1.0);
+                        let pi = format!("{p}/{m}/impact");
+                        if v.finite(&pi, fm.impact) {
+                            if fm.impact < 0.0 {
+                                v.push(pi, format!("impact must be >= 0, got {}", fm.impact));
+                                ok = false;
+                            }
+                        } else {
+                            ok = false;
+                        }
+                        sum_alpha += fm.alpha;
+                        s += fm.alpha * fm.impact;
+                    }
+                    if ok && !s.is_finite() {
+                        v.push(&p, "sum of alpha·impact exceeds the f64 range".to_owned());
+                        ok = false;
+                    }
+                    if ok {
+                        mode_sum[i] = Some(s);
+                        if (sum_alpha - 1.0).abs() > ALPHA_SUM_WARN_TOL {
+                            warnings.push(Warning {
+                                code: "ALPHA_SUM".to_owned(),
+                                detail: format!(
+                                    "failure-mode shares of \"{}\" sum to {sum_alpha:.6}, not 1",
+                                    c.id
+                                ),
+                                pointer: Some(p),
+                            });
+                        }
+                    }
+                }
+                (None, None) if ri_all => {}
+                (None, None) => v.push(
+                    format!("{base}/failure_modes"),
+                    format!(
+                        "component \"{}\" needs failure_modes or mode_sum (RI = λ·Σα·impact) \
+                         unless overrides give RI at every time",
+                        c.id
+                    ),
+                ),
+            }
+            if let Some(x) = c.efficiency_override {
+                let p = format!("{base}/efficiency_override");
+                if v.finite(&p, x) {
+                    if x < 0.0 {
+                        v.push(p, format!("efficiency_override must be >= 0, got {x}"));
+                    } else {
+                        efficiency_override[i] = Some(x);
+                    }
+                }
+            }
+            if let Some(h) = c.level_override {
+                if h < 1 {
+                    v.push(
+                        format!("{base}/level_override"),
+                        "level_override must be an integer >= 1, got 0".to_owned(),
+                    );
+                } else {
+                    level_override[i] = Some(h);
+                }
+            }
+        }
+
+        // Edges.
+        v.ensure(!req.edges.is_empty(), "/edges", || {
+            "needs at least one edge (without edges every index is 0)".to_owned()
+        });
+        let mut edges: Vec<(usize, usize)> = Vec::with_capacity(req.edges.len());
+        let mut edges_ok = true;
+        let mut seen: HashMap<(usize, usize), usize> = HashMap::with_capacity(req.edges.len());
+        for (k, [a, b]) in req.edges.iter().enumerate() {
+            let ia = index_of.get(a.as_str()).copied();
+            let ib = index_of.get(b.as_str()).copied();
+            if ia.is_none() {
+                v.push(
+                    format!("/edges/{k}/0"),
+                    format!("unknown component id \"{a}\""),
+                );
+            }
+            if ib.is_none() {
+                v.push(
+                    format!("/edges/{k}/1"),
+                    format!("unknown component id \"{b}\""),
+                );
+            }
+            let (Some(ia), Some(ib)) = (ia, ib) else {
+                edges_ok = false;
+                continue;
+            };
+            if ia == ib {
+                v.push(
+                    format!("/edges/{k}"),
+                    format!("self-loop \"{a}\" -> \"{a}\": a component cannot propagate to itself"),
+                );
+                edges_ok = false;
+                continue;
+            }
+            if let Some(&first) = seen.get(&(ia, ib)) {
+                v.push(
+                    format!("/edges/{k}"),
+                    format!("duplicate edge \"{a}\" -> \"{b}\" (first at /edges/{first})"),
+                );
+                edges_ok = false;
+                continue;
+            }
+            seen.insert((ia, ib), k);
+            edges.push((ia, ib));
+        }
+
+        // Options.
+        let o = &req.options;
+        let ok_q = v.in_range("/options/q_in", o.q_in, 0.0, 1.0);
+        let ok_o = v.in_range("/options/o_out", o.o_out, 0.0, 1.0);
+        if ok_q && ok_o && (o.q_in + o.o_out - 1.0).abs() > SUM_TOL {
+            v.push(
+                "/options/o_out",
+                format!(
+                    "Q + O must equal 1 (±{SUM_TOL:e}), got {} + {} = {}",
+                    o.q_in,
+                    o.o_out,
+                    o.q_in + o.o_out
+                ),
+            );
+        }
+        let weights = match &o.constant_weights {
+            ConstantWeights::Fixed(w) => {
+                weight_pair(&mut v, "/options/constant_weights", w).map(WeightSpec::Fixed)
+            }
+            ConstantWeights::Entropy(e) => {
+                let s = weight_pair(
+                    &mut v,
+                    "/options/constant_weights/subjective",
+                    &e.subjective,
+                );
+                let p = "/options/constant_weights/entropy_at_h";
+                let t = if v.finite(p, e.entropy_at_h) {
+                    let ts = find_time(e.entropy_at_h);
+                    if ts.is_empty() {
+                        v.push(
+                            p,
+                            format!("entropy time {} h is not one of times_h", e.entropy_at_h),
+                        );
+                    }
+                    ts.first().copied()
+                } else {
+                    None
+                };
+                s.zip(t)
+                    .map(|(subjective, time_index)| WeightSpec::Entropy {
+                        subjective,
+                        time_index,
+                    })
+            }
+        };
+        v.ensure(
+            (PATH_CAP_RANGE.0..=PATH_CAP_RANGE.1).contains(&o.path_cap),
+            "/options/path_cap",
+            || {
+                format!(
+                    "path_cap K must be an integer in [{}, {}], got {}",
+                    PATH_CAP_RANGE.0, PATH_CAP_RANGE.1, o.path_cap
+                )
+            },
+        );
+        v.in_range(
+            "/options/max_simple_paths",
+            o.max_simple_paths,
+            MAX_SIMPLE_PATHS_RANGE.0,
+            MAX_SIMPLE_PATHS_RANGE.1,
+        );
+
+        v.finish()?;
+        // Everything below was validated above; the fallbacks are unreachable.
+        let (Some(weights), true) = (weights, edges_ok) else {
+            return Err(CalcFailure::general(
+                crate::calc::ProblemClass::InvalidInput,
+                "INVALID_INPUT",
+                "invalid options",
+            ));
+        };
+        let (graph, edge_csr) = Digraph::from_edges(n, &edges).map_err(|e| {
+            CalcFailure::general(
+                crate::calc::ProblemClass::InvalidInput,
+                "INVALID_INPUT",
+                format!("invalid edge list: {e:?}"),
+            )
+        })?;
+        // max_simple_paths ∈ [1e3, 1e8] (validated): the cast is exact after rounding down.
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let max_simple_paths = o.max_simple_paths.floor() as u64;
+        Ok(Self {
+            ids: req.components.into_iter().map(|c| c.id).collect(),
+            graph,
+            edge_csr,
+            weibull,
+            mode_sum,
+            efficiency_override,
+            level_override,
+            times_h: req.times_h,
+            f_override,
+            ri_override,
+            q_in: o.q_in,
+            o_out: o.o_out,
+            weights,
+            path_cap: o.path_cap as usize,
+            path_method: o.path_method,
+            levels: match o.levels {
+                super::wire::LevelsMode::Paper => LevelMode::Paper,
+                super::wire::LevelsMode::Ism => LevelMode::Ism,
+            },
+            betweenness: o.betweenness,
+            max_simple_paths,
+            outputs: req.outputs,
+            warnings,
+        })
+    }
+}
