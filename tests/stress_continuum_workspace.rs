@@ -16,14 +16,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
-/// Keys whose value may legitimately be null (Option fields serialised without skipping).
-const NULLABLE: &[&str] = &[
-    "margin",
-    "ei_nm2",
-    "diameter_m",
-    "offset_m",
-    "youngs_modulus_pa",
-];
+/// Keys whose value may legitimately be null: none (absent optionals are omitted, never null).
+const NULLABLE: &[&str] = &[];
 /// Node arrays: null exactly where the node is not accepted.
 const NODE_ARRAYS: &[&str] = &[
     "px_m",

@@ -57,22 +57,28 @@ pub struct ContinuumWorkspaceRequest {
     pub inputs_m: Option<Vec<f64>>,
     /// Platform load.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub load: Option<LoadRequest>,
     /// Solver settings.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub solver: Option<SolverRequest>,
     /// Starting point of the FK (which equilibrium you get).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub start: Option<StartRequest>,
     /// Optional FK outputs.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub outputs: Option<OutputsRequest>,
     /// Workspace sweep settings (mode = workspace).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub workspace: Option<WorkspaceRequest>,
     /// Assembly-mode search settings (mode = assembly_modes, start kind assembly_mode, designs
     /// without a stress-free home).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub assembly_modes: Option<AssemblyModesRequest>,
     /// Wall-clock limit for this request [ms] (extension; capped by the service limit).
     #[serde(default)]
@@ -87,6 +93,7 @@ pub struct ContinuumWorkspaceRequest {
 pub struct DesignRequest {
     /// Named preset with ASSUMED geometry (extension, spec 6.2).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub preset: Option<PresetName>,
     /// Linear guides (1..4).
     #[serde(default)]
@@ -130,6 +137,7 @@ pub struct RodRequest {
     /// Clamp offset `c_i` on the carriage [m].
     #[serde(default)]
     #[schema(example = json!([-0.0225, 0.0]))]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub offset_m: Option<[f64; 2]>,
     /// Clamp angle `theta_c,i` [deg] (tangent direction at s = 0, counter-clockwise from +X).
     #[schema(example = -60.0)]
@@ -140,14 +148,17 @@ pub struct RodRequest {
     /// Solid round section diameter `d_i` [m] (L/d >= 20 recommended, >= 5 required).
     #[serde(default)]
     #[schema(exclusive_minimum = 0.0, example = 0.004)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub diameter_m: Option<f64>,
     /// Bending stiffness `EI_i` [N m^2] (alternative to the diameter; overrides `E pi d^4/64`).
     #[serde(default)]
     #[schema(exclusive_minimum = 0.0, example = 2.63894)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ei_nm2: Option<f64>,
     /// Young's modulus `E_i` [Pa] (default 2.1e11).
     #[serde(default)]
     #[schema(exclusive_minimum = 0.0, example = 2.1e11)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub youngs_modulus_pa: Option<f64>,
     /// Platform point `r_i` in the platform frame [m].
     #[schema(example = json!([-0.0225, 0.0]))]
@@ -218,6 +229,7 @@ pub struct StartRequest {
     pub kind: StartKind,
     /// Previous `solver_state` (kind = guess).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub state: Option<SolverState>,
     /// Assembly-mode index in the margin-sorted list (kind = assembly_mode; default 0).
     #[serde(default)]
@@ -273,6 +285,7 @@ pub struct SeedRequest {
     pub inputs_m: Option<[f64; 2]>,
     /// Solver state (kind = guess).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub state: Option<SolverState>,
     /// Assembly-mode index (kind = assembly_mode; default 0).
     #[serde(default)]
@@ -331,6 +344,7 @@ pub struct WorkspaceLimits {
     pub sigma_allow_pa: Option<f64>,
     /// `ignore` (default) or `reject`.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub rod_crossing: Option<RodCrossing>,
 }
 
@@ -358,6 +372,7 @@ pub struct WorkspaceRequest {
     pub ranges_m: Option<[[f64; 2]; 2]>,
     /// Seed of the wave (default home).
     #[serde(default)]
+    #[schema(nullable = false)]
     pub seed: Option<SeedRequest>,
     /// 4 (default) or 8 neighbours.
     #[serde(default)]
@@ -382,6 +397,7 @@ pub struct WorkspaceRequest {
     pub substep_max_iter: Option<u32>,
     /// Jump limits per sub-step.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub jump_limits: Option<JumpLimits>,
     /// Largest accepted condition number of the scaled Jacobian (default 1e12).
     #[serde(default)]
@@ -389,6 +405,7 @@ pub struct WorkspaceRequest {
     pub cond_max: Option<f64>,
     /// `full` (default), `det_sign` or `none`.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub stability_check: Option<StabilityCheckName>,
     /// Segments per rod of the stability test (default 20 in sweeps).
     #[serde(default)]
@@ -396,6 +413,7 @@ pub struct WorkspaceRequest {
     pub stability_segments: Option<u32>,
     /// Physical limits.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub limits: Option<WorkspaceLimits>,
     /// Threshold of the quasi-translational area [deg] (default 1).
     #[serde(default)]
@@ -403,6 +421,7 @@ pub struct WorkspaceRequest {
     pub quasi_translational_deg: Option<f64>,
     /// `union` (default) or `sum`.
     #[serde(default)]
+    #[schema(nullable = false)]
     pub area_method: Option<AreaMethod>,
     /// Return the per-node arrays (default false).
     #[serde(default)]
@@ -489,7 +508,8 @@ pub struct RodOut {
 pub struct StabilityOut {
     /// margin > 1e-8.
     pub stable: bool,
-    /// Smallest constrained eigenvalue times `L_ref^2/EI_ref` (null if undefined).
+    /// Smallest constrained eigenvalue times `L_ref^2/EI_ref` (omitted when undefined).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub margin: Option<f64>,
     /// Sign of det J (stable solutions have +1; -1 proves instability).
     pub det_sign: i8,
@@ -543,6 +563,7 @@ pub struct FkResponse {
     pub status: FkStatus,
     /// Platform pose (omitted when not converged).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub platform: Option<PlatformOut>,
     /// Per-rod results (omitted when not converged).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -552,14 +573,17 @@ pub struct FkResponse {
     pub actuator_forces_n: Option<Vec<f64>>,
     /// Stability (when requested and converged).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub stability: Option<StabilityOut>,
     /// Diagnostics.
     pub diagnostics: DiagnosticsOut,
     /// State for warm starts (omitted when not converged).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub solver_state: Option<SolverState>,
     /// Preset statement when a preset was used.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub preset: Option<PresetOut>,
     /// Cost and stop reason.
     pub report: SolverReport,
@@ -636,6 +660,7 @@ pub struct SeedOut {
     pub assembly_mode_index: Option<u64>,
     /// Seed pose, when solved.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub platform: Option<PlatformOut>,
 }
 
@@ -646,6 +671,7 @@ pub struct WaveOut {
     pub seed: SeedOut,
     /// Per-node arrays (return_nodes).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub nodes: Option<NodesOut>,
     /// Metrics.
     pub metrics: MetricsOut,
@@ -687,6 +713,7 @@ pub struct AssemblyModeOut {
     /// margin > 1e-8.
     pub stable: bool,
     /// Stability margin.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub margin: Option<f64>,
     /// Sign of det J.
     pub det_sign: i8,
@@ -717,6 +744,7 @@ pub struct AssemblyModesResponse {
     pub warnings: Vec<String>,
     /// Preset statement when a preset was used.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub preset: Option<PresetOut>,
     /// Cost and stop reason.
     pub report: SolverReport,
