@@ -10,6 +10,7 @@ pub mod cam_law;
 pub mod cam_law_fit;
 pub mod cognates;
 pub mod component_importance;
+pub mod continuum_workspace;
 pub mod irefc;
 pub mod json;
 pub mod meta;
@@ -102,6 +103,7 @@ JSON pointers to the offending fields.",
         (name = "reliability", description = "Reliability and maintenance: component importance under fault propagation"),
         (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
+        (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -120,6 +122,7 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(bus_fuel_economy::motor_map))
         .routes(routes!(irefc::stress))
         .routes(routes!(irefc::efficiency))
+        .routes(routes!(continuum_workspace::solve))
 }
 
 /// The OpenAPI document of the service, generated from the handlers and wire types.

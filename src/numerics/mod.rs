@@ -2,5 +2,6 @@
 //! interpolation and seeded random numbers. Pure Rust: no I/O, no async runtime.
 
 pub mod budget;
+pub mod elliptic;
 
 pub use budget::{Budget, SolverReport, StopReason};

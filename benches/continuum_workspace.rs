@@ -1,0 +1,632 @@
+//! Benchmarks of the continuum-workspace endpoint (spec 8): rod tip error and time against RK4
+//! steps, FK error against RK4 steps with the warm-start time per solve, the Newton tolerance,
+//! the stability segments M, the 31 x 31 and 61 x 61 sweeps with each stability mode, the sweep
+//! knobs (sub-steps, predictor, threads) and the assembly-mode search grid.
+//!
+//! Run: `cargo bench --bench continuum_workspace`. Plain tables (median and worst of repeated
+//! timings, plus process CPU time for the sweeps) are printed first for `benches/RESULTS.md`, then
+//! criterion times the hot paths.
+
+// `criterion_group!` generates an undocumented public function.
+#![allow(missing_docs)]
+// Benchmark arithmetic stays in textbook form.
+#![allow(clippy::suboptimal_flops)]
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use mechcalc::calc::continuum_workspace::closed_form::elastica;
+use mechcalc::calc::continuum_workspace::model::{Model, Params};
+use mechcalc::calc::continuum_workspace::newton::{self, Counter, NewtonOptions, Solution};
+use mechcalc::calc::continuum_workspace::presets::Preset;
+use mechcalc::calc::continuum_workspace::sweep::{self, Limits, StabilityCheck, SweepSettings};
+use mechcalc::calc::continuum_workspace::{
+    ContinuumWorkspaceRequest, compute, fk, modes, rod, run,
+};
+use mechcalc::numerics::Budget;
+use serde_json::{Value, json};
+
+const EI: f64 = 2.638_937_829_015_426;
+const LEN: f64 = 0.5;
+
+/// Median and worst of `reps` timings of `f`, in µs.
+fn time_us(reps: usize, mut f: impl FnMut()) -> (f64, f64) {
+    f();
+    let mut t: Vec<f64> = (0..reps)
+        .map(|_| {
+            let s = Instant::now();
+            f();
+            s.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    (t[t.len() / 2], t[t.len() - 1])
+}
+
+/// Process CPU time (user + system, all threads) in ms, from /proc (10 ms resolution).
+fn cpu_ms() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return f64::NAN;
+    };
+    let after = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let ticks = |i: usize| {
+        f.get(i)
+            .and_then(|x| x.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
+    // Fields 14 and 15 of the stat line are the 12th and 13th after the command name.
+    (ticks(11) + ticks(12)) * 10.0
+}
+
+struct RodCase {
+    name: &'static str,
+    theta1: f64,
+    psi: f64,
+    k: f64,
+    q: u32,
+}
+
+const ROD_CASES: [RodCase; 2] = [
+    RodCase {
+        name: "k 0.9, psi 0.3, theta1 -60 deg, mode 1 (spec 8)",
+        theta1: -1.047_197_551_196_597_6,
+        psi: 0.3,
+        k: 0.9,
+        q: 1,
+    },
+    RodCase {
+        name: "k -0.7, psi 1.0, theta1 -60 deg, mode 2",
+        theta1: -1.047_197_551_196_597_6,
+        psi: 1.0,
+        k: -0.7,
+        q: 2,
+    },
+];
+
+fn rod_table() {
+    println!(
+        "\n### Rod: tip error vs RK4 steps against the closed form (spec 4.4), time per integration\n"
+    );
+    println!(
+        "| case | steps | tip error [m] | m(L) [N m] | plain µs (median / worst) | with sensitivities µs (median / worst) |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for c in &ROD_CASES {
+        let e = elastica(EI, LEN, c.theta1, c.psi, c.k, c.q).expect("admissible");
+        let q = [
+            e.base_moment * LEN / EI,
+            e.force[0] * LEN * LEN / EI,
+            e.force[1] * LEN * LEN / EI,
+        ];
+        let ode = rod::RodOde {
+            theta_c: c.theta1,
+            ca: 0.0,
+        };
+        for steps in [4usize, 8, 16, 32, 64, 128, 256, 512] {
+            let z = rod::shoot_plain(&ode, &q, steps);
+            let err = (z[0] * LEN - e.tip[0]).hypot(z[1] * LEN - e.tip[1]);
+            let reps = (200_000 / steps).clamp(200, 20_000);
+            let (pm, pw) = time_us(reps, || {
+                black_box(rod::shoot_plain(black_box(&ode), black_box(&q), steps));
+            });
+            let (sm, sw) = time_us(reps, || {
+                black_box(rod::shoot(black_box(&ode), black_box(&q), steps));
+            });
+            let mark = if steps == 32 { " (default)" } else { "" };
+            println!(
+                "| {} | {steps}{mark} | {err:.2e} | {:.1e} | {pm:.2} / {pw:.1} | {sm:.2} / {sw:.1} |",
+                c.name,
+                z[3] * EI / LEN
+            );
+        }
+    }
+}
+
+fn d1(steps: usize) -> Model {
+    Model::new(Preset::KeopsD1.design(), steps, false)
+}
+
+fn solve_home(model: &Model, lambda: [f64; 2], tol: f64) -> Solution {
+    let home = compute::resolve_home(model).expect("home");
+    let p = Params {
+        lambda: lambda.to_vec(),
+        force: [0.0, 0.0],
+        moment: 0.0,
+    };
+    let k = fk::continuation_steps(model, &home.lambda, &p.lambda);
+    fk::from_home(
+        model,
+        &home,
+        &p,
+        k,
+        NewtonOptions::new(tol, 50),
+        &Budget::unlimited(),
+        &mut Counter::default(),
+    )
+    .expect("converges")
+    .solution
+}
+
+fn fk_table() {
+    let target = [-0.05, 0.1725];
+    let neighbour = [-0.06, 0.1725];
+    let refm = d1(4096);
+    let reference = solve_home(&refm, target, 1e-13);
+    let rp = refm.position(&reference.v);
+    let rt = refm.angle(&reference.v);
+    println!(
+        "\n### FK: error vs RK4 steps (d1 at (-0.05, 0.1725), F = 0; reference 4096 steps, tol 1e-13), warm start from a 10 mm neighbour\n"
+    );
+    println!(
+        "Reference: p = ({:.10}, {:.10}) m, theta = {:.8} deg (spec 6.2: (0.0569633347, -0.4839533093), -0.9044944).\n",
+        rp[0],
+        rp[1],
+        rt.to_degrees()
+    );
+    println!(
+        "| rk4_steps | position error [m] | angle error [deg] | force error [N] | Newton iterations | warm solve µs (median / worst) |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for steps in [8usize, 16, 32, 64, 128] {
+        let model = d1(steps);
+        let from = solve_home(&model, neighbour, 1e-10);
+        let p = Params {
+            lambda: target.to_vec(),
+            force: [0.0, 0.0],
+            moment: 0.0,
+        };
+        let opts = NewtonOptions::new(1e-10, 50);
+        let sol = newton::solve(
+            &model,
+            &p,
+            &from.v,
+            opts,
+            &Budget::unlimited(),
+            &mut Counter::default(),
+        )
+        .expect("warm");
+        let pos = model.position(&sol.v);
+        let perr = (pos[0] - rp[0]).hypot(pos[1] - rp[1]);
+        let terr = (model.angle(&sol.v) - rt).to_degrees().abs();
+        let ferr = sol
+            .eval
+            .forces
+            .iter()
+            .zip(&reference.eval.forces)
+            .fold(0.0f64, |m, (a, b)| {
+                m.max((a[0] - b[0]).abs()).max((a[1] - b[1]).abs())
+            });
+        let (tm, tw) = time_us(2000, || {
+            black_box(
+                newton::solve(
+                    &model,
+                    &p,
+                    black_box(&from.v),
+                    opts,
+                    &Budget::unlimited(),
+                    &mut Counter::default(),
+                )
+                .ok(),
+            );
+        });
+        let mark = if steps == 32 { " (default)" } else { "" };
+        println!(
+            "| {steps}{mark} | {perr:.2e} | {terr:.2e} | {ferr:.2e} | {} | {tm:.1} / {tw:.0} |",
+            sol.iterations
+        );
+    }
+
+    println!(
+        "\n### FK: Newton tolerance (32 steps, same warm start; error vs the 32-step solution at tol 1e-14)\n"
+    );
+    println!("| tol | position change [m] | iterations | warm solve µs (median / worst) |");
+    println!("|---|---|---|---|");
+    let model = d1(32);
+    let from = solve_home(&model, neighbour, 1e-10);
+    let p = Params {
+        lambda: target.to_vec(),
+        force: [0.0, 0.0],
+        moment: 0.0,
+    };
+    let tight = newton::solve(
+        &model,
+        &p,
+        &from.v,
+        NewtonOptions::new(1e-14, 50),
+        &Budget::unlimited(),
+        &mut Counter::default(),
+    )
+    .expect("tight");
+    let tp = model.position(&tight.v);
+    for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14] {
+        let opts = NewtonOptions::new(tol, 50);
+        let sol = newton::solve(
+            &model,
+            &p,
+            &from.v,
+            opts,
+            &Budget::unlimited(),
+            &mut Counter::default(),
+        )
+        .expect("solves");
+        let pos = model.position(&sol.v);
+        let (tm, tw) = time_us(2000, || {
+            black_box(
+                newton::solve(
+                    &model,
+                    &p,
+                    black_box(&from.v),
+                    opts,
+                    &Budget::unlimited(),
+                    &mut Counter::default(),
+                )
+                .ok(),
+            );
+        });
+        let mark = if (tol - 1e-10).abs() < 1e-20 {
+            " (default)"
+        } else {
+            ""
+        };
+        println!(
+            "| {tol:e}{mark} | {:.1e} | {} | {tm:.1} / {tw:.0} |",
+            (pos[0] - tp[0]).hypot(pos[1] - tp[1]),
+            sol.iterations
+        );
+    }
+
+    println!(
+        "\n### FK requests end to end (`run()`, JSON-free; d1 at (-0.15, 0.2225), F = (0, -50) N)\n"
+    );
+    println!("| request | median µs | worst µs |");
+    println!("|---|---|---|");
+    let req = |extra: Value| -> ContinuumWorkspaceRequest {
+        let mut v = json!({"mode": "fk", "design": {"preset": "keops_d1"}, "inputs_m": [-0.15, 0.2225], "load": {"force_n": [0, -50]}});
+        if let (Some(o), Some(e)) = (v.as_object_mut(), extra.as_object()) {
+            for (k, x) in e {
+                o.insert(k.clone(), x.clone());
+            }
+        }
+        serde_json::from_value(v).expect("valid")
+    };
+    let budget = Budget::unlimited();
+    for (name, extra) in [
+        (
+            "home start (20 continuation steps), no stability",
+            json!({"outputs": {"stability": false}}),
+        ),
+        (
+            "home start, stability M = 20",
+            json!({"outputs": {"stability_segments": 20}}),
+        ),
+        ("home start, stability M = 40 (default)", json!({})),
+        (
+            "warm start (guess = the solution), no stability",
+            json!({"outputs": {"stability": false}, "start": {"kind": "guess", "state": {"v": [-0.567_191, 0.279_439, -2.367_666, -0.51573, -0.261_704, -0.775_534, 0.541_469, -0.017_735, -1.593_555, 0.049_818, -0.934_123, 0.002_546]}}}),
+        ),
+        (
+            "warm start, stability M = 40",
+            json!({"start": {"kind": "guess", "state": {"v": [-0.567_191, 0.279_439, -2.367_666, -0.51573, -0.261_704, -0.775_534, 0.541_469, -0.017_735, -1.593_555, 0.049_818, -0.934_123, 0.002_546]}}}),
+        ),
+    ] {
+        let r = req(extra);
+        let (m, w) = time_us(300, || {
+            black_box(run(r.clone(), &budget).ok());
+        });
+        println!("| {name} | {m:.0} | {w:.0} |");
+    }
+}
+
+fn stability_table() {
+    let model = d1(32);
+    let sol = solve_home(&model, [-0.05, 0.1725], 1e-12);
+    let reference = fk::margin_of(&model, &sol, 640).expect("margin");
+    println!(
+        "\n### Stability margin vs segments M (d1 at (-0.05, 0.1725); reference M = 640: {reference:.4}; spec: true 7.765)\n"
+    );
+    println!("| M | margin | error vs M = 640 | µs (median / worst) |");
+    println!("|---|---|---|---|");
+    for m in [10usize, 20, 40, 80, 160] {
+        let g = fk::margin_of(&model, &sol, m).expect("margin");
+        let reps = if m >= 160 { 20 } else { 200 };
+        let (tm, tw) = time_us(reps, || {
+            black_box(fk::margin_of(&model, black_box(&sol), m));
+        });
+        let mark = match m {
+            20 => " (sweep default)",
+            40 => " (FK default)",
+            _ => "",
+        };
+        println!(
+            "| {m}{mark} | {g:.4} | {:.1e} | {tm:.0} / {tw:.0} |",
+            (g - reference).abs() / reference
+        );
+    }
+}
+
+fn sweep_request(n: u32, stability: &str, extra: Value) -> ContinuumWorkspaceRequest {
+    let mut w = json!({"grid": [n, n], "stability_check": stability, "limits": {"min_actuator_gap_m": 0.05}});
+    if let (Some(o), Some(e)) = (w.as_object_mut(), extra.as_object()) {
+        for (k, x) in e {
+            o.insert(k.clone(), x.clone());
+        }
+    }
+    serde_json::from_value(
+        json!({"mode": "workspace", "design": {"preset": "keops_d1"}, "workspace": w}),
+    )
+    .expect("valid")
+}
+
+fn run_sweep(req: &ContinuumWorkspaceRequest) -> (Value, f64, f64) {
+    let c0 = cpu_ms();
+    let t0 = Instant::now();
+    let r = run(req.clone(), &Budget::unlimited()).expect("sweep");
+    let wall = t0.elapsed().as_secs_f64() * 1e3;
+    let cpu = cpu_ms() - c0;
+    (serde_json::to_value(r).expect("json"), wall, cpu)
+}
+
+fn sweep_tables() {
+    println!(
+        "\n### Sweeps: design 1, ranges home +/- 0.45 m, gap limit 0.05 m, F = 0, 8 sub-steps, M = 20 (spec 6.2 reference: ~705 nodes, union 0.2333 m^2, 35 folded, 3.18 deg, QT 0.1252 m^2)\n"
+    );
+    println!(
+        "| grid | stability | wall ms (median / worst of reps) | CPU ms (both threads) | µs CPU per attempted node | accepted | union m^2 | sum m^2 | folded | max angle deg | QT m^2 |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for (n, reps) in [(31u32, 3usize), (61, 1)] {
+        for st in ["full", "det_sign", "none"] {
+            let req = sweep_request(n, st, json!({}));
+            let mut walls = Vec::new();
+            let mut cpus = Vec::new();
+            let mut last = Value::Null;
+            for _ in 0..reps {
+                let (v, w, c) = run_sweep(&req);
+                walls.push(w);
+                cpus.push(c);
+                last = v;
+            }
+            walls.sort_by(f64::total_cmp);
+            cpus.sort_by(f64::total_cmp);
+            let m = &last["metrics"];
+            let attempts = last["report"]["iterations"].as_f64().unwrap_or(f64::NAN);
+            println!(
+                "| {n} x {n} | {st} | {:.0} / {:.0} | {:.0} | {:.0} | {} | {:.4} | {:.4} | {} | {:.2} | {:.4} |",
+                walls[walls.len() / 2],
+                walls[walls.len() - 1],
+                cpus[cpus.len() / 2],
+                cpus[cpus.len() / 2] * 1e3 / attempts,
+                m["n_accepted"],
+                m["area_union_m2"].as_f64().unwrap_or(f64::NAN),
+                m["area_sum_m2"].as_f64().unwrap_or(f64::NAN),
+                m["folded_cells"],
+                m["max_abs_parasitic_deg"].as_f64().unwrap_or(f64::NAN),
+                m["quasi_translational_area_m2"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+            );
+        }
+    }
+
+    println!("\n### Sweep knobs (31 x 31, det_sign unless stated; one run each)\n");
+    println!("| knob | wall ms | CPU ms | accepted | union m^2 | max angle deg | failures |");
+    println!("|---|---|---|---|---|---|---|");
+    let knobs: Vec<(&str, ContinuumWorkspaceRequest)> = vec![
+        (
+            "max_substeps 1",
+            sweep_request(31, "det_sign", json!({"max_substeps": 1})),
+        ),
+        (
+            "max_substeps 2",
+            sweep_request(31, "det_sign", json!({"max_substeps": 2})),
+        ),
+        (
+            "max_substeps 4",
+            sweep_request(31, "det_sign", json!({"max_substeps": 4})),
+        ),
+        (
+            "max_substeps 8 (default)",
+            sweep_request(31, "det_sign", json!({"max_substeps": 8})),
+        ),
+        (
+            "max_substeps 16",
+            sweep_request(31, "det_sign", json!({"max_substeps": 16})),
+        ),
+        (
+            "predictor off",
+            sweep_request(31, "det_sign", json!({"predictor": false})),
+        ),
+        (
+            "substep_max_iter 50 (no sweep cap)",
+            sweep_request(31, "det_sign", json!({"substep_max_iter": 50})),
+        ),
+        (
+            "full stability, M = 40",
+            sweep_request(31, "full", json!({"stability_segments": 40})),
+        ),
+        (
+            "8 neighbours",
+            sweep_request(31, "det_sign", json!({"neighbours": 8})),
+        ),
+        (
+            "area_method sum",
+            sweep_request(31, "det_sign", json!({"area_method": "sum"})),
+        ),
+    ];
+    for (name, req) in knobs {
+        let (v, w, c) = run_sweep(&req);
+        let m = &v["metrics"];
+        println!(
+            "| {name} | {w:.0} | {c:.0} | {} | {} | {:.2} | {} |",
+            m["n_accepted"],
+            m["area_union_m2"]
+                .as_f64()
+                .map_or("-".to_string(), |a| format!("{a:.4}")),
+            m["max_abs_parasitic_deg"].as_f64().unwrap_or(f64::NAN),
+            v["failures"]
+        );
+    }
+
+    println!("\n### Threads (31 x 31, det_sign, wave only; results are identical)\n");
+    println!("| threads | wall ms | CPU ms |");
+    println!("|---|---|---|");
+    let model = d1(32);
+    let base = Params {
+        lambda: vec![-0.25, 0.2725],
+        force: [0.0, 0.0],
+        moment: 0.0,
+    };
+    for threads in [1usize, 2] {
+        let s = SweepSettings {
+            grid: [31, 31],
+            ranges: [[-0.7, 0.2], [-0.1775, 0.7225]],
+            diagonal_neighbours: false,
+            predictor: true,
+            max_substeps: 8,
+            max_tries: 4,
+            substep_max_iter: 20,
+            angle_jump: 5f64.to_radians(),
+            position_factor: 5.0,
+            cond_max: 1e12,
+            stability: StabilityCheck::DetSign,
+            segments: 20,
+            limits: Limits {
+                min_gap: Some(0.05),
+                sigma_allow: None,
+                rod_crossing: false,
+            },
+            threads,
+        };
+        let seed_sol = solve_home(&model, [-0.25, 0.2725], 1e-10);
+        let seed = sweep::accept(&model, &s, &[-0.25, 0.2725], &seed_sol, None).expect("seed");
+        let c0 = cpu_ms();
+        let t0 = Instant::now();
+        let w = sweep::wave(
+            &model,
+            &base,
+            &s,
+            (15, 15),
+            seed,
+            NewtonOptions::new(1e-10, 50),
+            &Budget::unlimited(),
+        );
+        let wall = t0.elapsed().as_secs_f64() * 1e3;
+        black_box(w);
+        println!("| {threads} | {wall:.0} | {:.0} |", cpu_ms() - c0);
+    }
+}
+
+fn modes_table() {
+    println!(
+        "\n### Assembly-mode search (d1 at (-0.22, 0.2425), Tol 0.45, cell 2; spec 6.2: N_grid 6 -> 4 solutions, 2 stable)\n"
+    );
+    println!("| N_grid | combinations examined | candidates | refined | solutions | stable | ms |");
+    println!("|---|---|---|---|---|---|---|");
+    let model = d1(32);
+    let p = Params {
+        lambda: vec![-0.22, 0.2425],
+        force: [0.0, 0.0],
+        moment: 0.0,
+    };
+    for ng in [3usize, 4, 5, 6, 7] {
+        let t0 = Instant::now();
+        let r = modes::search(
+            &model,
+            &p,
+            modes::ModeSearch {
+                n_grid: ng,
+                tol: 0.45,
+                cell: 2,
+                max_refine: 4000,
+            },
+            NewtonOptions::new(1e-10, 50),
+            40,
+            &Budget::unlimited(),
+            &mut Counter::default(),
+        );
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let mark = if ng == 6 { " (default)" } else { "" };
+        println!(
+            "| {ng}{mark} | {} | {} | {} | {} | {} | {ms:.0} |",
+            r.combinations,
+            r.candidates,
+            r.refined,
+            r.solutions.len(),
+            r.solutions.iter().filter(|s| s.stable).count()
+        );
+    }
+}
+
+fn criterion_benches(c: &mut Criterion) {
+    let e = elastica(EI, LEN, ROD_CASES[0].theta1, 0.3, 0.9, 1).expect("admissible");
+    let q = [
+        e.base_moment * LEN / EI,
+        e.force[0] * LEN * LEN / EI,
+        e.force[1] * LEN * LEN / EI,
+    ];
+    let ode = rod::RodOde {
+        theta_c: ROD_CASES[0].theta1,
+        ca: 0.0,
+    };
+    let mut g = c.benchmark_group("rod_32_steps");
+    g.bench_function("plain", |b| {
+        b.iter(|| rod::shoot_plain(black_box(&ode), black_box(&q), 32))
+    });
+    g.bench_function("with_sensitivities", |b| {
+        b.iter(|| rod::shoot(black_box(&ode), black_box(&q), 32))
+    });
+    g.finish();
+
+    let model = d1(32);
+    let from = solve_home(&model, [-0.06, 0.1725], 1e-10);
+    let p = Params {
+        lambda: vec![-0.05, 0.1725],
+        force: [0.0, 0.0],
+        moment: 0.0,
+    };
+    let sol = solve_home(&model, [-0.05, 0.1725], 1e-10);
+    let mut g = c.benchmark_group("fk_d1");
+    g.bench_function("warm_solve_10mm", |b| {
+        b.iter(|| {
+            newton::solve(
+                &model,
+                &p,
+                black_box(&from.v),
+                NewtonOptions::new(1e-10, 50),
+                &Budget::unlimited(),
+                &mut Counter::default(),
+            )
+            .ok()
+        })
+    });
+    g.bench_function("stability_m20", |b| {
+        b.iter(|| fk::margin_of(&model, black_box(&sol), 20))
+    });
+    g.bench_function("stability_m40", |b| {
+        b.iter(|| fk::margin_of(&model, black_box(&sol), 40))
+    });
+    g.finish();
+}
+
+fn tables(_: &mut Criterion) {
+    println!(
+        "\n## continuum_workspace tables (load average at start: {})",
+        std::fs::read_to_string("/proc/loadavg")
+            .unwrap_or_default()
+            .trim()
+    );
+    rod_table();
+    fk_table();
+    stability_table();
+    modes_table();
+    sweep_tables();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30);
+    targets = tables, criterion_benches
+}
+criterion_main!(benches);

@@ -1,0 +1,831 @@
+//! Validation of the request into the SI domain input (spec 3), collecting every offending field.
+
+use std::time::Duration;
+
+use super::fk::{self, HOME_REL_TOL};
+use super::model::{Actuator, Design, Model, Params, Rod};
+use super::modes::{self, ModeSearch};
+use super::newton::NewtonOptions;
+use super::presets::Preset;
+use super::sweep::{Limits, StabilityCheck, SweepSettings};
+use super::wire::{
+    AreaMethod, ContinuumWorkspaceRequest, Mode, PresetName, RodCrossing, SeedKind,
+    StabilityCheckName, StartKind,
+};
+use crate::calc::{CalcFailure, ProblemClass, Validator};
+
+/// Largest accepted coordinate, stroke or length magnitude [m]: the scales the service is
+/// tested at run from 1e-6 m to 1e6 m; beyond, products such as EI or B x n leave the range
+/// where the scaled residual is meaningful.
+const MAX_COORD_M: f64 = 1e6;
+/// Smallest rod length [m] (see `MAX_COORD_M`).
+const MIN_LENGTH_M: f64 = 1e-7;
+/// Smallest rod diameter [m] (EI ~ d^4 must stay a normal float).
+const MIN_DIAMETER_M: f64 = 1e-9;
+/// Accepted Young's modulus range [Pa] (gels to beyond diamond).
+const E_RANGE_PA: [f64; 2] = [1.0, 1e13];
+/// Accepted bending stiffness range [N m^2] when given directly.
+const EI_RANGE: [f64; 2] = [1e-30, 1e20];
+/// Largest allowable stress [Pa].
+const MAX_SIGMA_PA: f64 = 1e15;
+/// Default Young's modulus (steel) [Pa] (spec 3.1).
+const DEFAULT_E: f64 = 2.1e11;
+/// Rods with L/d below this are rejected (spec 3.1).
+const MIN_SLENDERNESS: f64 = 5.0;
+/// Rods with L/d below this get a warning: slender-rod theory becomes inaccurate (spec 7).
+const WARN_SLENDERNESS: f64 = 20.0;
+/// Guide directions shorter than this cannot be normalised (spec 3.1).
+const MIN_DIRECTION_NORM: f64 = 1e-12;
+/// Attachments closer than this fraction of L_ref to each other are coincident (spec 3.1).
+const COINCIDENT_REL: f64 = 1e-9;
+/// Load limit in units of `F_ref = EI_ref/L_ref^2` (spec 3.2); the moment limit uses `F_ref L_ref`.
+const MAX_LOAD_REL: f64 = 1e4;
+/// Largest grid side and node count (spec 4.7).
+const MAX_GRID_SIDE: u32 = 401;
+/// Largest number of grid nodes (spec 4.7).
+const MAX_GRID_NODES: u64 = 40_401;
+/// Largest number of closed-form grid combinations (spec 4.6).
+const MAX_COMBINATIONS: f64 = 1e8;
+/// Service-side ceiling of a request's own time limit [ms].
+pub const MAX_TIME_LIMIT_MS: u64 = 120_000;
+/// Default stability segments in sweeps (spec 8 targets use M = 20; the sign is what matters).
+const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
+/// Worker threads of the sweep (the service machine has 2 cores; results do not depend on it).
+pub const SWEEP_THREADS: usize = 2;
+
+/// How the FK starts.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Start {
+    /// Home continuation (fallback: the stable assembly mode with the smallest |theta|).
+    Home,
+    /// Newton from a given state.
+    Guess(Vec<f64>),
+    /// Assembly mode `index` of the margin-sorted search result.
+    AssemblyMode(usize),
+}
+
+/// Seed of a sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeedInput {
+    /// Kind.
+    pub kind: SeedKind,
+    /// Inputs near which the seed node is chosen [m].
+    pub inputs: Option<[f64; 2]>,
+    /// State for `guess`.
+    pub state: Option<Vec<f64>>,
+    /// Mode index for `assembly_mode`.
+    pub index: usize,
+}
+
+/// Sweep inputs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepInput {
+    /// Wave settings.
+    pub settings: SweepSettings,
+    /// Seed.
+    pub seed: SeedInput,
+    /// Quasi-translational threshold [rad].
+    pub qt_threshold: f64,
+    /// Compute the union area.
+    pub union: bool,
+    /// Return node arrays.
+    pub return_nodes: bool,
+}
+
+/// The validated domain input (SI units).
+#[derive(Debug, Clone)]
+pub struct Input {
+    /// Mode.
+    pub mode: Mode,
+    /// Model (design, scales, RK4 steps, extensibility).
+    pub model: Model,
+    /// Preset used, if any.
+    pub preset: Option<Preset>,
+    /// Inputs and loads (for workspace: loads only; lambda = seed inputs placeholder).
+    pub params: Params,
+    /// Newton settings.
+    pub newton: NewtonOptions,
+    /// FK start.
+    pub start: Start,
+    /// Continuation step override.
+    pub continuation_steps: Option<usize>,
+    /// Run the FK stability test.
+    pub stability: bool,
+    /// Stability segments of FK and mode search.
+    pub segments: usize,
+    /// Shape points per rod.
+    pub shape_points: usize,
+    /// Mode search settings.
+    pub modes: ModeSearch,
+    /// Sweep, for mode = workspace.
+    pub sweep: Option<SweepInput>,
+    /// Warnings found during validation.
+    pub warnings: Vec<String>,
+    /// Request time limit.
+    pub time_limit: Option<Duration>,
+}
+
+fn preset_of(p: PresetName) -> Preset {
+    match p {
+        PresetName::KeopsD1 => Preset::KeopsD1,
+        PresetName::KeopsD2 => Preset::KeopsD2,
+        PresetName::KeopsD3 => Preset::KeopsD3,
+        PresetName::KeopsD4 => Preset::KeopsD4,
+        PresetName::KeopsD1OptA => Preset::KeopsD1OptA,
+        PresetName::Symmetric => Preset::Symmetric,
+    }
+}
+
+fn u32_in(v: &mut Validator, ptr: &str, x: Option<u32>, lo: u32, hi: u32, default: u32) -> u32 {
+    match x {
+        Some(x) if x < lo || x > hi => {
+            v.push(ptr, format!("must be in [{lo}, {hi}], got {x}"));
+            default
+        }
+        Some(x) => x,
+        None => default,
+    }
+}
+
+fn f64_in(v: &mut Validator, ptr: &str, x: Option<f64>, lo: f64, hi: f64, default: f64) -> f64 {
+    match x {
+        Some(x) => {
+            if v.in_range(ptr, x, lo, hi) {
+                x
+            } else {
+                default
+            }
+        }
+        None => default,
+    }
+}
+
+/// Require every element finite and within `+/- MAX_COORD_M`.
+fn coords(v: &mut Validator, ptr: &str, values: &[f64]) -> bool {
+    if !v.all_finite(ptr, values) {
+        return false;
+    }
+    let mut ok = true;
+    for (i, x) in values.iter().enumerate() {
+        if x.abs() > MAX_COORD_M {
+            v.push(
+                format!("{ptr}/{i}"),
+                format!("must be within +/-{MAX_COORD_M:e} m, got {x}"),
+            );
+            ok = false;
+        }
+    }
+    ok
+}
+
+fn usize_of(x: u32) -> usize {
+    usize::try_from(x).unwrap_or(usize::MAX)
+}
+
+/// Validate the design part; returns the design (possibly partial when invalid).
+fn design_of(
+    req: &ContinuumWorkspaceRequest,
+    v: &mut Validator,
+    warnings: &mut Vec<String>,
+) -> (Design, Option<Preset>) {
+    let d = &req.design;
+    if let Some(p) = d.preset {
+        for (present, name) in [
+            (d.actuators.is_some(), "actuators"),
+            (d.rods.is_some(), "rods"),
+            (d.home_inputs_m.is_some(), "home_inputs_m"),
+        ] {
+            if present {
+                v.push(
+                    format!("/design/{name}"),
+                    "must be absent when design.preset is given (presets fix the geometry)",
+                );
+            }
+        }
+        let preset = preset_of(p);
+        let mut design = preset.design();
+        design.sigma_allow = d.sigma_allow_pa;
+        if let Some(s) = d.sigma_allow_pa {
+            v.in_range("/design/sigma_allow_pa", s, f64::MIN_POSITIVE, MAX_SIGMA_PA);
+        }
+        return (design, Some(preset));
+    }
+    let mut actuators = Vec::new();
+    match &d.actuators {
+        None => v.push("/design/actuators", "required (or give design.preset)"),
+        Some(acts) => {
+            if acts.is_empty() || acts.len() > 4 {
+                v.push(
+                    "/design/actuators",
+                    format!("must list 1..4 actuators, got {}", acts.len()),
+                );
+            }
+            for (j, a) in acts.iter().enumerate() {
+                let p = format!("/design/actuators/{j}");
+                coords(v, &format!("{p}/origin_m"), &a.origin_m);
+                let mut dir = [1.0, 0.0];
+                if v.all_finite(&format!("{p}/direction"), &a.direction) {
+                    let nrm = a.direction[0].hypot(a.direction[1]);
+                    if nrm > MIN_DIRECTION_NORM {
+                        dir = [a.direction[0] / nrm, a.direction[1] / nrm];
+                    } else {
+                        v.push(
+                            format!("{p}/direction"),
+                            format!("norm must be > {MIN_DIRECTION_NORM}, got {nrm}"),
+                        );
+                    }
+                }
+                if coords(v, &format!("{p}/stroke_m"), &a.stroke_m)
+                    && a.stroke_m[0] >= a.stroke_m[1]
+                {
+                    v.push(
+                        format!("{p}/stroke_m"),
+                        format!(
+                            "min must be < max, got [{}, {}]",
+                            a.stroke_m[0], a.stroke_m[1]
+                        ),
+                    );
+                }
+                actuators.push(Actuator {
+                    origin: a.origin_m,
+                    dir,
+                    stroke: a.stroke_m,
+                });
+            }
+        }
+    }
+    let n_act = actuators.len();
+    let mut rods = Vec::new();
+    match &d.rods {
+        None => v.push("/design/rods", "required (or give design.preset)"),
+        Some(rs) => {
+            if rs.len() < 2 || rs.len() > 8 {
+                v.push(
+                    "/design/rods",
+                    format!("must list 2..8 rods, got {}", rs.len()),
+                );
+            }
+            for (i, r) in rs.iter().enumerate() {
+                let p = format!("/design/rods/{i}");
+                if r.actuator >= n_act {
+                    v.push(
+                        format!("{p}/actuator"),
+                        format!(
+                            "unknown actuator index {} (design has {n_act} actuators)",
+                            r.actuator
+                        ),
+                    );
+                }
+                let offset = r.offset_m.unwrap_or([0.0, 0.0]);
+                coords(v, &format!("{p}/offset_m"), &offset);
+                v.finite(&format!("{p}/clamp_angle_deg"), r.clamp_angle_deg);
+                let len_ok = v.in_range(
+                    &format!("{p}/length_m"),
+                    r.length_m,
+                    MIN_LENGTH_M,
+                    MAX_COORD_M,
+                );
+                coords(v, &format!("{p}/attach_m"), &r.attach_m);
+                let e = r.youngs_modulus_pa.unwrap_or(DEFAULT_E);
+                let e_ok = v.in_range(
+                    &format!("{p}/youngs_modulus_pa"),
+                    e,
+                    E_RANGE_PA[0],
+                    E_RANGE_PA[1],
+                );
+                let mut diameter = None;
+                if let Some(dm) = r.diameter_m
+                    && v.in_range(&format!("{p}/diameter_m"), dm, MIN_DIAMETER_M, MAX_COORD_M)
+                {
+                    diameter = Some(dm);
+                    {
+                        if len_ok {
+                            let slender = r.length_m / dm;
+                            if slender < MIN_SLENDERNESS {
+                                v.push(
+                                    format!("{p}/diameter_m"),
+                                    format!(
+                                        "slenderness L/d = {slender:.3} is below {MIN_SLENDERNESS}: the rod model does not apply"
+                                    ),
+                                );
+                            } else if slender < WARN_SLENDERNESS {
+                                warnings.push(format!(
+                                    "slender_rod {i}: L/d = {slender:.2} < {WARN_SLENDERNESS}, slender-rod (Kirchhoff) theory is inaccurate"
+                                ));
+                            }
+                        }
+                    }
+                }
+                if let Some(ei) = r.ei_nm2 {
+                    v.in_range(&format!("{p}/ei_nm2"), ei, EI_RANGE[0], EI_RANGE[1]);
+                }
+                if r.diameter_m.is_none() && r.ei_nm2.is_none() {
+                    v.push(format!("{p}/diameter_m"), "required unless ei_nm2 is given");
+                }
+                let ei = match (r.ei_nm2, diameter) {
+                    (Some(ei), _) => ei,
+                    (None, Some(dm)) => e * std::f64::consts::PI * dm.powi(4) / 64.0,
+                    _ => 1.0,
+                };
+                let ea = match (diameter, e_ok) {
+                    (Some(dm), true) => Some(e * std::f64::consts::PI * dm * dm / 4.0),
+                    _ => None,
+                };
+                rods.push(Rod {
+                    actuator: r.actuator.min(n_act.saturating_sub(1)),
+                    offset,
+                    clamp: r.clamp_angle_deg.to_radians(),
+                    length: if len_ok { r.length_m } else { 1.0 },
+                    ei: if ei.is_finite() && ei > 0.0 { ei } else { 1.0 },
+                    ea,
+                    diameter,
+                    attach: r.attach_m,
+                });
+            }
+            for j in 0..n_act {
+                if !rs.iter().any(|r| r.actuator == j) {
+                    v.push(
+                        format!("/design/actuators/{j}"),
+                        "carries no rod: its input would be undetermined",
+                    );
+                }
+            }
+            if rods.len() >= 2 && v.is_clean() {
+                let l_ref = rods.iter().map(|r| r.length).sum::<f64>() / rods.len() as f64;
+                let r0 = rods[0].attach;
+                let spread = rods.iter().fold(0.0f64, |m, r| {
+                    m.max((r.attach[0] - r0[0]).hypot(r.attach[1] - r0[1]))
+                });
+                if spread <= COINCIDENT_REL * l_ref {
+                    v.push(
+                        "/design/rods",
+                        "all attachment points attach_m coincide: the platform rotation is undetermined",
+                    );
+                }
+            }
+        }
+    }
+    if let Some(s) = d.sigma_allow_pa {
+        v.in_range("/design/sigma_allow_pa", s, f64::MIN_POSITIVE, MAX_SIGMA_PA);
+    }
+    if let Some(h) = &d.home_inputs_m {
+        if h.len() != n_act {
+            v.push(
+                "/design/home_inputs_m",
+                format!(
+                    "must have {n_act} entries (one per actuator), got {}",
+                    h.len()
+                ),
+            );
+        } else {
+            coords(v, "/design/home_inputs_m", h);
+        }
+    }
+    let design = Design {
+        actuators,
+        rods,
+        home: d.home_inputs_m.clone(),
+        sigma_allow: d.sigma_allow_pa,
+    };
+    (design, None)
+}
+
+impl TryFrom<&ContinuumWorkspaceRequest> for Input {
+    type Error = CalcFailure;
+
+    fn try_from(req: &ContinuumWorkspaceRequest) -> Result<Self, CalcFailure> {
+        let mut v = Validator::new();
+        let mut warnings = Vec::new();
+        let (design, preset) = design_of(req, &mut v, &mut warnings);
+        let solver = req.solver.clone().unwrap_or_default();
+        let base_steps = u32_in(&mut v, "/solver/rk4_steps", solver.rk4_steps, 4, 4096, 32);
+        let tol = f64_in(&mut v, "/solver/tol", solver.tol, 1e-14, 1e-4, 1e-10);
+        let max_iter = u32_in(&mut v, "/solver/max_iter", solver.max_iter, 5, 200, 50);
+        let extensible = solver.axial_extensibility.unwrap_or(false);
+        if extensible && design.rods.iter().any(|r| r.ea.is_none()) {
+            v.push(
+                "/solver/axial_extensibility",
+                "needs diameter_m (and youngs_modulus_pa) on every rod to compute EA",
+            );
+        }
+        // Structural problems make everything below meaningless: stop here.
+        v.finish()?;
+        let mut v = Validator::new();
+        let model = Model::new(design, usize_of(base_steps), extensible);
+        let n_act = model.n_act();
+        let nr = model.n_rods();
+        // Given home inputs must really be stress-free.
+        if let (Some(h), None) = (&model.design.home, preset) {
+            let fit = fk::home_fit(&model, Some(h));
+            if fit.residual.is_nan() || fit.residual > HOME_REL_TOL * model.l_ref {
+                v.push(
+                    "/design/home_inputs_m",
+                    format!(
+                        "rods are not straight and unloaded with theta_EE = 0 at these inputs (closure residual {:.3e} m > {:.1e} L_ref)",
+                        fit.residual, HOME_REL_TOL
+                    ),
+                );
+            }
+        }
+        // Loads.
+        let load = req.load.clone().unwrap_or_default();
+        let force = load.force_n.unwrap_or([0.0, 0.0]);
+        let moment = load.moment_nm.unwrap_or(0.0);
+        if v.all_finite("/load/force_n", &force) {
+            let fmax = MAX_LOAD_REL * model.f_ref;
+            let fnorm = force[0].hypot(force[1]);
+            if fnorm > fmax {
+                v.push(
+                    "/load/force_n",
+                    format!("|F| = {fnorm} N exceeds 1e4 EI_ref/L_ref^2 = {fmax} N"),
+                );
+            }
+        }
+        if v.finite("/load/moment_nm", moment) {
+            let mmax = MAX_LOAD_REL * model.f_ref * model.l_ref;
+            if moment.abs() > mmax {
+                v.push(
+                    "/load/moment_nm",
+                    format!(
+                        "|M| = {} N m exceeds 1e4 EI_ref/L_ref = {mmax} N m",
+                        moment.abs()
+                    ),
+                );
+            }
+        }
+        // Inputs.
+        let mut lambda = vec![0.0; n_act];
+        if matches!(req.mode, Mode::Fk | Mode::AssemblyModes) {
+            match &req.inputs_m {
+                None => v.push("/inputs_m", "required for mode fk and assembly_modes"),
+                Some(l) if l.len() != n_act => {
+                    v.push(
+                        "/inputs_m",
+                        format!(
+                            "must have {n_act} entries (one per actuator), got {}",
+                            l.len()
+                        ),
+                    );
+                }
+                Some(l) => {
+                    for (j, (&x, a)) in l.iter().zip(&model.design.actuators).enumerate() {
+                        v.in_range(&format!("/inputs_m/{j}"), x, a.stroke[0], a.stroke[1]);
+                    }
+                    lambda.clone_from(l);
+                }
+            }
+        }
+        // Start.
+        let start_req = req.start.clone();
+        let start = match &start_req {
+            None => Start::Home,
+            Some(s) => match s.kind {
+                StartKind::Home => Start::Home,
+                StartKind::AssemblyMode => Start::AssemblyMode(s.index.unwrap_or(0)),
+                StartKind::Guess => match &s.state {
+                    None => {
+                        v.push("/start/state", "required when start.kind = guess");
+                        Start::Home
+                    }
+                    Some(st) => {
+                        if st.v.len() != 3 * nr + 3 {
+                            v.push(
+                                "/start/state/v",
+                                format!(
+                                    "must have 3N+3 = {} entries, got {}",
+                                    3 * nr + 3,
+                                    st.v.len()
+                                ),
+                            );
+                        } else {
+                            v.all_finite("/start/state/v", &st.v);
+                        }
+                        Start::Guess(st.v.clone())
+                    }
+                },
+            },
+        };
+        let continuation_steps = start_req
+            .as_ref()
+            .and_then(|s| s.continuation_steps)
+            .map(|k| {
+                usize_of(u32_in(
+                    &mut v,
+                    "/start/continuation_steps",
+                    Some(k),
+                    1,
+                    10_000,
+                    30,
+                ))
+            });
+        // Outputs.
+        let outputs = req.outputs.clone().unwrap_or_default();
+        let stability = outputs.stability.unwrap_or(true);
+        let segments = u32_in(
+            &mut v,
+            "/outputs/stability_segments",
+            outputs.stability_segments,
+            10,
+            400,
+            40,
+        );
+        let shape_points = u32_in(
+            &mut v,
+            "/outputs/rod_shape_points",
+            outputs.rod_shape_points,
+            0,
+            1000,
+            0,
+        );
+        // Mode search.
+        let am = req.assembly_modes.clone().unwrap_or_default();
+        let n_grid = u32_in(&mut v, "/assembly_modes/n_grid", am.n_grid, 1, 50, 6);
+        let mtol = f64_in(
+            &mut v,
+            "/assembly_modes/tol",
+            am.tol,
+            f64::MIN_POSITIVE,
+            10.0,
+            0.45,
+        );
+        let cell = u32_in(&mut v, "/assembly_modes/cell", am.cell, 1, 100, 2);
+        let max_refine = u32_in(
+            &mut v,
+            "/assembly_modes/max_refine",
+            am.max_refine,
+            1,
+            20_000,
+            4000,
+        );
+        let modes = ModeSearch {
+            n_grid: usize_of(n_grid),
+            tol: mtol,
+            cell: usize_of(cell),
+            max_refine: usize_of(max_refine),
+        };
+        // Time limit.
+        let time_limit = req.time_limit_ms.and_then(|ms| {
+            if (1..=MAX_TIME_LIMIT_MS).contains(&ms) {
+                Some(Duration::from_millis(ms))
+            } else {
+                v.push(
+                    "/time_limit_ms",
+                    format!("must be in [1, {MAX_TIME_LIMIT_MS}] ms, got {ms}"),
+                );
+                None
+            }
+        });
+        // Workspace.
+        let mut too_large: Option<CalcFailure> = None;
+        let sweep = if req.mode == Mode::Workspace {
+            if n_act != 2 {
+                v.push(
+                    "/design/actuators",
+                    format!("mode workspace needs exactly 2 actuators (2-D grid), got {n_act}"),
+                );
+            }
+            let w = req.workspace.clone().unwrap_or_default();
+            let grid = w.grid.unwrap_or([31, 31]);
+            for (k, &g) in grid.iter().enumerate() {
+                if !(2..=MAX_GRID_SIDE).contains(&g) {
+                    v.push(
+                        format!("/workspace/grid/{k}"),
+                        format!("must be in [2, {MAX_GRID_SIDE}], got {g}"),
+                    );
+                }
+            }
+            let nodes = u64::from(grid[0]) * u64::from(grid[1]);
+            if nodes > MAX_GRID_NODES {
+                too_large = Some(CalcFailure::field(
+                    ProblemClass::TooLarge,
+                    "GRID_TOO_LARGE",
+                    "/workspace/grid",
+                    format!(
+                        "{} x {} = {nodes} nodes exceeds the limit of {MAX_GRID_NODES}; split the ranges into tiles (they can run in parallel)",
+                        grid[0], grid[1]
+                    ),
+                ));
+            }
+            let strokes = if n_act == 2 {
+                [
+                    model.design.actuators[0].stroke,
+                    model.design.actuators[1].stroke,
+                ]
+            } else {
+                [[0.0, 1.0], [0.0, 1.0]]
+            };
+            let ranges = w.ranges_m.unwrap_or(strokes);
+            for (k, r) in ranges.iter().enumerate() {
+                if coords(&mut v, &format!("/workspace/ranges_m/{k}"), r) && r[0] >= r[1] {
+                    v.push(
+                        format!("/workspace/ranges_m/{k}"),
+                        format!("min must be < max, got [{}, {}]", r[0], r[1]),
+                    );
+                }
+            }
+            let neighbours = w.neighbours.unwrap_or(4);
+            if neighbours != 4 && neighbours != 8 {
+                v.push(
+                    "/workspace/neighbours",
+                    format!("must be 4 or 8, got {neighbours}"),
+                );
+            }
+            let max_substeps = u32_in(&mut v, "/workspace/max_substeps", w.max_substeps, 1, 64, 8);
+            if !max_substeps.is_power_of_two() {
+                v.push(
+                    "/workspace/max_substeps",
+                    format!("must be a power of two (1, 2, 4, ..., 64), got {max_substeps}"),
+                );
+            }
+            let max_tries = u32_in(&mut v, "/workspace/max_tries", w.max_tries, 1, 8, 4);
+            let substep_max_iter = u32_in(
+                &mut v,
+                "/workspace/substep_max_iter",
+                w.substep_max_iter,
+                5,
+                200,
+                20,
+            );
+            let jl = w.jump_limits.clone().unwrap_or_default();
+            let angle_jump = f64_in(
+                &mut v,
+                "/workspace/jump_limits/angle_deg",
+                jl.angle_deg,
+                1e-6,
+                180.0,
+                5.0,
+            );
+            let position_factor = f64_in(
+                &mut v,
+                "/workspace/jump_limits/position_factor",
+                jl.position_factor,
+                1e-6,
+                1000.0,
+                5.0,
+            );
+            let cond_max = f64_in(&mut v, "/workspace/cond_max", w.cond_max, 10.0, 1e18, 1e12);
+            let stab = match w.stability_check.unwrap_or(StabilityCheckName::Full) {
+                StabilityCheckName::Full => StabilityCheck::Full,
+                StabilityCheckName::DetSign => StabilityCheck::DetSign,
+                StabilityCheckName::None => StabilityCheck::None,
+            };
+            let wsegs = u32_in(
+                &mut v,
+                "/workspace/stability_segments",
+                w.stability_segments,
+                10,
+                400,
+                DEFAULT_SWEEP_SEGMENTS,
+            );
+            let lim = w.limits.clone().unwrap_or_default();
+            if let Some(g) = lim.min_actuator_gap_m {
+                v.in_range(
+                    "/workspace/limits/min_actuator_gap_m",
+                    g,
+                    -MAX_COORD_M,
+                    MAX_COORD_M,
+                );
+            }
+            if let Some(s) = lim.sigma_allow_pa {
+                v.in_range(
+                    "/workspace/limits/sigma_allow_pa",
+                    s,
+                    f64::MIN_POSITIVE,
+                    MAX_SIGMA_PA,
+                );
+            }
+            let qt = f64_in(
+                &mut v,
+                "/workspace/quasi_translational_deg",
+                w.quasi_translational_deg,
+                1e-9,
+                180.0,
+                1.0,
+            );
+            let seed = match &w.seed {
+                None => SeedInput {
+                    kind: SeedKind::Home,
+                    inputs: None,
+                    state: None,
+                    index: 0,
+                },
+                Some(s) => {
+                    if let Some(i) = &s.inputs_m {
+                        coords(&mut v, "/workspace/seed/inputs_m", i);
+                    }
+                    let state = match (s.kind, &s.state) {
+                        (SeedKind::Guess, None) => {
+                            v.push("/workspace/seed/state", "required when seed.kind = guess");
+                            None
+                        }
+                        (SeedKind::Guess, Some(st)) => {
+                            if st.v.len() != 3 * nr + 3 {
+                                v.push(
+                                    "/workspace/seed/state/v",
+                                    format!(
+                                        "must have 3N+3 = {} entries, got {}",
+                                        3 * nr + 3,
+                                        st.v.len()
+                                    ),
+                                );
+                            } else {
+                                v.all_finite("/workspace/seed/state/v", &st.v);
+                            }
+                            Some(st.v.clone())
+                        }
+                        _ => None,
+                    };
+                    SeedInput {
+                        kind: s.kind,
+                        inputs: s.inputs_m,
+                        state,
+                        index: s.index.unwrap_or(0),
+                    }
+                }
+            };
+            Some(SweepInput {
+                settings: SweepSettings {
+                    grid: [usize_of(grid[0]), usize_of(grid[1])],
+                    ranges,
+                    diagonal_neighbours: neighbours == 8,
+                    predictor: w.predictor.unwrap_or(true),
+                    max_substeps: usize_of(max_substeps),
+                    max_tries: usize_of(max_tries),
+                    substep_max_iter: usize_of(substep_max_iter),
+                    angle_jump: angle_jump.to_radians(),
+                    position_factor,
+                    cond_max,
+                    stability: stab,
+                    segments: usize_of(wsegs),
+                    limits: Limits {
+                        min_gap: lim.min_actuator_gap_m,
+                        sigma_allow: lim.sigma_allow_pa.or(model.design.sigma_allow),
+                        rod_crossing: lim.rod_crossing == Some(RodCrossing::Reject),
+                    },
+                    threads: SWEEP_THREADS,
+                },
+                seed,
+                qt_threshold: qt.to_radians(),
+                union: w.area_method.unwrap_or(AreaMethod::Union) == AreaMethod::Union,
+                return_nodes: w.return_nodes.unwrap_or(false),
+            })
+        } else {
+            None
+        };
+        // The mode search runs when asked for, or when there is no stress-free home to start from.
+        let has_home = model.design.home.is_some()
+            || fk::home_fit(&model, None).residual <= HOME_REL_TOL * model.l_ref;
+        let search_needed = req.mode == Mode::AssemblyModes
+            || matches!(start, Start::AssemblyMode(_))
+            || sweep.as_ref().is_some_and(|s| {
+                matches!(
+                    s.seed.kind,
+                    SeedKind::AssemblyMode | SeedKind::AllStableModes
+                ) || (s.seed.kind == SeedKind::Home && !has_home)
+            })
+            || (req.mode == Mode::Fk && start == Start::Home && !has_home);
+        v.finish()?;
+        if let Some(t) = too_large {
+            return Err(t);
+        }
+        if search_needed {
+            let combos = modes::combinations(modes.n_grid, nr);
+            if combos > MAX_COMBINATIONS {
+                let why = if has_home {
+                    ""
+                } else {
+                    " (the design has no stress-free home, so the FK starts from the mode search)"
+                };
+                return Err(CalcFailure::field(
+                    ProblemClass::TooLarge,
+                    "SEARCH_TOO_LARGE",
+                    "/assembly_modes/n_grid",
+                    format!(
+                        "(2 N_grid)^(2N) = {combos:.3e} grid combinations for N_grid = {} and N = {nr} rods exceeds {MAX_COMBINATIONS:e}; lower n_grid{why}",
+                        modes.n_grid
+                    ),
+                ));
+            }
+        }
+        Ok(Self {
+            mode: req.mode,
+            model,
+            preset,
+            params: Params {
+                lambda,
+                force,
+                moment,
+            },
+            newton: NewtonOptions::new(tol, usize_of(max_iter)),
+            start,
+            continuation_steps,
+            stability,
+            segments: usize_of(segments),
+            shape_points: usize_of(shape_points),
+            modes,
+            sweep,
+            warnings,
+            time_limit,
+        })
+    }
+}
