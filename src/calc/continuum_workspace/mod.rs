@@ -232,7 +232,7 @@ fn fk_response(input: &Input, f: FkOutput, budget: &Budget) -> FkResponse {
         },
         solver_state: state,
         preset: preset_out(input),
-        report: report(f.stop, u64_of(f.newton_iterations), f.evaluations, budget),
+        report: report(f.stop, u64_of(f.total_iterations), f.evaluations, budget),
     }
 }
 
