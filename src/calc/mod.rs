@@ -7,6 +7,7 @@ pub mod cam_law_fit;
 pub mod cognates;
 pub mod component_importance;
 pub mod continuum_workspace;
+pub mod irefc;
 pub mod problem;
 
 pub use problem::{CalcFailure, FieldIssue, ProblemClass, Validator};

@@ -11,6 +11,7 @@ pub mod cam_law_fit;
 pub mod cognates;
 pub mod component_importance;
 pub mod continuum_workspace;
+pub mod irefc;
 pub mod json;
 pub mod meta;
 pub mod pool;
@@ -101,6 +102,7 @@ JSON pointers to the offending fields.",
         (name = "linkages", description = "Planar linkages: Roberts–Chebyshev cognates of a four-bar"),
         (name = "reliability", description = "Reliability and maintenance: component importance under fault propagation"),
         (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
+        (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
         (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
     ),
     components(schemas(Problem, ProblemField))
@@ -118,6 +120,8 @@ fn api_router() -> OpenApiRouter<AppState> {
         .routes(routes!(component_importance::rank))
         .routes(routes!(bus_fuel_economy::compute))
         .routes(routes!(bus_fuel_economy::motor_map))
+        .routes(routes!(irefc::stress))
+        .routes(routes!(irefc::efficiency))
         .routes(routes!(continuum_workspace::solve))
 }
 

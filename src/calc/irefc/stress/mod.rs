@@ -1,0 +1,278 @@
+//! `POST /v1/irefc-stress`: element forces and Hertz contact stresses of one IREFC design, or the paper's
+//! "structured array" sweep over Z2 × χ (× rb × r2). Spec `irefc_stress.md`; paper
+//! `irefc-force-stress.txt` (Mathematics 2023, 11, 993, eqs 12–18).
+
+pub mod compute;
+pub mod input;
+pub mod wire;
+
+use std::time::Instant;
+
+use compute::{
+    ComboOutcome, DesignResult, GridTrig, WheelMaxResult, compute_design, compute_sweep,
+};
+use input::{SingleInput, StressInput, SweepInput};
+use wire::{
+    Curves, ElementOut, IrefcStressRequest, IrefcStressResponse, MaxOut, Reason, StressMeta,
+    StressMode, StressSingleResponse, StressSweepResponse, SweepMeta, SweepRecord, WheelMax,
+};
+
+use super::error::IrefcError;
+use super::geometry::Geometry;
+use super::wire::{GeometryOut, MM, Warning, geometry_warnings};
+use crate::calc::CalcFailure;
+use crate::numerics::{Budget, SolverReport};
+
+/// Pascals per MPa.
+const MPA: f64 = 1e6;
+
+/// Validate, compute and build the response of `POST /v1/irefc-stress` (run on the blocking pool).
+///
+/// # Errors
+/// `BAD_RANGE`/`MISSING_FIELD` (every offending field), `GRID_TOO_FINE`, `SWEEP_TOO_LARGE`, and for mode
+/// "single" `UNDERCUT`/`ELEMENT_OVERLAP`, `NON_FINITE` (absurd scales) or `DEADLINE`. Infeasible sweep
+/// combinations are records with `valid: false`, not errors.
+pub fn run_stress(
+    req: IrefcStressRequest,
+    budget: &Budget,
+) -> Result<IrefcStressResponse, CalcFailure> {
+    match StressInput::try_from_request(&req)? {
+        StressInput::Single(s) => {
+            run_single(&s, budget).map(|r| IrefcStressResponse::Single(Box::new(r)))
+        }
+        StressInput::Sweep(s) => Ok(IrefcStressResponse::Sweep(run_sweep(&s, budget))),
+    }
+}
+
+fn run_single(inp: &SingleInput, budget: &Budget) -> Result<StressSingleResponse, CalcFailure> {
+    let t0 = Instant::now();
+    let r = compute_design(
+        &inp.design,
+        &inp.params,
+        GridTrig::OnTheFly,
+        inp.curves_stride,
+        Some(budget),
+    )?;
+    let g = &r.geometry;
+    let geometry = GeometryOut::from_geometry(g, inp.profile_points);
+    if !geometry.is_finite() {
+        return Err(IrefcError::NonFinite {
+            quantity: "geometry",
+            phi_deg: None,
+        }
+        .into());
+    }
+    let mut warnings = geometry_warnings(g);
+    if r.n_intervals > inp.params.n_intervals {
+        warnings.push(Warning::new(
+            "GRID_REFINED",
+            format!(
+                "phase_exact with refine: the maximum search used {} grid intervals ({} deg) instead of {} so that every load-sharing ripple (period 360/Z2 deg) is resolved",
+                r.n_intervals,
+                180.0 / r.n_intervals as f64,
+                inp.params.n_intervals
+            ),
+        ));
+    }
+    let elements = inp.elements.then(|| {
+        r.forces
+            .elements
+            .iter()
+            .map(|e| ElementOut {
+                k: e.k,
+                phi2_deg: e.phi.to_degrees(),
+                alpha_deg: e.alpha.to_degrees(),
+                h_mm: e.h * MM,
+                f_n: e.f,
+            })
+            .collect()
+    });
+    let curves = r.curves.as_ref().map(|c| Curves {
+        phi2_deg: c.phi.iter().map(|v| v.to_degrees()).collect(),
+        f_n: c.f.clone(),
+        sigma_cam_mpa: c.sigma_cam.iter().map(|v| v / MPA).collect(),
+        sigma_crown_mpa: c.sigma_crown.iter().map(|v| v / MPA).collect(),
+        rho_cam_mm: c.rho_cam.iter().map(|v| v.map(|x| x * MM)).collect(),
+        rho_crown_mm: c.rho_crown.iter().map(|v| v.map(|x| x * MM)).collect(),
+    });
+    let p = &inp.params;
+    Ok(StressSingleResponse {
+        mode: StressMode::Single,
+        geometry,
+        t_cam_nm: r.t_cam,
+        t_crown_nm: r.t_crown,
+        t_in_nm: r.t_in,
+        e_star_mpa: r.e_star / MPA,
+        lb_mm: r.lb * MM,
+        fmax_n: r.forces.fmax,
+        sum_h2_mm2: r.forces.sum_h2 * MM * MM,
+        elements,
+        max: MaxOut {
+            cam: wheel_max(&r.cam, p.subsurface),
+            crown: wheel_max(&r.crown, p.subsurface),
+            overall: r.governing().map(|m| m.wheel.name().to_owned()),
+        },
+        curves,
+        warnings,
+        meta: StressMeta {
+            step_deg: p.step_deg,
+            refine: p.refine,
+            load_sharing: p.load_sharing,
+            n_grid: r.n_intervals as u64 + 1,
+            evaluations: r.evaluations,
+            compute_ms: t0.elapsed().as_secs_f64() * 1e3,
+        },
+    })
+}
+
+/// Wire form of one wheel's maximum.
+fn wheel_max(m: &WheelMaxResult, subsurface: bool) -> WheelMax {
+    let pt = m.point.as_ref();
+    WheelMax {
+        phi2_deg: m.phi.map(f64::to_degrees),
+        sigma_mpa: m.sigma / MPA,
+        f_n: m.f,
+        h_mm: pt.map(|a| a.lever_arm(m.wheel) * MM),
+        alpha_deg: pt.map(|a| a.alpha.to_degrees()),
+        l_mm: pt.map(|a| a.l * MM),
+        rho_mm: pt.and_then(|a| a.rho(m.wheel)).map(|r| r * MM),
+        b_mm: m.b * MM,
+        tau_max_mpa: subsurface.then_some(compute::TAU_MAX_RATIO * m.sigma / MPA),
+        tau_depth_mm: subsurface.then_some(compute::TAU_DEPTH_RATIO * m.b * MM),
+    }
+}
+
+fn run_sweep(inp: &SweepInput, budget: &Budget) -> StressSweepResponse {
+    let t0 = Instant::now();
+    let res = compute_sweep(inp, budget);
+    let mut records = Vec::with_capacity(res.outcomes.len());
+    let (mut n_valid, mut n_invalid, mut n_not) = (0u64, 0u64, 0u64);
+    let mut worst: Option<(usize, f64)> = None;
+    let mut best: Option<(usize, f64)> = None;
+    for (i, o) in res.outcomes.iter().enumerate() {
+        let d = inp.design(i);
+        let base = |valid: bool, reason: Option<Reason>, g: Option<&Geometry>| SweepRecord {
+            z2: d.z2,
+            chi: d.chi,
+            rb_mm: d.rb * MM,
+            r2_mm: d.r2 * MM,
+            valid,
+            reason,
+            fmax_n: None,
+            sigma_cam_max_mpa: None,
+            phi2_cam_deg: None,
+            sigma_crown_max_mpa: None,
+            phi2_crown_deg: None,
+            sigma_max_mpa: None,
+            governing: None,
+            f_at_max_n: None,
+            rho_at_max_mm: None,
+            min_profile_radius_mm: g
+                .map(|g| g.min_profile_radius() * MM)
+                .filter(|v| v.is_finite()),
+            warnings: g
+                .map(|g| g.warnings().iter().map(|w| w.code().to_owned()).collect())
+                .unwrap_or_default(),
+        };
+        let rec = match o {
+            ComboOutcome::Valid(r) => {
+                n_valid += 1;
+                let rec = valid_record(base(true, None, Some(&r.geometry)), r);
+                let s = rec.sigma_max_mpa.unwrap_or(0.0);
+                if worst.is_none_or(|(_, w)| s > w) {
+                    worst = Some((i, s));
+                }
+                if best.is_none_or(|(_, b)| s < b) {
+                    best = Some((i, s));
+                }
+                rec
+            }
+            ComboOutcome::Invalid {
+                code,
+                message,
+                geometry,
+            } => {
+                n_invalid += 1;
+                let mut rec = base(
+                    false,
+                    Some(Reason {
+                        code: (*code).to_owned(),
+                        message: message.clone(),
+                    }),
+                    None,
+                );
+                rec.min_profile_radius_mm =
+                    Some(geometry.min_profile_radius() * MM).filter(|v| v.is_finite());
+                rec
+            }
+            ComboOutcome::NotEvaluated => {
+                n_invalid += 1;
+                n_not += 1;
+                base(
+                    false,
+                    Some(Reason {
+                        code: "NOT_EVALUATED".to_owned(),
+                        message: "not evaluated: the time or evaluation budget ran out first"
+                            .to_owned(),
+                    }),
+                    None,
+                )
+            }
+        };
+        records.push(rec);
+    }
+    let mut warnings = inp.warnings.clone();
+    if n_not > 0 {
+        warnings.push(Warning::new(
+            "SWEEP_INCOMPLETE",
+            format!(
+                "{n_not} of {} combinations were not evaluated before the budget ran out",
+                records.len()
+            ),
+        ));
+    }
+    let p = &inp.params;
+    let elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
+    StressSweepResponse {
+        mode: StressMode::Sweep,
+        worst: worst.map(|w| w.0),
+        best: best.map(|b| b.0),
+        n_valid,
+        n_invalid,
+        n_not_evaluated: n_not,
+        warnings,
+        meta: SweepMeta {
+            step_deg: p.step_deg,
+            refine: p.refine,
+            load_sharing: p.load_sharing,
+            n_grid: p.n_intervals as u64 + 1,
+            n_combinations: records.len() as u64,
+            threads: res.threads,
+            compute_ms: elapsed_ms,
+            solver: SolverReport {
+                stop_reason: res.stop_reason,
+                iterations: res.evaluated,
+                evaluations: res.evaluated,
+                elapsed_ms,
+            },
+        },
+        records,
+    }
+}
+
+/// Fill the result fields of a valid record.
+fn valid_record(mut rec: SweepRecord, r: &DesignResult) -> SweepRecord {
+    rec.fmax_n = Some(r.forces.fmax);
+    rec.sigma_cam_max_mpa = Some(r.cam.sigma / MPA);
+    rec.phi2_cam_deg = r.cam.phi.map(f64::to_degrees);
+    rec.sigma_crown_max_mpa = Some(r.crown.sigma / MPA);
+    rec.phi2_crown_deg = r.crown.phi.map(f64::to_degrees);
+    rec.sigma_max_mpa = Some(r.cam.sigma.max(r.crown.sigma) / MPA);
+    let gov = r.governing();
+    rec.governing = gov.map(|m| m.wheel.name().to_owned());
+    rec.f_at_max_n = Some(gov.map_or(0.0, |m| m.f));
+    rec.rho_at_max_mm = gov
+        .and_then(|m| m.point.and_then(|a| a.rho(m.wheel)))
+        .map(|v| v * MM);
+    rec
+}

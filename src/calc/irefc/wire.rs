@@ -1,0 +1,300 @@
+//! Wire types shared by both IREFC endpoints: the `geometry` output object, warnings, materials,
+//! profile point sets, and the shared validation of the four initial parameters.
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use super::error::{BAD_RANGE, Issues, MISSING_FIELD};
+use super::geometry::{
+    CHI_MAX, Geometry, GeometryWarning, NEAR_UNDERCUT_FRACTION, Wheel, Z2_MAX, Z2_MIN,
+};
+
+/// Millimetres per metre (wire ↔ SI).
+pub(crate) const MM: f64 = 1e3;
+/// Upper limit of r2 [mm] (spec range).
+pub const R2_MAX_MM: f64 = 10_000.0;
+/// Default number of profile points per wheel (spec).
+pub const PROFILE_POINTS_DEFAULT: u32 = 720;
+/// Largest number of profile points per wheel (keeps responses below a few MB).
+pub const PROFILE_POINTS_MAX: u32 = 100_000;
+/// Smallest number of profile points per wheel (a closed polygon needs a few).
+pub const PROFILE_POINTS_MIN: u32 = 8;
+
+/// A non-fatal warning: stable code and human message.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, ToSchema)]
+pub struct Warning {
+    /// Stable code, e.g. `NEAR_UNDERCUT`, `RB_BELOW_PAPER_MIN`, `ROLLING_FRICTION_HIGH`.
+    #[schema(example = "RB_BELOW_PAPER_MIN")]
+    pub code: String,
+    /// What it means for this request, with the values involved.
+    pub message: String,
+}
+
+impl Warning {
+    /// A warning from code and message.
+    #[must_use]
+    pub fn new(code: &str, message: impl Into<String>) -> Self {
+        Self {
+            code: code.to_owned(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Warnings of a geometry with their messages (spec irefc_geometry "Warnings").
+#[must_use]
+pub fn geometry_warnings(g: &Geometry) -> Vec<Warning> {
+    g.warnings()
+        .into_iter()
+        .map(|w| {
+            let msg = match w {
+                GeometryWarning::ChiOutsidePaperRange => {
+                    format!("chi = {} is outside the force paper's range [1.25, 1.67] (assemblability)", g.chi)
+                }
+                GeometryWarning::RbBelowPaperMin => format!(
+                    "rb = {} mm <= 2*r2/Z2 = {} mm (lower bound of force-paper eq. 3)",
+                    g.rb * MM,
+                    g.rb_min_paper * MM
+                ),
+                GeometryWarning::ContactABeyondPitch => format!(
+                    "rb = {} mm >= r2*(chi-1) = {} mm: the cam contact A lies at or before the pitch point near phi2 = 0 (LA <= 0)",
+                    g.rb * MM,
+                    g.r2 * (g.chi - 1.0) * MM
+                ),
+                GeometryWarning::NearUndercut => format!(
+                    "sharpest convex profile radius {} mm < {} * rb: contact stresses become very large near the undercut limit rb_undercut = {} mm",
+                    g.min_profile_radius() * MM,
+                    NEAR_UNDERCUT_FRACTION,
+                    g.rb_undercut * MM
+                ),
+            };
+            Warning::new(w.code(), msg)
+        })
+        .collect()
+}
+
+/// Elastic material of a body.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Young's modulus E [MPa].
+    #[serde(rename = "E_MPa")]
+    #[schema(minimum = 1e3, maximum = 1e7, example = 210_000.0)]
+    pub e_mpa: f64,
+    /// Poisson's ratio ν [–], 0 ≤ ν < 0.5.
+    #[schema(minimum = 0.0, exclusive_maximum = 0.5, example = 0.3)]
+    pub nu: f64,
+}
+
+impl Default for Material {
+    /// Steel, E = 210 000 MPa, ν = 0.3 (the paper gives no values).
+    fn default() -> Self {
+        Self {
+            e_mpa: 210_000.0,
+            nu: 0.3,
+        }
+    }
+}
+
+impl Material {
+    /// Validate E and ν under `pointer`.
+    pub(crate) fn validate(&self, issues: &mut Issues, pointer: &str) {
+        issues.range(
+            &format!("{pointer}/E_MPa"),
+            "Young's modulus E_MPa",
+            self.e_mpa,
+            1e3,
+            1e7,
+        );
+        issues.range_open_hi(
+            &format!("{pointer}/nu"),
+            "Poisson's ratio nu",
+            self.nu,
+            0.0,
+            0.5,
+        );
+    }
+
+    /// Plane-strain modulus term (1 − ν²)/E [1/Pa].
+    #[must_use]
+    pub fn compliance(&self) -> f64 {
+        self.nu.mul_add(-self.nu, 1.0) / (self.e_mpa * 1e6)
+    }
+}
+
+/// Profile point sets of both wheels (spec irefc_geometry "profile point sets").
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Profiles {
+    /// Points per wheel.
+    pub n_points: u32,
+    /// Cam profile [[x, y]] [mm] in the cam frame (cam centre at the origin), Z2 − 1 lobes.
+    pub cam_mm: Vec<[f64; 2]>,
+    /// Crown profile [[x, y]] [mm] in the crown frame (crown centre at the origin), Z2 + 1 lobes.
+    pub crown_mm: Vec<[f64; 2]>,
+}
+
+impl Profiles {
+    /// Generate `n` points per wheel.
+    #[must_use]
+    pub fn generate(g: &Geometry, n: u32) -> Self {
+        let to_mm = |v: Vec<[f64; 2]>| v.into_iter().map(|[x, y]| [x * MM, y * MM]).collect();
+        let n_us = usize::try_from(n)
+            .unwrap_or(usize::MAX)
+            .min(PROFILE_POINTS_MAX as usize);
+        Self {
+            n_points: n,
+            cam_mm: to_mm(g.profile(Wheel::Cam, n_us)),
+            crown_mm: to_mm(g.profile(Wheel::Crown, n_us)),
+        }
+    }
+}
+
+/// Derived geometry (spec irefc_geometry "Outputs"), shared by both endpoints.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct GeometryOut {
+    /// Eccentricity of each mesh e = r2/Z2 [mm].
+    pub e_mm: f64,
+    /// Cam centre to crown centre 2e [mm].
+    pub e_total_mm: f64,
+    /// Cam pitch radius r1 = r2(1 − 1/Z2) [mm].
+    pub r1_mm: f64,
+    /// Crown pitch radius r3 = r2(1 + 1/Z2) [mm].
+    pub r3_mm: f64,
+    /// Element-centre circle radius rc = χ·r2 [mm].
+    pub rc_mm: f64,
+    /// Cam lobes Z1 = Z2 − 1.
+    #[serde(rename = "Z1")]
+    pub z1: u32,
+    /// Crown lobes Z3 = Z2 + 1.
+    #[serde(rename = "Z3")]
+    pub z3: u32,
+    /// Cam tip radius r2(χ + 1/Z2) − rb [mm] (force paper eq. 8).
+    pub cam_tip_mm: f64,
+    /// Cam root radius r2(χ − 1/Z2) − rb [mm] (eq. 9).
+    pub cam_root_mm: f64,
+    /// Crown tip radius r2(χ − 1/Z2) + rb [mm] (eq. 10).
+    pub crown_tip_mm: f64,
+    /// Crown root radius r2(χ + 1/Z2) + rb [mm] (eq. 11).
+    pub crown_root_mm: f64,
+    /// Lower bound of force-paper eq. 3, 2·r2/Z2 [mm] (below it: warning only).
+    pub rb_min_paper_mm: f64,
+    /// Element overlap limit χ·r2·sin(π/Z2) [mm] (rb must be below).
+    pub rb_overlap_mm: f64,
+    /// Undercut limit (closed form) [mm] (rb must be below).
+    pub rb_undercut_mm: f64,
+    /// Sharpest convex cam profile radius [mm].
+    pub min_profile_radius_cam_mm: f64,
+    /// Sharpest convex crown profile radius [mm]; null when the crown profile is concave everywhere (χ ≥ Z2).
+    pub min_profile_radius_crown_mm: Option<f64>,
+    /// Carrier → cam ratio with the crown fixed, (Z2 − 1)/2; the cam turns opposite to the carrier.
+    pub ratio_cam_output: f64,
+    /// Carrier → crown ratio with the cam rotation locked, (Z2 + 1)/2; same direction as the carrier.
+    pub ratio_crown_output: f64,
+    /// Profile point sets, only when `include.profiles` is true.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub profiles: Option<Profiles>,
+}
+
+impl GeometryOut {
+    /// Wire form of `g`; profiles with `profile_points` points per wheel when requested.
+    #[must_use]
+    pub fn from_geometry(g: &Geometry, profile_points: Option<u32>) -> Self {
+        Self {
+            e_mm: g.e * MM,
+            e_total_mm: g.e_total * MM,
+            r1_mm: g.r1 * MM,
+            r3_mm: g.r3 * MM,
+            rc_mm: g.rc * MM,
+            z1: g.z1,
+            z3: g.z3,
+            cam_tip_mm: g.cam_tip * MM,
+            cam_root_mm: g.cam_root * MM,
+            crown_tip_mm: g.crown_tip * MM,
+            crown_root_mm: g.crown_root * MM,
+            rb_min_paper_mm: g.rb_min_paper * MM,
+            rb_overlap_mm: g.rb_overlap * MM,
+            rb_undercut_mm: g.rb_undercut * MM,
+            min_profile_radius_cam_mm: g.min_profile_radius_cam() * MM,
+            min_profile_radius_crown_mm: g.min_profile_radius_crown().map(|r| r * MM),
+            ratio_cam_output: g.ratio_cam_output(),
+            ratio_crown_output: g.ratio_crown_output(),
+            profiles: profile_points.map(|n| Profiles::generate(g, n)),
+        }
+    }
+
+    /// Whether every number is finite.
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        [
+            self.e_mm,
+            self.r1_mm,
+            self.r3_mm,
+            self.rc_mm,
+            self.cam_tip_mm,
+            self.cam_root_mm,
+            self.crown_tip_mm,
+            self.crown_root_mm,
+            self.rb_min_paper_mm,
+            self.rb_overlap_mm,
+            self.rb_undercut_mm,
+            self.min_profile_radius_cam_mm,
+            self.min_profile_radius_crown_mm.unwrap_or(0.0),
+        ]
+        .iter()
+        .all(|v| v.is_finite())
+            && self.profiles.as_ref().is_none_or(|p| {
+                p.cam_mm
+                    .iter()
+                    .chain(p.crown_mm.iter())
+                    .all(|[x, y]| x.is_finite() && y.is_finite())
+            })
+    }
+}
+
+/// Validate r2 [mm] at `pointer`; returns it when valid.
+pub(crate) fn check_r2(issues: &mut Issues, pointer: &str, v: f64) -> Option<f64> {
+    issues
+        .range_open_lo(pointer, "cage pitch radius r2_mm", v, 0.0, R2_MAX_MM)
+        .then_some(v)
+}
+
+/// Validate Z2 at `pointer`; returns it when valid.
+pub(crate) fn check_z2(issues: &mut Issues, pointer: &str, v: i64) -> Option<u32> {
+    if issues.int_range(
+        pointer,
+        "number of rolling elements Z2",
+        v,
+        i64::from(Z2_MIN),
+        i64::from(Z2_MAX),
+    ) {
+        u32::try_from(v).ok()
+    } else {
+        None
+    }
+}
+
+/// Validate χ at `pointer`; returns it when valid.
+pub(crate) fn check_chi(issues: &mut Issues, pointer: &str, v: f64) -> Option<f64> {
+    issues
+        .range_open_lo(pointer, "displacement coefficient chi", v, 1.0, CHI_MAX)
+        .then_some(v)
+}
+
+/// Validate rb [mm] > 0 at `pointer` (feasibility limits are checked on the geometry).
+pub(crate) fn check_rb(issues: &mut Issues, pointer: &str, v: f64) -> Option<f64> {
+    let ok = v.is_finite() && v > 0.0;
+    if !ok {
+        issues.push(
+            BAD_RANGE,
+            pointer,
+            format!("rolling element radius rb_mm must be a finite number > 0, got {v}"),
+        );
+    }
+    ok.then_some(v)
+}
+
+/// Record a missing required field.
+pub(crate) fn missing(issues: &mut Issues, pointer: &str, what: &str) {
+    issues.push(MISSING_FIELD, pointer, format!("{what} is required"));
+}
