@@ -575,3 +575,24 @@ fn mutated_examples_never_produce_nan() {
         }
     }
 }
+
+/// The rod-crossing limit (spec 4.7 limits) stops the wave where rod centre lines cross.
+#[test]
+fn rod_crossing_limit_cuts_the_workspace() {
+    let sweep = |rc: &str| {
+        call(json!({"mode": "workspace", "design": {"preset": "keops_d1"},
+                    "workspace": {"grid": [21, 21], "stability_check": "det_sign", "limits": {"rod_crossing": rc}}}))
+        .expect("typed response")
+    };
+    let (ignore, reject) = (sweep("ignore"), sweep("reject"));
+    let n = |v: &Value| v["metrics"]["n_accepted"].as_u64().expect("count");
+    assert!(n(&reject) < n(&ignore), "{} vs {}", n(&reject), n(&ignore));
+    assert!(
+        reject["failures"]["limit_rod_crossing"]
+            .as_u64()
+            .is_some_and(|c| c > 0),
+        "{}",
+        reject["failures"]
+    );
+    assert!(ignore["failures"].get("limit_rod_crossing").is_none());
+}

@@ -26,8 +26,10 @@ pub struct FkOutput {
     pub residual_inf: f64,
     /// Condition number of the scaled Jacobian (converged only; else the cap).
     pub cond: f64,
-    /// Newton iterations.
+    /// Newton iterations of the final solve.
     pub newton_iterations: usize,
+    /// Newton iterations over all solves (continuation steps included).
+    pub total_iterations: usize,
     /// Continuation steps.
     pub continuation_steps: usize,
     /// Stability segments used (when the test ran).
@@ -193,11 +195,11 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
     let mut counter = Counter::default();
     let mut warnings = input.warnings.clone();
     let mut continuation_steps = 0usize;
-    let mut newton_iterations = 0usize;
+    let mut total_iterations = 0usize;
     let result: Result<Solution, Failed> = match &input.start {
         Start::Guess(v) => newton::solve(model, target, v, input.newton, budget, &mut counter)
             .inspect(|s| {
-                newton_iterations = s.iterations;
+                total_iterations = s.iterations;
             }),
         Start::AssemblyMode(index) => {
             let res = modes::search(
@@ -233,7 +235,7 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 fk::from_home(model, &home, target, k, input.newton, budget, &mut counter).map(
                     |r| {
                         continuation_steps = r.steps;
-                        newton_iterations = r.newton_iterations;
+                        total_iterations = r.newton_iterations;
                         r.solution
                     },
                 )
@@ -304,7 +306,8 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                     f64::MAX
                 },
                 cond: crate::calc::continuum_workspace::linalg::COND_CAP,
-                newton_iterations: newton_iterations.max(f.iterations),
+                newton_iterations: f.iterations,
+                total_iterations: total_iterations.max(f.iterations),
                 continuation_steps,
                 segments: None,
                 warnings,
@@ -348,7 +351,8 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 status,
                 residual_inf: sol.eval.norm_inf(),
                 cond,
-                newton_iterations: newton_iterations.max(sol.iterations),
+                newton_iterations: sol.iterations,
+                total_iterations: total_iterations.max(sol.iterations),
                 continuation_steps,
                 segments,
                 solution: Some((sol, described)),

@@ -520,7 +520,8 @@ pub struct StabilityOut {
 /// FK diagnostics.
 #[derive(Debug, Clone, Serialize, ToSchema)]
 pub struct DiagnosticsOut {
-    /// Newton iterations of the final solve (all continuation steps for home starts).
+    /// Newton iterations of the final solve (the total over all continuation steps is in
+    /// `report.iterations`).
     pub newton_iterations: u64,
     /// `||g||_inf` at the returned point.
     pub residual_inf: f64,
