@@ -520,36 +520,82 @@ fn sweep_tables() {
 
 fn modes_table() {
     println!(
-        "\n### Assembly-mode search (d1 at (-0.22, 0.2425), Tol 0.45, cell 2; spec 6.2: N_grid 6 -> 4 solutions, 2 stable)\n"
+        "\n### Assembly-mode search (d1 at (-0.22, 0.2425), F = 0, cell 2; spec 6.2: N_grid 6 / Tol 0.45 -> 4 solutions, 2 stable; N_grid 9 / Tol 0.5 -> 10, 5 stable)\n"
     );
-    println!("| N_grid | combinations examined | candidates | refined | solutions | stable | ms |");
-    println!("|---|---|---|---|---|---|---|");
+    println!(
+        "Missed = modes of the N_grid 9 / Tol 0.5 / max_refine 20 000 search (the reference set) not found.\n"
+    );
+    println!(
+        "| N_grid | Tol | max_refine | combinations examined | candidates | refined | solutions | stable | missed | ms |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     let model = d1(32);
     let p = Params {
         lambda: vec![-0.22, 0.2425],
         force: [0.0, 0.0],
         moment: 0.0,
     };
-    for ng in [3usize, 4, 5, 6, 7] {
+    let search = |n_grid: usize, tol: f64, max_refine: usize| {
         let t0 = Instant::now();
         let r = modes::search(
             &model,
             &p,
             modes::ModeSearch {
-                n_grid: ng,
-                tol: 0.45,
+                n_grid,
+                tol,
                 cell: 2,
-                max_refine: 4000,
+                max_refine,
             },
             NewtonOptions::new(1e-10, 50),
             40,
             &Budget::unlimited(),
             &mut Counter::default(),
         );
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
-        let mark = if ng == 6 { " (default)" } else { "" };
+        (r, t0.elapsed().as_secs_f64() * 1e3)
+    };
+    let (reference, _) = search(9, 0.5, 20_000);
+    let nr = model.n_rods();
+    let pose = |s: &modes::ModeSolution| {
+        [
+            s.solution.v[3 * nr],
+            s.solution.v[3 * nr + 1],
+            s.solution.v[3 * nr + 2],
+        ]
+    };
+    for (ng, tol, max_refine) in [
+        (3usize, 0.45, 4000usize),
+        (4, 0.45, 4000),
+        (5, 0.3, 4000),
+        (5, 0.45, 4000),
+        (6, 0.45, 4000),
+        (7, 0.45, 4000),
+        (7, 0.5, 4000),
+        (8, 0.5, 4000),
+        (9, 0.5, 1000),
+        (9, 0.5, 4000),
+        (9, 0.5, 20_000),
+    ] {
+        let (r, ms) = search(ng, tol, max_refine);
+        let missed = reference
+            .solutions
+            .iter()
+            .filter(|want| {
+                let w = pose(want);
+                !r.solutions.iter().any(|got| {
+                    let g = pose(got);
+                    (g[0] - w[0]).abs() < 1e-6
+                        && (g[1] - w[1]).abs() < 1e-6
+                        && fk::wrap_pi(g[2] - w[2]).abs() < 1e-6
+                })
+            })
+            .count();
+        let mark = match (ng, max_refine) {
+            (9, 4000) => " (default, 3 rods)",
+            (6, 4000) if tol < 0.46 => " (default of the no-home start)",
+            _ => "",
+        };
         println!(
-            "| {ng}{mark} | {} | {} | {} | {} | {} | {ms:.0} |",
+            "| {ng}{mark} | {tol} | {max_refine} | {} | {} | {} | {} | {} | {missed} | {ms:.0} |",
             r.combinations,
             r.candidates,
             r.refined,

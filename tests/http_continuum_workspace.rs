@@ -76,10 +76,31 @@ async fn assembly_modes_are_marked_non_certified() {
     let b = post_json(PATH, &body).await.json();
     assert_eq!(b["complete"], false);
     assert!(
-        b["solutions"]
-            .as_array()
-            .is_some_and(|s| s.iter().filter(|x| x["stable"] == true).count() == 2)
+        b["note"]
+            .as_str()
+            .is_some_and(|n| n.contains("Non-certified"))
     );
+    // The settings used are echoed: the given N_grid, the defaults for the rest.
+    assert_eq!(
+        b["search"],
+        json!({"n_grid": 4, "tol": 0.5, "cell": 2, "max_refine": 4000})
+    );
+    // N_grid 4 / Tol 0.5 finds the spec's two stable modes (theta -0.00483 and -118.658 deg) and
+    // one more (-136.64 deg, spec 6.2 N_grid 9 list).
+    let stable: Vec<f64> = b["solutions"]
+        .as_array()
+        .expect("solutions")
+        .iter()
+        .filter(|x| x["stable"] == true)
+        .filter_map(|x| x["pose"]["parasitic_angle_deg"].as_f64())
+        .collect();
+    assert_eq!(stable.len(), 3, "stable modes {stable:?}");
+    for want in [-0.00483, -118.658, -136.64] {
+        assert!(
+            stable.iter().any(|t| (t - want).abs() < 5e-3),
+            "{want} deg not in {stable:?}"
+        );
+    }
 }
 
 #[tokio::test]
@@ -167,7 +188,8 @@ async fn oversized_work_is_too_large_and_missing_modes_not_converged() {
         (
             "SEARCH_TOO_LARGE",
             "/problems/too-large",
-            json!({"mode": "assembly_modes", "design": {"preset": "symmetric"}, "inputs_m": [-0.2, 0.25]}),
+            json!({"mode": "assembly_modes", "design": {"preset": "symmetric"}, "inputs_m": [-0.2, 0.25],
+                   "assembly_modes": {"n_grid": 6}}),
             "/assembly_modes/n_grid",
         ),
         (

@@ -131,7 +131,7 @@ fn sweep(
         json!({"mode": "workspace", "design": {"preset": preset}, "load": {"force_n": force},
                 "solver": {"axial_extensibility": extensible},
                 // Designs 3 and 4 seed from the mode search; N_grid 4 finds their small-angle mode
-                // at a fifth of the default search cost.
+                // at a third of the cost of the default fallback search (N_grid 6).
                 "assembly_modes": {"n_grid": 4},
                 "workspace": {"grid": [31, 31], "stability_check": stability, "max_substeps": 8,
                               "limits": {"min_actuator_gap_m": gap}}}),
@@ -605,27 +605,52 @@ fn fk_json_example_values() {
 
 /// Spec 6.2 assembly modes: design 1 at home + (0.03, -0.03), F = 0, N_grid 6, Tol 0.45, cell 2:
 /// 4 solutions, 2 stable (theta -0.00483 deg at (0.0000082, -0.4487398); theta -118.658 deg at
-/// (0.0332856, -0.4290000)); the two stable ones also with N_grid 5, Tol 0.3 (exact to 1e-6).
+/// (0.0332856, -0.4290000)); the two stable ones also with N_grid 5, Tol 0.3 (exact to 1e-6);
+/// N_grid 9, Tol 0.5: 10 solutions, 5 stable, adding -136.64, 127.39 and 6.42 deg.
 #[test]
 fn assembly_modes_design1() {
     let want = [
         (-0.004_83, [0.000_008_2, -0.448_739_8]),
         (-118.658, [0.033_285_6, -0.429_000_0]),
     ];
-    for (ng, tol, count) in [(6, 0.45, Some(4)), (5, 0.3, None)] {
+    for (ng, tol, count) in [
+        (6, 0.45, Some((4, 2))),
+        (5, 0.3, None),
+        (9, 0.5, Some((10, 5))),
+    ] {
+        // N_grid 9 / Tol 0.5 / cell 2 are the 3-rod defaults: sent as an empty object.
+        let settings = if ng == 9 {
+            json!({})
+        } else {
+            json!({"n_grid": ng, "tol": tol, "cell": 2})
+        };
         let r = call(
             json!({"mode": "assembly_modes", "design": {"preset": "keops_d1"}, "inputs_m": [-0.22, 0.2425],
-            "assembly_modes": {"n_grid": ng, "tol": tol, "cell": 2}}),
+            "assembly_modes": settings}),
         );
         assert_eq!(r["complete"], false, "the search is never certified");
         let sols = r["solutions"].as_array().expect("solutions");
-        if let Some(c) = count {
+        if let Some((c, stable)) = count {
             assert_eq!(sols.len(), c, "N_grid {ng}: number of solutions");
             assert_eq!(
                 sols.iter().filter(|s| s["stable"] == true).count(),
-                2,
+                stable,
                 "N_grid {ng}: stable solutions"
             );
+        }
+        if ng == 9 {
+            assert_eq!(
+                r["search"],
+                json!({"n_grid": 9, "tol": 0.5, "cell": 2, "max_refine": 4000})
+            );
+            // The spec prints these to 0.01 deg.
+            for th in [-136.64, 127.39, 6.42] {
+                assert!(
+                    sols.iter().any(|s| s["stable"] == true
+                        && (num(s, "/pose/parasitic_angle_deg") - th).abs() <= 0.005),
+                    "N_grid 9 Tol 0.5: stable mode theta {th} deg not found"
+                );
+            }
         }
         for (th, p) in want {
             let hit = sols.iter().any(|s| {

@@ -460,10 +460,12 @@ fn extreme_scales_keep_working() {
 
 #[test]
 fn search_limits_and_missing_modes() {
-    let e = call(json!({"mode": "assembly_modes", "design": {"preset": "symmetric"}, "inputs_m": [-0.2, 0.25]}))
+    let e = call(json!({"mode": "assembly_modes", "design": {"preset": "symmetric"}, "inputs_m": [-0.2, 0.25],
+                        "assembly_modes": {"n_grid": 6}}))
         .expect_err("(2*6)^8 combinations exceed 1e8");
     assert_eq!(e.code, "SEARCH_TOO_LARGE");
     assert_eq!(e.class, ProblemClass::TooLarge);
+    assert_eq!(e.errors[0].pointer, "/assembly_modes/n_grid");
     let r = call(json!({"mode": "assembly_modes", "design": {"preset": "symmetric"}, "inputs_m": [-0.2, 0.25],
                         "assembly_modes": {"n_grid": 3, "max_refine": 50}}))
     .expect("small search runs");

@@ -244,7 +244,7 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 let res = modes::search(
                     model,
                     target,
-                    input.modes,
+                    input.home_fallback_modes,
                     input.newton,
                     input.segments,
                     budget,
@@ -253,8 +253,10 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 match smallest_angle_stable(model, &res) {
                     Some(f) => {
                         warnings.push(format!(
-                            "no_stress_free_home: started from assembly mode {} (the stable solution with the smallest |theta_EE| of a non-certified search, spec 4.3)",
-                            f.index
+                            "no_stress_free_home: started from assembly mode {} (the stable solution with the smallest |theta_EE| of a non-certified search with N_grid {}, Tol {}, spec 4.3)",
+                            f.index,
+                            input.home_fallback_modes.n_grid,
+                            input.home_fallback_modes.tol
                         ));
                         Ok(f.solution)
                     }
@@ -421,11 +423,11 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
         _ => NodeStatus::NoConvergence,
     };
     let mut seeds: Vec<SeedResult> = Vec::new();
-    let search = |counter: &mut Counter| {
+    let search = |counter: &mut Counter, settings: modes::ModeSearch| {
         modes::search(
             model,
             &params0,
-            input.modes,
+            settings,
             input.newton,
             input.segments,
             budget,
@@ -442,12 +444,14 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
                     seeds.push((None, r.map(|r| r.solution).map_err(fail)));
                 }
                 None => {
-                    let res = search(&mut counter);
+                    let res = search(&mut counter, input.home_fallback_modes);
                     match smallest_angle_stable(model, &res) {
                         Some(f) => {
                             warnings.push(format!(
-                            "no_stress_free_home: the wave starts from assembly mode {} (stable, smallest |theta_EE|, non-certified search)",
-                            f.index
+                            "no_stress_free_home: the wave starts from assembly mode {} (stable, smallest |theta_EE|, non-certified search with N_grid {}, Tol {})",
+                            f.index,
+                            input.home_fallback_modes.n_grid,
+                            input.home_fallback_modes.tol
                         ));
                             seeds.push((Some(f.index), Ok(f.solution)));
                         }
@@ -467,7 +471,7 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
             seeds.push((None, r.map_err(fail)));
         }
         SeedKind::AssemblyMode => {
-            let res = search(&mut counter);
+            let res = search(&mut counter, input.modes);
             match res.solutions.get(*index) {
                 Some(m) => seeds.push((Some(*index), Ok(m.solution.clone()))),
                 None => {
@@ -480,7 +484,7 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
             }
         }
         SeedKind::AllStableModes => {
-            let res = search(&mut counter);
+            let res = search(&mut counter, input.modes);
             for (i, m) in res.solutions.iter().enumerate().filter(|(_, m)| m.stable) {
                 seeds.push((Some(i), Ok(m.solution.clone())));
             }

@@ -115,8 +115,13 @@ pub struct Input {
     pub segments: usize,
     /// Shape points per rod.
     pub shape_points: usize,
-    /// Mode search settings.
+    /// Mode search settings (mode `assembly_modes`, `start.kind = assembly_mode`, seeds of kind
+    /// `assembly_mode` / `all_stable_modes`).
     pub modes: ModeSearch,
+    /// Mode search settings of the fallback start of a design without a stress-free home (spec
+    /// 4.3 rule 2): the request's values where given, else [`modes::HOME_FALLBACK_N_GRID`] and
+    /// [`modes::HOME_FALLBACK_TOL`].
+    pub home_fallback_modes: ModeSearch,
     /// Sweep, for mode = workspace.
     pub sweep: Option<SweepInput>,
     /// Warnings found during validation.
@@ -539,29 +544,56 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         );
         // Mode search.
         let am = req.assembly_modes.clone().unwrap_or_default();
-        let n_grid = u32_in(&mut v, "/assembly_modes/n_grid", am.n_grid, 1, 50, 6);
+        let n_grid = u32_in(
+            &mut v,
+            "/assembly_modes/n_grid",
+            am.n_grid,
+            1,
+            50,
+            u32::try_from(modes::default_n_grid(nr)).unwrap_or(1),
+        );
         let mtol = f64_in(
             &mut v,
             "/assembly_modes/tol",
             am.tol,
             f64::MIN_POSITIVE,
             10.0,
-            0.45,
+            modes::DEFAULT_TOL,
         );
-        let cell = u32_in(&mut v, "/assembly_modes/cell", am.cell, 1, 100, 2);
+        let cell = u32_in(
+            &mut v,
+            "/assembly_modes/cell",
+            am.cell,
+            1,
+            100,
+            u32::try_from(modes::DEFAULT_CELL).unwrap_or(2),
+        );
         let max_refine = u32_in(
             &mut v,
             "/assembly_modes/max_refine",
             am.max_refine,
             1,
             20_000,
-            4000,
+            u32::try_from(modes::DEFAULT_MAX_REFINE).unwrap_or(4000),
         );
         let modes = ModeSearch {
             n_grid: usize_of(n_grid),
             tol: mtol,
             cell: usize_of(cell),
             max_refine: usize_of(max_refine),
+        };
+        let home_fallback_modes = ModeSearch {
+            n_grid: if am.n_grid.is_some() {
+                modes.n_grid
+            } else {
+                modes.n_grid.min(modes::HOME_FALLBACK_N_GRID)
+            },
+            tol: if am.tol.is_some() {
+                modes.tol
+            } else {
+                modes::HOME_FALLBACK_TOL
+            },
+            ..modes
         };
         // Time limit.
         let time_limit = req.time_limit_ms.and_then(|ms| {
@@ -823,6 +855,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             segments: usize_of(segments),
             shape_points: usize_of(shape_points),
             modes,
+            home_fallback_modes,
             sweep,
             warnings,
             time_limit,

@@ -42,7 +42,9 @@
 //!   actuator forces equal the derivative of the potential energy to 3.5e-10 relative; the
 //!   symmetric design keeps theta_EE = 0 to 5e-14 deg; the design-1 sweeps reproduce the spec's
 //!   node counts, union areas, folded cells and maximum angles (717 vs ~705 nodes, 0.2333 m^2,
-//!   35 cells, 3.18 deg).
+//!   35 cells, 3.18 deg); the assembly-mode search finds the spec's 4 solutions (2 stable) of
+//!   design 1 at (-0.22, 0.2425) with N_grid 6 / Tol 0.45 and all 10 (5 stable) with the 3-rod
+//!   default N_grid 9 / Tol 0.5, stable poses to 1e-6 m.
 //! * Outside the range: nodes/solves that do not converge are reported (`no_convergence`,
 //!   `taut_rod i`), straight rods of over-constrained designs give `singular` (forces indeterminate:
 //!   not returned; enable `axial_extensibility`), unstable equilibria are flagged and stop the wave.
@@ -78,8 +80,8 @@ use self::presets::Preset;
 use self::sweep::NodeStatus;
 use self::wire::{
     ActuatorRequest, AssemblyModeOut, AssemblyModesResponse, DiagnosticsOut, FkResponse, GridOut,
-    MetricsOut, Mode, NodesOut, PlatformOut, PresetName, PresetOut, RodOut, RodRequest, SeedOut,
-    SolverState, StabilityOut, WaveOut, WorkspaceResponse,
+    MetricsOut, Mode, ModeSearchOut, NodesOut, PlatformOut, PresetName, PresetOut, RodOut,
+    RodRequest, SeedOut, SolverState, StabilityOut, WaveOut, WorkspaceResponse,
 };
 use crate::calc::CalcFailure;
 use crate::numerics::{Budget, SolverReport, StopReason};
@@ -411,6 +413,12 @@ fn modes_response(input: &Input, m: ModesOutput, budget: &Budget) -> AssemblyMod
         candidates: m.result.candidates,
         refined: m.result.refined,
         combinations: m.result.combinations,
+        search: ModeSearchOut {
+            n_grid: u64_of(input.modes.n_grid),
+            tol: input.modes.tol,
+            cell: u64_of(input.modes.cell),
+            max_refine: u64_of(input.modes.max_refine),
+        },
         complete: false,
         note: "Non-certified: a grid over the closed-form rod shapes (buckling mode 1, |k| <= 0.999) refined by Newton \
                can miss equilibria; raise n_grid/tol/max_refine to search wider."

@@ -17,12 +17,37 @@ use crate::numerics::{Budget, StopReason};
 const DEDUP_TOL: f64 = 1e-6;
 /// Lower end offset of the `|k|` grid above `|c|` (spec 4.6: `|c| + 1e-6`).
 const K_LOW_OFFSET: f64 = 1e-6;
-/// Newton iterations per candidate refinement: candidates inside a basin converge within ~15
-/// (the slowest mode of the design-1 reference case needs 15); the rest wander for the full
-/// `max_iter` and dominated the cost (design 3: 8 s -> 4 s with identical solutions).
-const REFINE_MAX_ITER: usize = 20;
 /// Upper end of the `|k|` grid (spec 4.6 and 7: cap `|k| <= 0.999`).
 const K_HIGH: f64 = 0.999;
+/// Default `Tol` (spec 6.2, the N_grid 9 reference case).
+pub const DEFAULT_TOL: f64 = 0.5;
+/// Largest default `N_grid` (spec 6.2 reference case: 10 modes, 5 stable, for design 1).
+pub const DEFAULT_N_GRID_MAX: usize = 9;
+/// The default `N_grid` keeps the grid at or below this many combinations: N_grid 9 for 3 rods
+/// (3.4e7 combinations, 0.6 s, all 10 reference modes of design 1; N_grid 6 costs 80 ms but misses
+/// 6, benches/RESULTS.md), N_grid 4 for 4 rods (1.7e7, ~2 s; N_grid 5 is 1e8 and ~10 s).
+pub const DEFAULT_COMBINATIONS: f64 = 3.5e7;
+/// Default `N_grid` of the search that picks the start of a design without a stress-free home
+/// (spec 4.3 rule 2: the stable mode with the smallest |theta_EE|). Spec 6.2's reference values of
+/// designs 3 and 4 (max angle 55.5 / 50.2 deg) come from the mode this grid finds; N_grid 9 also
+/// finds a stable mode at 3.6 deg for design 3 and the wave from it is another workspace.
+pub const HOME_FALLBACK_N_GRID: usize = 6;
+/// Default `Tol` of that search (spec 6.2's first assembly-mode case).
+pub const HOME_FALLBACK_TOL: f64 = 0.45;
+/// Default coarse cell (spec 4.6).
+pub const DEFAULT_CELL: usize = 2;
+/// Default refinement cap (spec 4.6).
+pub const DEFAULT_MAX_REFINE: usize = 4000;
+
+/// Default `N_grid` for a design with `n_rods` rods: the largest `N_grid <= 9` whose grid has at
+/// most [`DEFAULT_COMBINATIONS`] combinations (at least 1).
+#[must_use]
+pub fn default_n_grid(n_rods: usize) -> usize {
+    (1..=DEFAULT_N_GRID_MAX)
+        .rev()
+        .find(|&n| combinations(n, n_rods) <= DEFAULT_COMBINATIONS)
+        .unwrap_or(1)
+}
 
 /// Settings of the search.
 #[derive(Debug, Clone, Copy)]
@@ -68,7 +93,9 @@ struct GridPoint {
     tip: [f64; 2],
     force: [f64; 2],
     m0: f64,
+    /// Zero-based index of `psi` in its grid (`psi_{psi_idx + 1}` of spec 4.6).
     psi_idx: u32,
+    /// Zero-based index of `|k|` among the interior grid points.
     k_idx: u32,
     negative: bool,
 }
@@ -95,8 +122,8 @@ fn table(model: &Model, i: usize, lambda: &[f64], n_grid: usize) -> Vec<GridPoin
                         tip: [base[0] + e.tip[0], base[1] + e.tip[1]],
                         force: e.force,
                         m0: e.base_moment,
-                        psi_idx: u32::try_from(kp).unwrap_or(u32::MAX),
-                        k_idx: u32::try_from(m).unwrap_or(u32::MAX),
+                        psi_idx: u32::try_from(kp - 1).unwrap_or(u32::MAX),
+                        k_idx: u32::try_from(m - 1).unwrap_or(u32::MAX),
                         negative,
                     });
                 }
@@ -223,6 +250,10 @@ pub fn search(
                     continue;
                 }
                 candidates += 1;
+                // Cells group zero-based indices {0, 1}, {2, 3}, ... (array indices, as the
+                // reference counts). One-based grouping ({1}, {2, 3}, ...) shifts every cell
+                // boundary: with N_grid 9 / Tol 0.5 its 4 000 best cells reach only 2 of the
+                // spec's 10 modes, the zero-based ones all 10.
                 let mut key = Vec::with_capacity(3 * nr);
                 for i in 0..nr {
                     let g = &tables[i][idx[i]];
@@ -283,11 +314,7 @@ pub fn search(
         v0[3 * nr] = c.position[0] / l_ref;
         v0[3 * nr + 1] = c.position[1] / l_ref;
         v0[3 * nr + 2] = c.theta;
-        let capped = NewtonOptions {
-            max_iter: opts.max_iter.min(REFINE_MAX_ITER),
-            ..opts
-        };
-        match newton::solve(model, params, &v0, capped, budget, counter) {
+        match newton::solve(model, params, &v0, opts, budget, counter) {
             Ok(mut sol) => {
                 let th = &mut sol.v[3 * nr + 2];
                 *th = fk::wrap_pi(*th);
@@ -335,5 +362,19 @@ pub fn search(
         refined,
         combinations: combos,
         stop,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_grid_follows_the_rod_count() {
+        // (2*9)^6 = 3.4e7, (2*4)^8 = 1.7e7 (N_grid 5 would be 1e8), (2*2)^10 = 1.0e6, (2*2)^12 = 1.7e7.
+        for (rods, want) in [(2, 9), (3, 9), (4, 4), (5, 2), (6, 2), (12, 1)] {
+            assert_eq!(default_n_grid(rods), want, "{rods} rods");
+            assert!(combinations(want, rods) <= DEFAULT_COMBINATIONS || want == 1);
+        }
     }
 }

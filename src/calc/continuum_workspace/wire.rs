@@ -432,13 +432,17 @@ pub struct WorkspaceRequest {
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AssemblyModesRequest {
-    /// `N_grid` (default 6); `(2 N_grid)^(2N) <= 1e8`.
+    /// `N_grid`: psi and |k| grid points per rod; `(2 N_grid)^(2N) <= 1e8` for N rods.
+    /// Default: the largest N_grid <= 9 with at most 3.5e7 combinations (9 for 3 rods, 4 for
+    /// 4 rods, 2 for 5 or more); the search that picks the start of a design without a
+    /// stress-free home defaults to min(6, that).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 50, example = 6)]
+    #[schema(minimum = 1, maximum = 50, example = 9)]
     pub n_grid: Option<u32>,
-    /// `Tol` on the normalised grid residual (default 0.45).
+    /// `Tol` on the normalised grid residual, dimensionless (default 0.5; 0.45 for the start of a
+    /// design without a stress-free home).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 10.0, example = 0.45)]
+    #[schema(exclusive_minimum = 0.0, maximum = 10.0, example = 0.5)]
     pub tol: Option<f64>,
     /// Coarse cell size (default 2).
     #[serde(default)]
@@ -451,6 +455,22 @@ pub struct AssemblyModesRequest {
 }
 
 // ----------------------------------------------------------------------------------- responses
+
+/// Assembly-mode search settings actually used.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct ModeSearchOut {
+    /// `N_grid`.
+    #[schema(minimum = 1, maximum = 50)]
+    pub n_grid: u64,
+    /// `Tol` on the normalised grid residual, dimensionless.
+    pub tol: f64,
+    /// Coarse cell size in grid indices.
+    #[schema(minimum = 1, maximum = 100)]
+    pub cell: u64,
+    /// Newton refinement cap.
+    #[schema(minimum = 1, maximum = 20_000)]
+    pub max_refine: u64,
+}
 
 /// The response: one shape per mode.
 #[derive(Debug, Clone, Serialize, ToSchema)]
@@ -737,6 +757,8 @@ pub struct AssemblyModesResponse {
     pub refined: u64,
     /// Grid combinations examined.
     pub combinations: u64,
+    /// The search settings used (request values or defaults).
+    pub search: ModeSearchOut,
     /// Always false: a grid search cannot certify that every equilibrium was found.
     pub complete: bool,
     /// Why the list is not certified.
