@@ -18,9 +18,13 @@ use mechcalc::numerics::Budget;
 use proptest::prelude::*;
 use serde_json::{Value, json};
 
+/// 48 cases per property by default; `PROPTEST_CASES` overrides it for bigger runs.
 fn config() -> ProptestConfig {
     ProptestConfig {
-        cases: 48,
+        cases: std::env::var("PROPTEST_CASES")
+            .ok()
+            .and_then(|c| c.parse().ok())
+            .unwrap_or(48),
         ..ProptestConfig::default()
     }
 }
@@ -290,8 +294,12 @@ proptest! {
             prop_assert!(rel(b4.sigma_mpa, 2.0 * a.sigma_mpa) < 1e-12);
             prop_assert!(rel(l4.sigma_mpa, 0.5 * a.sigma_mpa) < 1e-12);
             prop_assert!(rel(c.sigma_mpa, a.sigma_mpa) < 1e-10, "{} vs {}", c.sigma_mpa, a.sigma_mpa);
+            // The maximum's location is conditioned like sqrt(eps): on a flat maximum the round-off
+            // of the scaled design moves the refined argmax by up to ~3e-7 rad (found: Z2 = 14,
+            // chi = 2.557, s = 0.1: 1.8e-5 deg) while sigma passes the 1e-10 check. 1e-3 deg still tells a
+            // different bump or a wrongly scaled angle (grid step 1 deg).
             let (pa, pc) = (a.phi2_deg.unwrap_or(-1.0), c.phi2_deg.unwrap_or(-2.0));
-            prop_assert!((pa - pc).abs() < 1e-5, "phi2 {pa} vs {pc}");
+            prop_assert!((pa - pc).abs() < 1e-3, "phi2 {pa} vs {pc}");
         }
     }
 
@@ -375,7 +383,12 @@ proptest! {
             if d.abs() > 1e-9 * g.r2 {
                 prop_assert_eq!(t.vs_m_s > 0.0, d > 0.0);
                 prop_assert_eq!(r.vs_m_s > 0.0, d < 0.0);
-                prop_assert!(rel(t.vs_m_s / r.vs_m_s, -2.0 / (z + 1.0)) < 1e-9);
+                // Both speeds are ∝ d and carry the absolute error checked above (1e-14 · scale):
+                // relative to |Vs| that is 1e-14 (l + rb)(Z2 + 1)/(2|d|) each, which dominates near
+                // the sign change (found: Z2 = 43, seed 13, close to L = Z2 rb).
+                let cond = 1e-14 * (l + g.rb) * (z + 1.0) / d.abs();
+                prop_assert!(rel(t.vs_m_s / r.vs_m_s, -2.0 / (z + 1.0)) < 1e-9 + cond,
+                    "ratio off by {} (allowed {})", rel(t.vs_m_s / r.vs_m_s, -2.0 / (z + 1.0)), 1e-9 + cond);
             }
             prop_assert!(a.ns_w >= t.ns_w - 1e-12 * t.ns_w.abs());
         }
