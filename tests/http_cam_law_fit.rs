@@ -121,6 +121,10 @@ async fn sample_problems_are_422_with_pointers() {
     let mut b = small();
     b["abscissa"]["values"][4] = json!(0.1);
     expect_422(&b, "/abscissa/values/4").await;
+    // Unit label over 32 characters (shared check with /v1/cam-law/evaluate).
+    let mut b = small();
+    b["units"] = json!({"x": "s", "s": "r".repeat(33)});
+    expect_422(&b, "/units/s").await;
     // Grid too small.
     let mut b = small();
     b["abscissa"] = json!({"grid": {"start": 0.0, "end": 1.0, "count": 5}});

@@ -19,9 +19,6 @@ pub const SUM_SILENT_TOL: f64 = 1e-12;
 /// (spec §2).
 pub const ABSCISSA_TOL: f64 = 1e-9;
 
-/// Longest accepted unit label.
-pub const MAX_UNIT_LABEL: usize = 32;
-
 /// Which law to evaluate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LawChoice {
@@ -360,20 +357,7 @@ impl TryFrom<EvaluateRequest> for EvaluateInput {
         }
 
         if let Some(u) = &req.units {
-            for (name, label) in [("x", &u.x), ("s", &u.s)] {
-                if let Some(l) = label {
-                    v.ensure(
-                        l.chars().count() <= MAX_UNIT_LABEL,
-                        format!("/units/{name}"),
-                        || {
-                            format!(
-                                "unit label must have at most {MAX_UNIT_LABEL} characters, got {}",
-                                l.chars().count()
-                            )
-                        },
-                    );
-                }
-            }
+            u.validate(&mut v);
         }
 
         v.finish()?;

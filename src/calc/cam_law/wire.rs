@@ -130,6 +130,23 @@ pub struct Units {
     pub s: Option<String>,
 }
 
+/// Longest accepted unit label, in characters (the `max_length` of [`Units`]).
+pub const MAX_UNIT_LABEL: usize = 32;
+
+impl Units {
+    /// Report every label longer than [`MAX_UNIT_LABEL`] at `/units/x` or `/units/s`.
+    pub fn validate(&self, v: &mut crate::calc::Validator) {
+        for (name, label) in [("x", &self.x), ("s", &self.s)] {
+            if let Some(l) = label {
+                let n = l.chars().count();
+                v.ensure(n <= MAX_UNIT_LABEL, format!("/units/{name}"), || {
+                    format!("unit label must have at most {MAX_UNIT_LABEL} characters, got {n}")
+                });
+            }
+        }
+    }
+}
+
 /// Warning codes (spec §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]

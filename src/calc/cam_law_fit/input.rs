@@ -34,8 +34,6 @@ pub const MAX_SNAP_TOL: f64 = 0.05;
 pub const DEFAULT_DTW_RESTARTS: u32 = 3;
 /// Largest accepted IPOP restart count (spec §2).
 pub const MAX_DTW_RESTARTS: u32 = 9;
-/// Longest accepted unit label (characters).
-pub const MAX_UNIT_LABEL: usize = 32;
 
 /// A validated fit request (SI is not imposed: units are the caller's, spec §2).
 #[derive(Debug, Clone)]
@@ -620,20 +618,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         None => (0, Vec::new()),
     };
     if let Some(u) = &req.units {
-        for (name, label) in [("x", &u.x), ("s", &u.s)] {
-            if let Some(l) = label {
-                v.ensure(
-                    l.chars().count() <= MAX_UNIT_LABEL,
-                    format!("/units/{name}"),
-                    || {
-                        format!(
-                            "unit label must have at most {MAX_UNIT_LABEL} characters, got {}",
-                            l.chars().count()
-                        )
-                    },
-                );
-            }
-        }
+        u.validate(&mut v);
     }
 
     v.finish()?;
