@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{post_json, send, send_to};
+use common::{post_json, send_to};
 use mechcalc::AppState;
 use mechcalc::config::ServiceConfig;
 use serde_json::{Value, json};
@@ -90,27 +90,6 @@ async fn motor_map_runs() {
     let b = r.json();
     assert_eq!(b["t_max_nm"][0], 800.0);
     assert!(b["components"]["mode"].to_string().contains("fw"));
-}
-
-#[tokio::test]
-async fn malformed_json_is_400() {
-    let r = send(
-        "POST",
-        PATH,
-        Some("application/json"),
-        br#"{"cycles": ["#.to_vec(),
-    )
-    .await;
-    assert_eq!(r.problem(400)["type"], "/problems/malformed-json");
-}
-
-#[tokio::test]
-async fn wrong_content_type_is_415() {
-    let body = serde_json::to_vec(&example()).expect("json");
-    let r = send("POST", PATH, Some("text/plain"), body.clone()).await;
-    assert_eq!(r.problem(415)["type"], "/problems/unsupported-media-type");
-    let r = send("POST", MAP_PATH, None, body).await;
-    r.problem(415);
 }
 
 #[tokio::test]

@@ -5,7 +5,7 @@ mod common;
 
 use std::time::Duration;
 
-use common::{post_json, send, send_to};
+use common::{post_json, send_to};
 use mechcalc::AppState;
 use mechcalc::config::ServiceConfig;
 use serde_json::{Value, json};
@@ -54,28 +54,6 @@ async fn named_law_is_evaluated() {
         b["curves"].get("v").is_none(),
         "only the requested quantities are returned"
     );
-}
-
-#[tokio::test]
-async fn malformed_json_is_400() {
-    let r = send(
-        "POST",
-        PATH,
-        Some("application/json"),
-        br#"{"coefficients": [0.1, "#.to_vec(),
-    )
-    .await;
-    let p = r.problem(400);
-    assert_eq!(p["type"], "/problems/malformed-json");
-}
-
-#[tokio::test]
-async fn wrong_content_type_is_415() {
-    let body = serde_json::to_vec(&table1()).expect("json");
-    let r = send("POST", PATH, Some("text/plain"), body.clone()).await;
-    assert_eq!(r.problem(415)["type"], "/problems/unsupported-media-type");
-    let r = send("POST", PATH, None, body).await;
-    r.problem(415);
 }
 
 #[tokio::test]

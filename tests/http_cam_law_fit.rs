@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{post_json, send};
+use common::post_json;
 use serde_json::{Value, json};
 
 const PATH: &str = "/v1/fit-cam-law";
@@ -75,26 +75,6 @@ async fn optional_outputs_only_when_requested() {
     assert!(j["curves"].get("s").is_none());
     assert!(j["history"].is_array());
     assert!(j.get("error_table").is_none() && j.get("classification").is_none());
-}
-
-#[tokio::test]
-async fn malformed_json_is_400() {
-    let r = send(
-        "POST",
-        PATH,
-        Some("application/json"),
-        br#"{"abscissa": "#.to_vec(),
-    )
-    .await;
-    assert_eq!(r.problem(400)["type"], "/problems/malformed-json");
-}
-
-#[tokio::test]
-async fn wrong_content_type_is_415() {
-    let body = serde_json::to_vec(&small()).expect("json");
-    let r = send("POST", PATH, Some("text/plain"), body.clone()).await;
-    assert_eq!(r.problem(415)["type"], "/problems/unsupported-media-type");
-    send("POST", PATH, None, body).await.problem(415);
 }
 
 #[tokio::test]

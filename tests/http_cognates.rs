@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{post_json, send};
+use common::post_json;
 use serde_json::{Value, json};
 
 const PATH: &str = "/v1/cognates";
@@ -55,26 +55,6 @@ async fn optional_outputs_are_omitted_unless_asked() {
     for m in b["mechanisms"].as_array().expect("mechanisms") {
         assert!(m.get("curves").is_none() && m.get("metrics").is_none());
     }
-}
-
-#[tokio::test]
-async fn malformed_json_is_400() {
-    let r = send(
-        "POST",
-        PATH,
-        Some("application/json"),
-        br#"{"crank": 1.0, "#.to_vec(),
-    )
-    .await;
-    assert_eq!(r.problem(400)["type"], "/problems/malformed-json");
-}
-
-#[tokio::test]
-async fn wrong_content_type_is_415() {
-    let body = serde_json::to_vec(&table1()).expect("json");
-    let r = send("POST", PATH, Some("text/plain"), body.clone()).await;
-    assert_eq!(r.problem(415)["type"], "/problems/unsupported-media-type");
-    send("POST", PATH, None, body).await.problem(415);
 }
 
 /// Shape errors are decode errors (the service answers data errors with 422 and serde's path).

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{post_json, send, send_to};
+use common::{post_json, send_to};
 use mechcalc::AppState;
 use mechcalc::config::ServiceConfig;
 use serde_json::{Value, json};
@@ -88,26 +88,6 @@ async fn optional_outputs_on_request() {
         .as_f64()
         .expect("τ_b");
     assert!((tau - 0.804_030).abs() < 5e-7, "{tau}");
-}
-
-#[tokio::test]
-async fn malformed_json_is_400() {
-    let r = send(
-        "POST",
-        PATH,
-        Some("application/json"),
-        br#"{"components": ["#.to_vec(),
-    )
-    .await;
-    assert_eq!(r.problem(400)["type"], "/problems/malformed-json");
-}
-
-#[tokio::test]
-async fn wrong_content_type_is_415() {
-    let body = serde_json::to_vec(&machining_center()).expect("json");
-    let r = send("POST", PATH, Some("text/plain"), body.clone()).await;
-    assert_eq!(r.problem(415)["type"], "/problems/unsupported-media-type");
-    send("POST", PATH, None, body).await.problem(415);
 }
 
 #[tokio::test]

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{post_json, send};
+use common::post_json;
 use serde_json::{Value, json};
 
 const PATH: &str = "/v1/continuum-workspace";
@@ -101,21 +101,6 @@ async fn assembly_modes_are_marked_non_certified() {
             "{want} deg not in {stable:?}"
         );
     }
-}
-
-#[tokio::test]
-async fn malformed_json_is_400_and_wrong_content_type_415() {
-    let r = send(
-        "POST",
-        PATH,
-        Some("application/json"),
-        br#"{"mode": "fk", "#.to_vec(),
-    )
-    .await;
-    assert_eq!(r.problem(400)["type"], "/problems/malformed-json");
-    let body = serde_json::to_vec(&fk_example()).expect("json");
-    let r = send("POST", PATH, Some("text/plain"), body).await;
-    assert_eq!(r.problem(415)["type"], "/problems/unsupported-media-type");
 }
 
 /// Shape errors are decode errors with serde's path as the pointer.

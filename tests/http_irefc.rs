@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{post_json, send};
+use common::post_json;
 use serde_json::{Value, json};
 
 const STRESS: &str = "/v1/irefc-stress";
@@ -86,23 +86,6 @@ async fn efficiency_paper_example_is_answered() {
     let b = r.json();
     assert!((b["totals"]["eta_product"].as_f64().expect("n") - 0.93224).abs() < 5e-6);
     assert_eq!(b["elements"].as_array().map(Vec::len), Some(14));
-}
-
-#[tokio::test]
-async fn malformed_json_and_wrong_content_type() {
-    for path in [STRESS, EFFICIENCY] {
-        let r = send(
-            "POST",
-            path,
-            Some("application/json"),
-            br#"{"r2_mm": 20, "#.to_vec(),
-        )
-        .await;
-        assert_eq!(r.problem(400)["type"], "/problems/malformed-json");
-        let body = serde_json::to_vec(&example("stress_single")).expect("json");
-        let r = send("POST", path, Some("text/plain"), body).await;
-        assert_eq!(r.problem(415)["type"], "/problems/unsupported-media-type");
-    }
 }
 
 #[tokio::test]
