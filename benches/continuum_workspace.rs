@@ -520,22 +520,22 @@ fn sweep_tables() {
 
 fn modes_table() {
     println!(
-        "\n### Assembly-mode search (d1 at (-0.22, 0.2425), F = 0, cell 2; spec 6.2: N_grid 6 / Tol 0.45 -> 4 solutions, 2 stable; N_grid 9 / Tol 0.5 -> 10, 5 stable)\n"
+        "\n### Assembly-mode search (d1 at (-0.22, 0.2425), F = 0; spec 6.2 (cell 2): N_grid 6 / Tol 0.45 -> 4 solutions, 2 stable; N_grid 9 / Tol 0.5 -> 10, 5 stable)\n"
     );
     println!(
         "Missed = modes of the N_grid 9 / Tol 0.5 / max_refine 20 000 search (the reference set) not found.\n"
     );
     println!(
-        "| N_grid | Tol | max_refine | combinations examined | candidates | refined | solutions | stable | missed | ms |"
+        "| N_grid | Tol | cell | max_refine | combinations examined | candidates | refined | solutions | stable | missed | ms |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let model = d1(32);
     let p = Params {
         lambda: vec![-0.22, 0.2425],
         force: [0.0, 0.0],
         moment: 0.0,
     };
-    let search = |n_grid: usize, tol: f64, max_refine: usize| {
+    let search = |n_grid: usize, tol: f64, cell: usize, max_refine: usize| {
         let t0 = Instant::now();
         let r = modes::search(
             &model,
@@ -543,7 +543,7 @@ fn modes_table() {
             modes::ModeSearch {
                 n_grid,
                 tol,
-                cell: 2,
+                cell,
                 max_refine,
             },
             NewtonOptions::new(1e-10, 50),
@@ -553,7 +553,7 @@ fn modes_table() {
         );
         (r, t0.elapsed().as_secs_f64() * 1e3)
     };
-    let (reference, _) = search(9, 0.5, 20_000);
+    let (reference, _) = search(9, 0.5, 2, 20_000);
     let nr = model.n_rods();
     let pose = |s: &modes::ModeSolution| {
         [
@@ -562,20 +562,24 @@ fn modes_table() {
             s.solution.v[3 * nr + 2],
         ]
     };
-    for (ng, tol, max_refine) in [
-        (3usize, 0.45, 4000usize),
-        (4, 0.45, 4000),
-        (5, 0.3, 4000),
-        (5, 0.45, 4000),
-        (6, 0.45, 4000),
-        (7, 0.45, 4000),
-        (7, 0.5, 4000),
-        (8, 0.5, 4000),
-        (9, 0.5, 1000),
-        (9, 0.5, 4000),
-        (9, 0.5, 20_000),
+    for (ng, tol, cell, max_refine) in [
+        (3usize, 0.45, 2usize, 4000usize),
+        (4, 0.45, 2, 4000),
+        (5, 0.3, 2, 4000),
+        (5, 0.45, 2, 4000),
+        (6, 0.45, 1, 4000),
+        (6, 0.45, 2, 4000),
+        (6, 0.45, 3, 4000),
+        (7, 0.45, 2, 4000),
+        (7, 0.5, 2, 4000),
+        (8, 0.5, 2, 4000),
+        (9, 0.5, 2, 1000),
+        (9, 0.5, 1, 4000),
+        (9, 0.5, 2, 4000),
+        (9, 0.5, 3, 4000),
+        (9, 0.5, 2, 20_000),
     ] {
-        let (r, ms) = search(ng, tol, max_refine);
+        let (r, ms) = search(ng, tol, cell, max_refine);
         let missed = reference
             .solutions
             .iter()
@@ -589,13 +593,13 @@ fn modes_table() {
                 })
             })
             .count();
-        let mark = match (ng, max_refine) {
-            (9, 4000) => " (default, 3 rods)",
-            (6, 4000) if tol < 0.46 => " (default of the no-home start)",
+        let mark = match (ng, cell, max_refine) {
+            (9, 2, 4000) => " (default, 3 rods)",
+            (6, 2, 4000) if tol < 0.46 => " (default of the no-home start)",
             _ => "",
         };
         println!(
-            "| {ng}{mark} | {tol} | {max_refine} | {} | {} | {} | {} | {} | {missed} | {ms:.0} |",
+            "| {ng}{mark} | {tol} | {cell} | {max_refine} | {} | {} | {} | {} | {} | {missed} | {ms:.0} |",
             r.combinations,
             r.candidates,
             r.refined,
