@@ -14,15 +14,15 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use mechcalc::calc::bus_fuel_economy::ac_factor::{AcFactor, Dowell};
-use mechcalc::calc::bus_fuel_economy::ipmsm::{
-    Ipmsm, IpmsmParams, psi_from_back_emf, rpm_to_rad_s,
-};
 use mechcalc::calc::bus_fuel_economy::{
     BusFuelEconomyRequest, MotorMapRequest, run, run_motor_map,
 };
 use mechcalc::numerics::Budget;
 use serde_json::{Value, json};
+
+#[path = "../tests/support/bus_demo_motor.rs"]
+mod bus_demo_motor;
+use bus_demo_motor::demo_efficiency_map;
 
 const CYCLES: [&str; 3] = ["manhattan", "hwfet", "hdudds"];
 /// Repetitions per accuracy-table cell (median and worst are reported).
@@ -106,69 +106,6 @@ fn accuracy_table() {
     println!();
 }
 
-/// The demo motor as a model object (for the efficiency-map conversion table).
-fn demo_model() -> Ipmsm {
-    Ipmsm::new(&IpmsmParams {
-        pole_pairs: 4.0,
-        psi_m_wb: psi_from_back_emf(83.3, 1000.0, 4.0),
-        ld_h: 0.00035,
-        lq_h: 0.00055,
-        r_20_ohm: 0.006,
-        winding_temp_c: 100.0,
-        i_max_arms: 500.0,
-        v_dc: 360.0,
-        voltage_utilization: 1.0,
-        n_max_rpm: 5200.0,
-        t_cap_nm: 800.0,
-        p_cap_w: 130_000.0,
-        ac: AcFactor::Dowell(Dowell {
-            conductor_height_m: 0.0035,
-            layers: 6.0,
-            porosity: 0.9,
-            stack_length_m: 0.083,
-            end_length_m: 0.05,
-        }),
-        k_h: 3.0,
-        k_e: 0.03,
-        c_fric: 0.0,
-        c_wind: 0.0,
-        stack_scale: 1.0,
-    })
-}
-
-/// Efficiency map of the demo motor on a grid (η at the torque clamped to the envelope).
-fn efficiency_map_motor(speed_step: f64, torque_step: f64) -> Value {
-    let m = demo_model();
-    let speeds: Vec<f64> = (0..)
-        .map(|k| f64::from(k) * speed_step)
-        .take_while(|&n| n < 5200.0 - 1e-9)
-        .chain([5200.0])
-        .collect();
-    let torques: Vec<f64> = (0..)
-        .map(|k| f64::from(k) * torque_step)
-        .take_while(|&t| t <= 800.0 + 1e-9)
-        .collect();
-    let eff: Vec<Vec<f64>> = speeds
-        .iter()
-        .map(|&n| {
-            let w = rpm_to_rad_s(n);
-            let tm = m.t_max(w);
-            torques
-                .iter()
-                .map(|&t| {
-                    if n <= 0.0 || t <= 0.0 {
-                        return 0.5;
-                    }
-                    let tc = t.min(tm);
-                    let p = tc * w;
-                    p / (p + m.evaluate(w, tc, tm).0.total)
-                })
-                .collect()
-        })
-        .collect();
-    json!({"id": "emap", "model": "efficiency_map", "speed_rpm": speeds, "torque_nm": torques, "efficiency": eff})
-}
-
 /// Efficiency-map conversion (spec §8 item 2): FE error of the converted map vs direct evaluation.
 fn efficiency_map_table() {
     println!(
@@ -177,7 +114,7 @@ fn efficiency_map_table() {
     println!("| grid | cycle | median ms | FE km/kWh | rel. error vs direct |");
     println!("|---|---|---|---|---|");
     for grid in [(500.0, 100.0), (250.0, 50.0)] {
-        let motor = efficiency_map_motor(grid.0, grid.1);
+        let motor = demo_efficiency_map(grid.0, grid.1);
         for cycle in CYCLES {
             let req = request(json!({"cycles": [cycle], "motors": [motor.clone()]}));
             let direct = fe(&request(

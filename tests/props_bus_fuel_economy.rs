@@ -11,6 +11,9 @@ use mechcalc::numerics::Budget;
 use proptest::prelude::*;
 use serde_json::{Value, json};
 
+#[path = "support/bus_demo_motor.rs"]
+mod bus_demo_motor;
+
 fn cfg(cases: u32) -> ProptestConfig {
     ProptestConfig {
         cases: std::env::var("PROPTEST_CASES")
@@ -60,20 +63,12 @@ fn big_constant(eta: f64) -> Value {
     json!({"id": "m", "model": "constant", "efficiency": eta, "t_peak_nm": 1e6, "p_peak_w": 1e9, "n_max_rpm": 1e5})
 }
 
+/// The demo motor without caps, with the winding resistance and conductor height varied and
+/// non-zero friction and windage.
 fn demo_params(r20: f64, h: f64) -> IpmsmParams {
     IpmsmParams {
-        pole_pairs: 4.0,
         psi_m_wb: 0.198864,
-        ld_h: 0.00035,
-        lq_h: 0.00055,
         r_20_ohm: r20,
-        winding_temp_c: 100.0,
-        i_max_arms: 500.0,
-        v_dc: 360.0,
-        voltage_utilization: 1.0,
-        n_max_rpm: 5200.0,
-        t_cap_nm: f64::INFINITY,
-        p_cap_w: f64::INFINITY,
         ac: AcFactor::Dowell(Dowell {
             conductor_height_m: h,
             layers: 6.0,
@@ -81,11 +76,9 @@ fn demo_params(r20: f64, h: f64) -> IpmsmParams {
             stack_length_m: 0.083,
             end_length_m: 0.05,
         }),
-        k_h: 3.0,
-        k_e: 0.03,
         c_fric: 0.1,
         c_wind: 1e-7,
-        stack_scale: 1.0,
+        ..bus_demo_motor::demo_params(false)
     }
 }
 
