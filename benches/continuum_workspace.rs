@@ -480,24 +480,14 @@ fn sweep_tables() {
     };
     for threads in [1usize, 2] {
         let s = SweepSettings {
-            grid: [31, 31],
-            ranges: [[-0.7, 0.2], [-0.1775, 0.7225]],
-            diagonal_neighbours: false,
-            predictor: true,
-            max_substeps: 8,
-            max_tries: 4,
-            substep_max_iter: 20,
-            angle_jump: 5f64.to_radians(),
-            position_factor: 5.0,
-            cond_max: 1e12,
             stability: StabilityCheck::DetSign,
-            segments: 20,
             limits: Limits {
                 min_gap: Some(0.05),
                 sigma_allow: None,
                 rod_crossing: false,
             },
             threads,
+            ..SweepSettings::with_defaults([31, 31], [[-0.7, 0.2], [-0.1775, 0.7225]])
         };
         let seed_sol = solve_home(&model, [-0.25, 0.2725], 1e-10);
         let seed = sweep::accept(&model, &s, &[-0.25, 0.2725], &seed_sol, None).expect("seed");

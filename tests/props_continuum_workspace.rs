@@ -159,24 +159,14 @@ fn sweep_is_independent_of_thread_count() {
     };
     let run_with = |threads: usize| {
         let s = SweepSettings {
-            grid: [13, 13],
-            ranges: [[-0.7, 0.2], [-0.1775, 0.7225]],
-            diagonal_neighbours: false,
-            predictor: true,
-            max_substeps: 8,
-            max_tries: 4,
-            substep_max_iter: 20,
-            angle_jump: 5f64.to_radians(),
-            position_factor: 5.0,
-            cond_max: 1e12,
             stability: StabilityCheck::DetSign,
-            segments: 20,
             limits: Limits {
                 min_gap: Some(0.05),
                 sigma_allow: None,
                 rod_crossing: false,
             },
             threads,
+            ..SweepSettings::with_defaults([13, 13], [[-0.7, 0.2], [-0.1775, 0.7225]])
         };
         let home = compute::resolve_home(&model).expect("design 1 has a home");
         let seed_l = sweep::lambda_at(&s, 6, 6);

@@ -862,3 +862,22 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calc::continuum_workspace::ContinuumWorkspaceRequest;
+
+    /// A `workspace` request without settings gets exactly `SweepSettings::with_defaults` (the
+    /// documented defaults the bench and the property tests start from).
+    #[test]
+    fn empty_workspace_settings_are_the_sweep_defaults() {
+        let req: ContinuumWorkspaceRequest = serde_json::from_value(serde_json::json!({
+            "mode": "workspace", "design": {"preset": "keops_d1"}
+        }))
+        .expect("request decodes");
+        let input = Input::try_from(&req).expect("valid");
+        let got = input.sweep.expect("workspace mode").settings;
+        assert_eq!(got, SweepSettings::with_defaults(got.grid, got.ranges));
+    }
+}

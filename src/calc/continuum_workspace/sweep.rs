@@ -92,6 +92,37 @@ pub struct SweepSettings {
     pub threads: usize,
 }
 
+impl SweepSettings {
+    /// The settings of a `workspace` request that gives only the grid and the ranges (spec 4.7
+    /// defaults): axis neighbours, predictor on, up to 8 sub-steps of at most 20 Newton iterations,
+    /// 4 tries, jump limits 5 deg and 5x the input change, cond(J) <= 1e12, full stability test
+    /// with 20 segments per rod, no physical limits, 2 threads. The request parser takes its
+    /// defaults from here.
+    #[must_use]
+    pub fn with_defaults(grid: [usize; 2], ranges: [[f64; 2]; 2]) -> Self {
+        Self {
+            grid,
+            ranges,
+            diagonal_neighbours: false,
+            predictor: true,
+            max_substeps: 8,
+            max_tries: 4,
+            substep_max_iter: 20,
+            angle_jump: 5f64.to_radians(),
+            position_factor: 5.0,
+            cond_max: 1e12,
+            stability: StabilityCheck::Full,
+            segments: 20,
+            limits: Limits {
+                min_gap: None,
+                sigma_allow: None,
+                rod_crossing: false,
+            },
+            threads: 2,
+        }
+    }
+}
+
 /// Status of a grid node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum NodeStatus {
