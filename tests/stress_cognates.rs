@@ -56,6 +56,16 @@ fn assert_all_finite(v: &Value, path: &str) {
 }
 
 /// Runs a request; returns the response after checking finiteness, or the typed failure.
+/// The `sync` certificate was computed and passed.
+fn assert_sync_passed(r: &CognatesResponse) {
+    let sync = r
+        .verification
+        .as_ref()
+        .and_then(|v| v.sync.as_ref())
+        .expect("sync");
+    assert!(sync.passed, "{sync:?}");
+}
+
 fn attempt(v: Value) -> Result<CognatesResponse, CalcFailure> {
     let req: CognatesRequest = match serde_json::from_value(v.clone()) {
         Ok(r) => r,
@@ -181,12 +191,7 @@ fn absolute_scale_extremes() {
             "C at scale {s:e}: {:?}",
             r.c
         );
-        let sync = r
-            .verification
-            .as_ref()
-            .and_then(|v| v.sync.as_ref())
-            .expect("sync");
-        assert!(sync.passed, "{sync:?}");
+        assert_sync_passed(&r);
     }
 }
 
@@ -566,12 +571,7 @@ fn collinear_and_near_degenerate_coupler_triangles() {
                                 r.warnings
                             );
                         }
-                        let sync = r
-                            .verification
-                            .as_ref()
-                            .and_then(|v| v.sync.as_ref())
-                            .expect("sync");
-                        assert!(sync.passed, "{sync:?}");
+                        assert_sync_passed(&r);
                     }
                     Err(err) => {
                         assert_eq!(err.code, "COUPLER_TRIANGLE_INVALID", "{d2} {e}: {err}");
