@@ -14,27 +14,16 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use mechcalc::calc::cam_law::catalogue::TABLE3;
-use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
+use mechcalc::calc::cam_law::law::{Quantity, SevenSegmentLaw};
 use mechcalc::calc::cam_law::run;
 use mechcalc::calc::cam_law::wire::EvaluateRequest;
 use mechcalc::numerics::Budget;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const TABLE1_C: [f64; 7] = [2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0];
-
-fn table1_bc() -> BoundaryConditions {
-    BoundaryConditions {
-        t_a: 0.0,
-        t_b: 1.0,
-        s_a: 0.0,
-        s_b: 1.0,
-        v_a: 0.2,
-        v_b: 0.5,
-        a_a: 1.4,
-        a_b: 1.2,
-    }
-}
+#[path = "../tests/support/cam_table1.rs"]
+mod cam_table1;
+use cam_table1::{TABLE1_BC, TABLE1_C};
 
 fn grid(n: usize) -> Vec<f64> {
     #[allow(clippy::cast_precision_loss)] // n ≤ 200 000
@@ -79,7 +68,7 @@ fn time_ns(reps: usize, per: usize, mut f: impl FnMut()) -> (f64, f64) {
 }
 
 fn print_table() {
-    let law = SevenSegmentLaw::try_new(&TABLE1_C, &table1_bc()).expect("Table-1 law");
+    let law = SevenSegmentLaw::try_new(&TABLE1_C, &TABLE1_BC).expect("Table-1 law");
     println!("\n| case | N | median ns/sample | worst ns/sample |");
     println!("|---|---|---|---|");
     for n in [300usize, 200_000] {
@@ -111,7 +100,7 @@ fn print_table() {
     println!("\n| construction | median ns/law | worst ns/law |");
     println!("|---|---|---|");
     let cs = candidates(1000);
-    let bc = table1_bc();
+    let bc = TABLE1_BC;
     let (med, worst) = time_ns(2000, cs.len(), || {
         for c in &cs {
             black_box(SevenSegmentLaw::try_new(black_box(c), &bc).ok());
@@ -151,7 +140,7 @@ fn print_table() {
 
 fn benches(c: &mut Criterion) {
     print_table();
-    let law = SevenSegmentLaw::try_new(&TABLE1_C, &table1_bc()).expect("Table-1 law");
+    let law = SevenSegmentLaw::try_new(&TABLE1_C, &TABLE1_BC).expect("Table-1 law");
     for n in [300usize, 200_000] {
         let mut g = c.benchmark_group(format!("cam_law/eval_quantity_into/N={n}"));
         g.throughput(Throughput::Elements(n as u64));
@@ -173,7 +162,7 @@ fn benches(c: &mut Criterion) {
     }
     let mut g = c.benchmark_group("cam_law/construct");
     let mt = TABLE3[4].coefficients;
-    let bc = table1_bc();
+    let bc = TABLE1_BC;
     g.bench_function("try_new", |b| {
         b.iter(|| SevenSegmentLaw::try_new(black_box(&TABLE1_C), black_box(&bc)))
     });

@@ -30,17 +30,10 @@ use mechcalc::calc::cam_law_fit::prep::grid;
 use mechcalc::calc::cam_law_fit::wire::Method;
 use mechcalc::numerics::Budget;
 
-const TABLE1_C: [f64; 7] = [2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0];
-const TABLE1_BC: BoundaryConditions = BoundaryConditions {
-    t_a: 0.0,
-    t_b: 1.0,
-    s_a: 0.0,
-    s_b: 1.0,
-    v_a: 0.2,
-    v_b: 0.5,
-    a_a: 1.4,
-    a_b: 1.2,
-};
+#[path = "../tests/support/cam_table1.rs"]
+mod cam_table1;
+use cam_table1::{TABLE1_BC, TABLE1_C};
+
 /// Best-known answer of the noisy Table-1 case (spec §5.4), used as its "truth".
 const NOISY_BEST: [f64; 7] = [
     0.063652, 0.148306, 0.169314, 0.094919, 0.332718, 0.150644, 0.040448,

@@ -20,26 +20,17 @@ use mechcalc::calc::{CalcFailure, ProblemClass};
 use mechcalc::numerics::Budget;
 use serde_json::{Value, json};
 
+#[path = "support/cam_table1.rs"]
+mod cam_table1;
+use cam_table1::TABLE1_BC;
+
 /// Spec §5.2: 1e-9 absolute on s, v, a.
 const ABS_SVA: f64 = 1e-9;
 /// Spec §5.2: 1e-7 relative on jerk.
 const REL_J: f64 = 1e-7;
 
-fn table1_bc() -> BoundaryConditions {
-    BoundaryConditions {
-        t_a: 0.0,
-        t_b: 1.0,
-        s_a: 0.0,
-        s_b: 1.0,
-        v_a: 0.2,
-        v_b: 0.5,
-        a_a: 1.4,
-        a_b: 1.2,
-    }
-}
-
 fn table1_law() -> SevenSegmentLaw {
-    SevenSegmentLaw::try_new(&[2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0], &table1_bc())
+    SevenSegmentLaw::try_new(&[2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0], &TABLE1_BC)
         .expect("valid Table-1 law")
 }
 
@@ -439,7 +430,7 @@ fn appendix_a1_explicit_pieces_match_general_law() {
 #[test]
 fn cramer_matches_centroid_on_spec_cases() {
     let cases = [
-        ([2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0], table1_bc()),
+        ([2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0], TABLE1_BC),
         (phase2_coefficients(), phase2_bc()),
     ];
     for (c, bc) in cases {

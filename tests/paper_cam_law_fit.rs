@@ -19,6 +19,10 @@ use mechcalc::calc::cam_law_fit::{self, FitCamLawRequest};
 use mechcalc::numerics::{Budget, StopReason};
 use serde_json::{Value, json};
 
+#[path = "support/cam_table1.rs"]
+mod cam_table1;
+use cam_table1::TABLE1_BC;
+
 fn heavy() -> bool {
     std::env::var_os("CAMFIT_HEAVY").is_some()
 }
@@ -46,17 +50,6 @@ const TABLE1_C: [f64; 7] = [
     7.0 / 31.0,
     1.0 / 31.0,
 ];
-const TABLE1_BC: BoundaryConditions = BoundaryConditions {
-    t_a: 0.0,
-    t_b: 1.0,
-    s_a: 0.0,
-    s_b: 1.0,
-    v_a: 0.2,
-    v_b: 0.5,
-    a_a: 1.4,
-    a_b: 1.2,
-};
-
 fn fit(req: Value) -> FitCamLawResponse {
     let req: FitCamLawRequest = serde_json::from_value(req).expect("request decodes");
     cam_law_fit::run(req, &Budget::unlimited()).unwrap_or_else(|e| panic!("fit failed: {e}"))

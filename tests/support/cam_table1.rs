@@ -1,0 +1,21 @@
+//! The spec's Table-1 cam-law case (cam_law_fit.md §5.2/§8: non-zero end rates, all seven
+//! segments non-empty), shared by the cam-law tests and benches (each includes this file with
+//! `#[path]`) so they evaluate, fit and time the same law.
+#![allow(dead_code)]
+
+use mechcalc::calc::cam_law::law::BoundaryConditions;
+
+/// Table-1 boundary conditions on [0, 1] with unit rise.
+pub const TABLE1_BC: BoundaryConditions = BoundaryConditions {
+    t_a: 0.0,
+    t_b: 1.0,
+    s_a: 0.0,
+    s_b: 1.0,
+    v_a: 0.2,
+    v_b: 0.5,
+    a_a: 1.4,
+    a_b: 1.2,
+};
+
+/// Table-1 coefficient vector before normalisation (ĉ = c / 31).
+pub const TABLE1_C: [f64; 7] = [2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0];
