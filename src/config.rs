@@ -26,6 +26,24 @@ pub struct ServiceConfig {
     )]
     pub compute_slots: usize,
 
+    /// Threads of the compute pool that runs every calculation (0 = number of CPU cores). All
+    /// jobs and their parallel parts share these threads, so they bound the service's CPU.
+    #[arg(
+        long = "compute-threads",
+        env = "MECHCALC_COMPUTE_THREADS",
+        default_value_t = 0
+    )]
+    pub compute_threads: usize,
+
+    /// Threads one job may use for its parallel parts (sweeps, multi-starts, folds; 0 = every
+    /// compute thread). Results do not depend on it.
+    #[arg(
+        long = "threads-per-job",
+        env = "MECHCALC_THREADS_PER_JOB",
+        default_value_t = 0
+    )]
+    pub threads_per_job: usize,
+
     /// Maximum number of compute jobs waiting for a slot before requests get 503.
     #[arg(
         long = "queue-depth",
@@ -60,6 +78,8 @@ impl Default for ServiceConfig {
         Self {
             bind: SocketAddr::from(([127, 0, 0, 1], 8080)),
             compute_slots: 0,
+            compute_threads: 0,
+            threads_per_job: 0,
             queue_depth: 16,
             max_body_bytes: 16 * 1024 * 1024,
             max_time_budget_ms: 600_000,
@@ -69,13 +89,36 @@ impl Default for ServiceConfig {
 }
 
 impl ServiceConfig {
-    /// Effective number of concurrent compute jobs.
+    /// Effective number of concurrent compute jobs (at most the compute threads: a job beyond
+    /// them could only wait inside the pool).
     #[must_use]
     pub fn effective_compute_slots(&self) -> usize {
-        if self.compute_slots > 0 {
+        let slots = if self.compute_slots > 0 {
             self.compute_slots
         } else {
-            std::thread::available_parallelism().map_or(2, std::num::NonZeroUsize::get)
+            cores()
+        };
+        slots.min(self.effective_compute_threads())
+    }
+
+    /// Effective size of the compute pool.
+    #[must_use]
+    pub fn effective_compute_threads(&self) -> usize {
+        if self.compute_threads > 0 {
+            self.compute_threads
+        } else {
+            cores()
+        }
+    }
+
+    /// Effective threads per job.
+    #[must_use]
+    pub fn effective_threads_per_job(&self) -> usize {
+        let all = self.effective_compute_threads();
+        if self.threads_per_job > 0 {
+            self.threads_per_job.min(all)
+        } else {
+            all
         }
     }
 
@@ -84,4 +127,9 @@ impl ServiceConfig {
     pub fn max_time_budget(&self) -> Duration {
         Duration::from_millis(self.max_time_budget_ms.max(1))
     }
+}
+
+/// CPU cores of this machine (2 when unknown).
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(2, std::num::NonZeroUsize::get)
 }

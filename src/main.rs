@@ -49,6 +49,15 @@ async fn main() -> std::process::ExitCode {
             .init();
     }
 
+    // The one compute pool: every calculation and its parallel parts run on these threads.
+    if let Err(e) = rayon::ThreadPoolBuilder::new()
+        .num_threads(config.effective_compute_threads())
+        .thread_name(|i| format!("mechcalc-compute-{i}"))
+        .build_global()
+    {
+        tracing::error!(error = %e, "cannot start the compute pool");
+        return std::process::ExitCode::FAILURE;
+    }
     let listener = match tokio::net::TcpListener::bind(config.bind).await {
         Ok(l) => l,
         Err(e) => {
@@ -59,6 +68,8 @@ async fn main() -> std::process::ExitCode {
     tracing::info!(
         bind = %config.bind,
         compute_slots = config.effective_compute_slots(),
+        compute_threads = config.effective_compute_threads(),
+        threads_per_job = config.effective_threads_per_job(),
         queue_depth = config.queue_depth,
         max_body_bytes = config.max_body_bytes,
         max_time_budget_ms = config.max_time_budget_ms,

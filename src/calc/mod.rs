@@ -1,13 +1,29 @@
-//! Pure compute modules, one folder per paper method. Nothing here knows about HTTP or async:
-//! each module exposes `compute(input, budget) -> Result<Output, Error>` and its wire types.
+//! Pure compute modules, one folder per paper method. Nothing here knows about HTTP or async.
+//!
+//! Every module has the same five files with the same roles (ARCHITECTURE.md): `wire.rs` (serde +
+//! OpenAPI types, bounds), `input.rs` (the validated SI domain input), `compute.rs` (the pure
+//! `compute(&Input, &Budget) -> Result<Output, Error>`), `output.rs` (the one place that builds the
+//! response) and `mod.rs` (docs and `run`, which chains them). Shared here: the validator and
+//! failure types ([`problem`]), the bounds table ([`bounds`]) and the wire types every endpoint
+//! uses the same way ([`common`]).
 
+pub mod bounds;
 pub mod bus_fuel_economy;
 pub mod cam_law;
 pub mod cam_law_fit;
 pub mod cognates;
+pub mod common;
 pub mod component_importance;
 pub mod continuum_workspace;
 pub mod irefc;
 pub mod problem;
 
-pub use problem::{CalcFailure, FieldIssue, ProblemClass, Validator};
+pub use bounds::{Range, SchemaBound};
+pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validator};
+
+/// Every module's documented request bounds (the `schema_bounds!` tables), for the OpenAPI
+/// document.
+#[must_use]
+pub fn schema_bounds() -> Vec<SchemaBound> {
+    [crate::numerics::budget::schema_bounds()].concat()
+}

@@ -6,6 +6,8 @@
 
 use std::fmt::Display;
 
+use super::bounds::Range;
+
 /// One offending input field: an RFC 6901 JSON pointer into the request body and what is wrong.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FieldIssue {
@@ -84,19 +86,29 @@ impl Display for CalcFailure {
 
 impl std::error::Error for CalcFailure {}
 
-/// Collects every validation problem of a request, then fails once with all of them.
+/// The code of a validation failure that has no more specific code of its module.
+pub const INVALID_INPUT: &str = "INVALID_INPUT";
+
+/// Collects every validation problem of a request, then fails once with all of them: the one
+/// validator of the crate, so that messages, codes and pointers come from one place.
+///
+/// Each problem carries a JSON pointer, a message naming the quantity, the value and the broken
+/// limit, and a code (`INVALID_INPUT` unless the module's spec names another, e.g.
+/// `NON_POSITIVE_LENGTH`). Range checks take a [`Range`] constant: the same constant the module's
+/// [`schema_bounds!`](crate::schema_bounds) table writes into the OpenAPI document.
 ///
 /// ```
-/// use mechcalc::calc::Validator;
+/// use mechcalc::calc::{Range, Validator};
 /// let mut v = Validator::new();
 /// v.finite("/x", f64::NAN);
-/// v.in_range("/n", 3.0, 8.0, 200_000.0);
+/// v.range("/n", "n", 3.0, Range::int(8, 200_000));
 /// let err = v.finish().unwrap_err();
 /// assert_eq!(err.errors.len(), 2);
+/// assert_eq!(err.errors[1].detail, "n must be an integer in [8, 200000], got 3");
 /// ```
 #[derive(Debug, Default)]
 pub struct Validator {
-    issues: Vec<FieldIssue>,
+    issues: Vec<(&'static str, FieldIssue)>,
 }
 
 impl Validator {
@@ -106,24 +118,52 @@ impl Validator {
         Self::default()
     }
 
-    /// Record a problem at `pointer`.
+    /// Record a problem at `pointer` with the code `INVALID_INPUT`.
     pub fn push(&mut self, pointer: impl Into<String>, detail: impl Into<String>) {
-        self.issues.push(FieldIssue {
-            pointer: pointer.into(),
-            detail: detail.into(),
-        });
+        self.push_code(INVALID_INPUT, pointer, detail);
     }
 
-    /// Record a problem at `pointer` unless `ok`.
+    /// Record a problem at `pointer` with a module-specific code.
+    pub fn push_code(
+        &mut self,
+        code: &'static str,
+        pointer: impl Into<String>,
+        detail: impl Into<String>,
+    ) {
+        self.issues.push((
+            code,
+            FieldIssue {
+                pointer: pointer.into(),
+                detail: detail.into(),
+            },
+        ));
+    }
+
+    /// Record a problem at `pointer` unless `ok`; returns `ok`.
     pub fn ensure(
         &mut self,
         ok: bool,
         pointer: impl Into<String>,
         detail: impl FnOnce() -> String,
-    ) {
+    ) -> bool {
         if !ok {
             self.push(pointer, detail());
         }
+        ok
+    }
+
+    /// Like [`Validator::ensure`], with a module-specific code.
+    pub fn ensure_code(
+        &mut self,
+        ok: bool,
+        code: &'static str,
+        pointer: impl Into<String>,
+        detail: impl FnOnce() -> String,
+    ) -> bool {
+        if !ok {
+            self.push_code(code, pointer, detail());
+        }
+        ok
     }
 
     /// Require a finite number; returns whether it was.
@@ -138,17 +178,31 @@ impl Validator {
     /// Require every element of a slice to be finite (reports the first offending index only,
     /// with a count, so a 200 000-sample array cannot produce 200 000 errors).
     pub fn all_finite(&mut self, pointer: &str, values: &[f64]) -> bool {
-        let mut bad = values.iter().enumerate().filter(|(_, v)| !v.is_finite());
+        self.all_in(pointer, "", values, Range::FINITE)
+    }
+
+    /// Require every element of a slice to lie in `range` (reports the first offending index
+    /// only, with a count).
+    pub fn all_in(&mut self, pointer: &str, name: &str, values: &[f64], range: Range) -> bool {
+        let mut bad = values
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| !range.contains(**v));
         if let Some((i, v)) = bad.next() {
             let more = bad.count();
             let tail = if more > 0 {
-                format!(" ({more} more non-finite values follow)")
+                format!(" ({more} more values out of range follow)")
             } else {
                 String::new()
             };
+            let name = if name.is_empty() {
+                String::new()
+            } else {
+                format!("{name}[{i}] ")
+            };
             self.push(
                 format!("{pointer}/{i}"),
-                format!("must be a finite number, got {v}{tail}"),
+                format!("{name}must be {range}, got {v}{tail}"),
             );
             false
         } else {
@@ -156,28 +210,48 @@ impl Validator {
         }
     }
 
-    /// Require `lo <= value <= hi` (and finite).
-    pub fn in_range(&mut self, pointer: &str, value: f64, lo: f64, hi: f64) -> bool {
-        if !self.finite(pointer, value) {
-            return false;
-        }
-        let ok = (lo..=hi).contains(&value);
+    /// Require `value` in `range` (finite, and whole for an integer range), code `INVALID_INPUT`.
+    /// `name` (may be empty) starts the message: `"a must be > 0, got -1"`.
+    pub fn range(&mut self, pointer: &str, name: &str, value: f64, range: Range) -> bool {
+        self.range_code(INVALID_INPUT, pointer, name, value, range)
+    }
+
+    /// Like [`Validator::range`], with a module-specific code.
+    pub fn range_code(
+        &mut self,
+        code: &'static str,
+        pointer: &str,
+        name: &str,
+        value: f64,
+        range: Range,
+    ) -> bool {
+        let ok = range.contains(value);
         if !ok {
-            self.push(pointer, format!("must be in [{lo}, {hi}], got {value}"));
+            let sep = if name.is_empty() { "" } else { " " };
+            self.push_code(
+                code,
+                pointer,
+                format!("{name}{sep}must be {range}, got {value}"),
+            );
         }
         ok
     }
 
+    /// Require an unsigned integer in `range`.
+    pub fn uint(&mut self, pointer: &str, name: &str, value: u64, range: Range) -> bool {
+        // Request integers beyond 2^53 are far outside every range; the rounding cannot admit one.
+        let x = value as f64;
+        self.range(pointer, name, x, range)
+    }
+
+    /// Require `lo <= value <= hi` (and finite).
+    pub fn in_range(&mut self, pointer: &str, value: f64, lo: f64, hi: f64) -> bool {
+        self.range(pointer, "", value, Range::closed(lo, hi))
+    }
+
     /// Require `value > lo` (and finite).
     pub fn greater_than(&mut self, pointer: &str, value: f64, lo: f64) -> bool {
-        if !self.finite(pointer, value) {
-            return false;
-        }
-        let ok = value > lo;
-        if !ok {
-            self.push(pointer, format!("must be > {lo}, got {value}"));
-        }
-        ok
+        self.range(pointer, "", value, Range::FINITE.gt(lo))
     }
 
     /// Whether no problem has been recorded so far.
@@ -186,23 +260,34 @@ impl Validator {
         self.issues.is_empty()
     }
 
+    /// The problems recorded so far.
+    pub fn issues(&self) -> impl Iterator<Item = &FieldIssue> {
+        self.issues.iter().map(|(_, i)| i)
+    }
+
+    /// Move every problem of `other` into this validator.
+    pub fn absorb(&mut self, other: Self) {
+        self.issues.extend(other.issues);
+    }
+
     /// `Ok(())` when no problem was recorded, else one [`ProblemClass::InvalidInput`] failure
-    /// listing all of them.
+    /// listing all of them. Its code is the code shared by all problems, else the first
+    /// problem's code.
     pub fn finish(self) -> Result<(), CalcFailure> {
-        if self.issues.is_empty() {
+        let Some(&(code, _)) = self.issues.first() else {
             return Ok(());
-        }
+        };
         let n = self.issues.len();
         let detail = if n == 1 {
-            format!("{} {}", self.issues[0].pointer, self.issues[0].detail)
+            format!("{} {}", self.issues[0].1.pointer, self.issues[0].1.detail)
         } else {
             format!("{n} fields failed validation")
         };
         Err(CalcFailure {
             class: ProblemClass::InvalidInput,
-            code: "INVALID_INPUT",
+            code,
             detail,
-            errors: self.issues,
+            errors: self.issues.into_iter().map(|(_, i)| i).collect(),
         })
     }
 }

@@ -2,6 +2,8 @@
 //! document and the interactive API docs (Swagger UI, vendored so it works with no network on
 //! the server side).
 
+use std::sync::OnceLock;
+
 use axum::Json;
 use axum::extract::State;
 use axum::http::{HeaderValue, header};
@@ -111,13 +113,22 @@ pub fn endpoint_index() -> EndpointIndex {
     operation_id = "list_endpoints",
     responses((status = 200, description = "Every endpoint with a one-line summary", body = EndpointIndex))
 )]
-pub async fn index() -> Json<EndpointIndex> {
-    Json(endpoint_index())
+pub async fn index() -> Response {
+    static BODY: OnceLock<Vec<u8>> = OnceLock::new();
+    json_bytes(BODY.get_or_init(|| serde_json::to_vec(&endpoint_index()).unwrap_or_default()))
 }
 
-/// The OpenAPI 3.1 document (JSON).
+/// The OpenAPI 3.1 document (JSON), serialized once per process.
 pub async fn openapi_json() -> Response {
-    let body = super::openapi().to_pretty_json().unwrap_or_default();
+    static BODY: OnceLock<Vec<u8>> = OnceLock::new();
+    json_bytes(
+        BODY.get_or_init(|| {
+            serde_json::to_vec_pretty(super::openapi::document()).unwrap_or_default()
+        }),
+    )
+}
+
+fn json_bytes(body: &'static [u8]) -> Response {
     let mut r = body.into_response();
     r.headers_mut().insert(
         header::CONTENT_TYPE,

@@ -14,6 +14,7 @@ pub mod continuum_workspace;
 pub mod irefc;
 pub mod json;
 pub mod meta;
+pub mod openapi;
 pub mod pool;
 pub mod problem;
 pub mod state;
@@ -109,31 +110,40 @@ JSON pointers to the offending fields.",
 )]
 struct ApiDoc;
 
-/// The documented routes; the OpenAPI document is generated from exactly these.
-fn api_router() -> OpenApiRouter<AppState> {
-    OpenApiRouter::with_openapi(ApiDoc::openapi())
-        .routes(routes!(meta::healthz))
-        .routes(routes!(meta::index))
-        .routes(routes!(cam_law::evaluate))
-        .routes(routes!(cam_law_fit::fit))
-        .routes(routes!(cognates::construct))
-        .routes(routes!(component_importance::rank))
-        .routes(routes!(bus_fuel_economy::compute))
-        .routes(routes!(bus_fuel_economy::motor_map))
-        .routes(routes!(irefc::stress))
-        .routes(routes!(irefc::efficiency))
-        .routes(routes!(continuum_workspace::solve))
+/// The documented routes; the OpenAPI document is generated from exactly these. Also returns
+/// the schema names claimed by two different Rust types (see [`openapi::Registry`]).
+fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
+    openapi::Registry::new(OpenApiRouter::with_openapi(ApiDoc::openapi()))
+        .route(routes!(meta::healthz))
+        .route(routes!(meta::index))
+        .route(routes!(cam_law::evaluate))
+        .route(routes!(cam_law_fit::fit))
+        .route(routes!(cognates::construct))
+        .route(routes!(component_importance::rank))
+        .route(routes!(bus_fuel_economy::compute))
+        .route(routes!(bus_fuel_economy::motor_map))
+        .route(routes!(irefc::stress))
+        .route(routes!(irefc::efficiency))
+        .route(routes!(continuum_workspace::solve))
+        .finish()
 }
 
-/// The OpenAPI document of the service, generated from the handlers and wire types.
+/// The document as utoipa generates it, before [`openapi::document`] completes it.
+fn api_parts() -> (utoipa::openapi::OpenApi, Vec<String>) {
+    let (router, conflicts) = api_router();
+    (router.split_for_parts().1, conflicts)
+}
+
+/// The OpenAPI document of the service (generated from the handlers and wire types, completed
+/// from the bounds tables; see [`openapi`]).
 #[must_use]
 pub fn openapi() -> utoipa::openapi::OpenApi {
-    api_router().split_for_parts().1
+    serde_json::from_value(openapi::document().clone()).unwrap_or_else(|_| api_parts().0)
 }
 
 /// The whole application. Tests drive it without a socket.
 pub fn app(state: AppState) -> Router {
-    let (router, _api) = api_router().split_for_parts();
+    let (router, _api) = api_router().0.split_for_parts();
     let body_limit = state.config.max_body_bytes;
     router
         .route("/openapi.json", get(meta::openapi_json))

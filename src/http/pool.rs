@@ -1,16 +1,21 @@
-//! The compute pool: calculations run on tokio's blocking pool, at most `slots` at once, with at
-//! most `queue_depth` more waiting; beyond that a request is refused with 503 + `Retry-After`.
+//! The compute pool: calculations run on the process's one rayon pool (sized by
+//! `--compute-threads`), at most `slots` at once, with at most `queue_depth` more waiting; beyond
+//! that a request is refused with 503 + `Retry-After`.
 //!
-//! Each job receives a [`Budget`]: the request's own time limit capped by the server's maximum.
-//! Blocking tasks cannot be cancelled, so solvers check the budget every iteration and return
-//! their best-so-far answer with an honest stop reason.
+//! Each job receives a [`Budget`]: the request's own time limit (capped by the server's maximum)
+//! counted from the request's arrival, so queueing spends it too; the number of threads its
+//! parallel parts may use (`--threads-per-job`, through [`crate::numerics::parallel`], on the same
+//! rayon pool, so the CPU of all jobs together stays within the pool); and a cancellation flag that
+//! is raised when the request is dropped (the client went away), so the job stops at its next
+//! budget check and frees its slot. Solvers check the budget every iteration and return their
+//! best-so-far answer with an honest stop reason.
 
+use std::panic::AssertUnwindSafe;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::Duration;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 use tokio::sync::{OwnedSemaphorePermit, Semaphore};
-use tracing::Instrument;
 
 use crate::numerics::Budget;
 
@@ -26,6 +31,24 @@ pub struct ComputePool {
     waiting: Arc<AtomicUsize>,
     queue_depth: usize,
     max_budget: Duration,
+    threads_per_job: usize,
+}
+
+/// Raises the job's cancellation flag when the request is dropped before the job finished.
+struct CancelOnDrop {
+    flag: Arc<AtomicBool>,
+    done: bool,
+}
+
+impl Drop for CancelOnDrop {
+    fn drop(&mut self) {
+        if !self.done {
+            self.flag.store(true, Ordering::Relaxed);
+            tracing::warn!(
+                "client went away; the running job is cancelled at its next budget check"
+            );
+        }
+    }
 }
 
 /// Decrements the waiting counter however the wait ends (permit, timeout or cancellation).
@@ -38,7 +61,8 @@ impl Drop for WaitGuard {
 }
 
 impl ComputePool {
-    /// A pool with `slots` concurrent jobs, `queue_depth` waiters and a server-wide budget cap.
+    /// A pool with `slots` concurrent jobs, `queue_depth` waiters and a server-wide budget cap;
+    /// each job may use every thread of the rayon pool for its parallel parts.
     #[must_use]
     pub fn new(slots: usize, queue_depth: usize, max_budget: Duration) -> Self {
         Self {
@@ -46,7 +70,21 @@ impl ComputePool {
             waiting: Arc::new(AtomicUsize::new(0)),
             queue_depth,
             max_budget,
+            threads_per_job: rayon::current_num_threads(),
         }
+    }
+
+    /// The same pool with `threads` threads per job for parallel parts (at least 1).
+    #[must_use]
+    pub fn with_threads_per_job(mut self, threads: usize) -> Self {
+        self.threads_per_job = threads.max(1);
+        self
+    }
+
+    /// Threads one job may use for its parallel parts.
+    #[must_use]
+    pub fn threads_per_job(&self) -> usize {
+        self.threads_per_job
     }
 
     /// The server-wide cap on a job's time budget.
@@ -78,33 +116,44 @@ impl ComputePool {
         }
     }
 
-    /// Run `job` on the blocking pool with a budget of `requested` (capped by the server maximum;
-    /// the maximum when `None`). The job keeps the caller's tracing span. A panic inside the job
-    /// is logged and becomes a 500 whose body does not echo it.
+    /// Run `job` on the compute pool with a budget of `requested` (capped by the server maximum;
+    /// the maximum when `None`) counted from now, queueing included. The job keeps the caller's
+    /// tracing span. A panic inside the job is logged and becomes a 500 whose body does not echo
+    /// it. Dropping the returned future (the client went away) cancels the job's budget.
     pub async fn run<T, F>(&self, requested: Option<Duration>, job: F) -> Result<T, ApiError>
     where
         T: Send + 'static,
         F: FnOnce(&Budget) -> T + Send + 'static,
     {
+        let arrived = Instant::now();
         let limit = requested.map_or(self.max_budget, |r| r.min(self.max_budget));
         let permit = self.acquire(limit).await?;
+        let mut cancel = CancelOnDrop {
+            flag: Arc::new(AtomicBool::new(false)),
+            done: false,
+        };
+        let budget = Budget::starting_at(arrived, limit)
+            .with_threads(self.threads_per_job)
+            .with_cancel_flag(Arc::clone(&cancel.flag));
         let span = tracing::Span::current();
-        let handle = tokio::task::spawn_blocking(move || {
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        rayon::spawn(move || {
             let _entered = span.enter();
-            let budget = Budget::new(limit);
-            let out = job(&budget);
+            let out = std::panic::catch_unwind(AssertUnwindSafe(|| job(&budget)));
             drop(permit);
-            out
+            // The receiver is gone only when the request was dropped; nobody wants the answer.
+            let _ = tx.send(out);
         });
-        match handle.instrument(tracing::Span::current()).await {
-            Ok(v) => Ok(v),
-            Err(e) => {
-                if e.is_panic() {
-                    let msg = panic_message(e.into_panic());
-                    tracing::error!(panic = %msg, "compute job panicked");
-                } else {
-                    tracing::error!(error = %e, "compute job failed to complete");
-                }
+        let out = rx.await;
+        cancel.done = true;
+        match out {
+            Ok(Ok(v)) => Ok(v),
+            Ok(Err(payload)) => {
+                tracing::error!(panic = %panic_message(payload), "compute job panicked");
+                Err(ApiError::internal())
+            }
+            Err(_) => {
+                tracing::error!("compute job ended without an answer");
                 Err(ApiError::internal())
             }
         }

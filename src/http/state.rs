@@ -23,7 +23,8 @@ impl AppState {
             config.effective_compute_slots(),
             config.queue_depth,
             config.max_time_budget(),
-        );
+        )
+        .with_threads_per_job(config.effective_threads_per_job());
         Self {
             config: Arc::new(config),
             pool,

@@ -1,33 +1,54 @@
-//! Time and evaluation budgets that iterative solvers check every iteration.
+//! Time, evaluation and thread budgets that iterative solvers check every iteration.
 //!
 //! Blocking tasks cannot be aborted from outside, so every solver polls its [`Budget`] once per
-//! iteration (generation, Newton step, sweep node, ...) and stops with [`StopReason::Deadline`] or
-//! [`StopReason::MaxEvaluations`] when it is spent, returning its best-so-far answer.
+//! iteration (generation, Newton step, sweep node, ...) and stops with [`StopReason::Deadline`],
+//! [`StopReason::MaxEvaluations`] or [`StopReason::Cancelled`] when it is spent, returning its
+//! best-so-far answer. The budget also says how many threads the job may use for its parallel
+//! parts ([`Budget::threads`], consumed by [`crate::numerics::parallel`]): the compute pool sets it,
+//! so that admission bounds the CPU.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
 use utoipa::ToSchema;
 
-/// A wall-clock deadline plus an optional cap on objective/model evaluations.
-#[derive(Debug, Clone, Copy)]
+/// A wall-clock deadline plus an optional cap on objective/model evaluations, the number of threads
+/// the job may use, and a cancellation flag the service raises when the client has gone.
+#[derive(Debug, Clone)]
 pub struct Budget {
     start: Instant,
     deadline: Instant,
     max_evaluations: Option<u64>,
+    threads: usize,
+    cancel: Option<Arc<AtomicBool>>,
+}
+
+/// The threads a job may use when nobody says otherwise: the machine's cores.
+fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
 }
 
 impl Budget {
     /// A budget of `limit` wall-clock time from now, without an evaluation cap.
     #[must_use]
     pub fn new(limit: Duration) -> Self {
-        let start = Instant::now();
+        Self::starting_at(Instant::now(), limit)
+    }
+
+    /// A budget of `limit` counted from `start` (for example the request's arrival, so that time
+    /// spent waiting in the admission queue is part of the budget), without an evaluation cap.
+    #[must_use]
+    pub fn starting_at(start: Instant, limit: Duration) -> Self {
         Self {
             start,
             deadline: start
                 .checked_add(limit)
                 .unwrap_or(start + Duration::from_secs(86_400)),
             max_evaluations: None,
+            threads: default_threads(),
+            cancel: None,
         }
     }
 
@@ -44,6 +65,35 @@ impl Budget {
         self
     }
 
+    /// The same budget allowed `threads` threads (at least 1) for its parallel parts.
+    #[must_use]
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads.max(1);
+        self
+    }
+
+    /// The same budget, cancelled once `flag` is raised (the service raises it when the client
+    /// disconnects or the service shuts down).
+    #[must_use]
+    pub fn with_cancel_flag(mut self, flag: Arc<AtomicBool>) -> Self {
+        self.cancel = Some(flag);
+        self
+    }
+
+    /// Threads this job may use for its parallel parts (at least 1).
+    #[must_use]
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// True once the job has been cancelled (client gone, service stopping).
+    #[must_use]
+    pub fn cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
     /// The tighter of this budget's deadline and `now + limit`.
     #[must_use]
     pub fn capped(mut self, limit: Duration) -> Self {
@@ -53,10 +103,11 @@ impl Budget {
         self
     }
 
-    /// True once the wall-clock deadline has passed.
+    /// True once the wall-clock deadline has passed, or the job was cancelled (a cancelled job is
+    /// out of time: every solver that polls `expired` stops at its next check).
     #[must_use]
     pub fn expired(&self) -> bool {
-        Instant::now() >= self.deadline
+        self.cancelled() || Instant::now() >= self.deadline
     }
 
     /// True when `evaluations` has reached the evaluation cap (never, without a cap).
@@ -71,10 +122,13 @@ impl Budget {
         self.max_evaluations
     }
 
-    /// Why a solver must stop now, if it must: deadline first, then the evaluation cap.
+    /// Why a solver must stop now, if it must: cancellation first, then the deadline, then the
+    /// evaluation cap.
     #[must_use]
     pub fn check(&self, evaluations: u64) -> Option<StopReason> {
-        if self.expired() {
+        if self.cancelled() {
+            Some(StopReason::Cancelled)
+        } else if self.expired() {
             Some(StopReason::Deadline)
         } else if self.evaluations_exhausted(evaluations) {
             Some(StopReason::MaxEvaluations)
@@ -112,10 +166,14 @@ pub enum StopReason {
     Stall,
     /// The method is closed-form or finite: it ran to completion.
     Completed,
+    /// The client went away or the service is stopping; the job stopped at its next check.
+    Cancelled,
 }
 
-/// What a solver cost and how it stopped; every heavy endpoint returns one.
+/// What a solver cost and how it stopped; every endpoint with iterative or swept work returns one
+/// as `report` (one shape across the service).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = Report)]
 pub struct SolverReport {
     /// How the solver stopped.
     pub stop_reason: StopReason,
@@ -126,6 +184,9 @@ pub struct SolverReport {
     #[schema(minimum = 0)]
     pub evaluations: u64,
     /// Wall-clock time spent in the solver [ms].
-    #[schema(minimum = 0.0)]
     pub elapsed_ms: f64,
+}
+
+crate::schema_bounds! {
+    SolverReport { elapsed_ms: crate::calc::Range::FINITE.min(0.0) },
 }

@@ -1,7 +1,11 @@
-//! Shared numerics: solver budgets and stop reasons, and (as modules need them) roots, quadrature,
-//! interpolation and seeded random numbers. Pure Rust: no I/O, no async runtime.
+//! Shared numerics: solver budgets and stop reasons, the one parallel map, angle conventions and
+//! the building blocks more than one module needs (roots, small dense linear algebra, grids and
+//! interpolation, seeded random numbers, elliptic integrals). Pure Rust: no I/O, no async runtime.
 
+pub mod angles;
 pub mod budget;
 pub mod elliptic;
+pub mod parallel;
 
 pub use budget::{Budget, SolverReport, StopReason};
+pub use parallel::{par_map, par_map_while};

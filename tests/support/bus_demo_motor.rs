@@ -1,8 +1,7 @@
 //! The spec's demo IPMSM (bus_fuel_economy.md V5) as a model object, and an efficiency map
-//! tabulated from it. Shared by tests/paper_bus_fuel_economy.rs and benches/bus_fuel_economy.rs
-//! and tests/props_bus_fuel_economy.rs (each includes this file with `#[path]`), so they check and
+//! tabulated from it. Shared by tests/it/paper_bus_fuel_economy.rs and benches/bus_fuel_economy.rs
+//! and tests/slow/props_bus_fuel_economy.rs (each includes this file with `#[path]`), so they check and
 //! time the same motor.
-#![allow(dead_code)]
 
 use mechcalc::calc::bus_fuel_economy::ac_factor::{AcFactor, Dowell};
 use mechcalc::calc::bus_fuel_economy::ipmsm::{

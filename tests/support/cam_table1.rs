@@ -1,7 +1,6 @@
 //! The spec's Table-1 cam-law case (cam_law_fit.md §5.2/§8: non-zero end rates, all seven
 //! segments non-empty), shared by the cam-law tests and benches (each includes this file with
 //! `#[path]`) so they evaluate, fit and time the same law.
-#![allow(dead_code)]
 
 use mechcalc::calc::cam_law::law::BoundaryConditions;
 

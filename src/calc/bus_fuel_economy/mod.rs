@@ -31,7 +31,7 @@
 //!   [1 ms, 60 s], gear ratio ≥ 0.01, gear / inverter / battery / constant-motor efficiency ≥ 0.01,
 //!   efficiency-map values ≥ 1e-6, IPMSM inductances ≤ 1 H and ψ_m ≤ 100 Wb; ≤ 200 000 samples
 //!   per cycle, ≤ 10⁶ intervals after sub-stepping, ≤ 250 000 map points, ≤ 100 000 histogram bins.
-//! * Achieved error against the spec's reference implementation (tests/paper_bus_fuel_economy.rs):
+//! * Achieved error against the spec's reference implementation (tests/it/paper_bus_fuel_economy.rs):
 //!   the lossless identity E_in = road-load energy to 1e-9 (V2); every printed reference value
 //!   (V2-V5, V9: FE, energies, distances, brake energy, SOC) within 5e-7 relative, i.e. at its
 //!   6-digit print; envelope counts exact; the demo IPMSM's envelope, loss points and k_AC (V5)

@@ -18,6 +18,7 @@ use crate::numerics::SolverReport;
 
 /// Drive-cycle energy and fuel economy of a battery-electric bus for 1..8 motors over 1..16 cycles.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::BusFuelEconomyRequest)]
 #[serde(deny_unknown_fields)]
 pub struct BusFuelEconomyRequest {
     /// Vehicle (defaults: the paper's 12 m bus, Tables 2-3).
@@ -40,6 +41,7 @@ pub struct BusFuelEconomyRequest {
 
 /// Vehicle of the backward longitudinal model (§3.1, paper eq. 4-5).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::VehicleSpec)]
 #[serde(deny_unknown_fields, default)]
 pub struct VehicleSpec {
     /// Curb mass [kg].
@@ -109,6 +111,7 @@ impl Default for VehicleSpec {
 
 /// Inverter (§3.2).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::InverterSpec)]
 #[serde(deny_unknown_fields, default)]
 pub struct InverterSpec {
     /// Inverter efficiency η_Inv [-], applied in both power directions (service minimum 0.01).
@@ -124,6 +127,7 @@ impl Default for InverterSpec {
 
 /// Battery model selector (§3.3).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::BatteryModel)]
 #[serde(rename_all = "snake_case")]
 pub enum BatteryModel {
     /// Constant efficiency η_Bat in both directions.
@@ -136,6 +140,7 @@ pub enum BatteryModel {
 
 /// Battery (§3.3). Fields of the other model are rejected.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::BatterySpec)]
 #[serde(deny_unknown_fields)]
 pub struct BatterySpec {
     /// `constant` (default) or `ecm_2rc`.
@@ -176,6 +181,7 @@ pub struct BatterySpec {
 
 /// A drive cycle: a built-in name or a custom trace (§3.4).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::CycleSpec)]
 #[serde(untagged)]
 pub enum CycleSpec {
     /// Built-in cycle: `manhattan`, `hwfet` or `hdudds`.
@@ -187,6 +193,7 @@ pub enum CycleSpec {
 /// A custom speed trace: 2..200 000 samples, time steps in [0.001, 60] s, speeds in [0, 200] m/s.
 /// Give exactly one of `speed_kmh` and `speed_mps`.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::CustomCycle)]
 #[serde(deny_unknown_fields)]
 pub struct CustomCycle {
     /// Cycle name (unique in the request, 1..64 characters).
@@ -203,6 +210,7 @@ pub struct CustomCycle {
 
 /// Torque envelope given as a table: T_max linear in speed, held constant outside the table.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::EnvelopeTable)]
 #[serde(deny_unknown_fields)]
 pub struct EnvelopeTable {
     /// Speeds [rpm], strictly increasing, first ≥ 0.
@@ -213,6 +221,7 @@ pub struct EnvelopeTable {
 
 /// Traction motor (§3.5), selected by `model`.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::MotorSpec)]
 #[serde(tag = "model", rename_all = "snake_case")]
 pub enum MotorSpec {
     /// Constant efficiency η_M.
@@ -240,6 +249,7 @@ impl MotorSpec {
 
 /// Constant-efficiency motor with a torque/power envelope.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::ConstantMotor)]
 #[serde(deny_unknown_fields)]
 pub struct ConstantMotor {
     /// Motor name (unique in the request, 1..64 characters).
@@ -263,6 +273,7 @@ pub struct ConstantMotor {
 
 /// Motor given by an efficiency map (motoring, optional generating table).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::EfficiencyMapMotor)]
 #[serde(deny_unknown_fields)]
 pub struct EfficiencyMapMotor {
     /// Motor name (unique in the request, 1..64 characters).
@@ -288,6 +299,7 @@ pub struct EfficiencyMapMotor {
 
 /// Motor given by a total-loss map.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::LossMapMotor)]
 #[serde(deny_unknown_fields)]
 pub struct LossMapMotor {
     /// Motor name (unique in the request, 1..64 characters).
@@ -311,6 +323,7 @@ pub struct LossMapMotor {
 
 /// Back-EMF measurement from which ψ_m is derived: ψ_m = V_peak_phase / (p·2π·at_rpm/60).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::BackEmf)]
 #[serde(deny_unknown_fields)]
 pub struct BackEmf {
     /// Peak phase back-EMF [V].
@@ -323,6 +336,7 @@ pub struct BackEmf {
 
 /// AC resistance factor k_AC(f_e, T_w) of the winding (§5.5 item 4).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::AcFactorSpec)]
 #[serde(tag = "model", rename_all = "snake_case")]
 pub enum AcFactorSpec {
     /// k_AC = 1.
@@ -336,11 +350,13 @@ pub enum AcFactorSpec {
 
 /// No AC effect (k_AC = 1).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::NoAcFactor)]
 #[serde(deny_unknown_fields)]
 pub struct NoAcFactor {}
 
 /// k_AC table.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::AcFactorTable)]
 #[serde(deny_unknown_fields)]
 pub struct AcFactorTable {
     /// Electrical frequencies [Hz], strictly increasing, ≥ 0.
@@ -351,6 +367,7 @@ pub struct AcFactorTable {
 
 /// Dowell parameters (rectangular conductors in layers).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::DowellSpec)]
 #[serde(deny_unknown_fields)]
 pub struct DowellSpec {
     /// Conductor height h in the slot-depth direction [m].
@@ -372,6 +389,7 @@ pub struct DowellSpec {
 
 /// Iron loss P_fe = (k_h ω_e + k_e ω_e²)·|ψ|².
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::IronSpec)]
 #[serde(deny_unknown_fields, default)]
 pub struct IronSpec {
     /// Hysteresis coefficient k_h [W/(Wb²·rad/s)] (≥ 0).
@@ -384,6 +402,7 @@ pub struct IronSpec {
 
 /// Mechanical loss P_mech = c_fric ω_m + c_wind ω_m³.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::MechSpec)]
 #[serde(deny_unknown_fields, default)]
 pub struct MechSpec {
     /// Friction torque [N·m] (≥ 0).
@@ -396,6 +415,7 @@ pub struct MechSpec {
 
 /// Parametric IPMSM (amplitude-invariant dq model, peak values; §5.5 item 4).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::IpmsmMotor)]
 #[serde(deny_unknown_fields)]
 pub struct IpmsmMotor {
     /// Motor name (unique in the request, 1..64 characters).
@@ -456,6 +476,7 @@ pub struct IpmsmMotor {
 
 /// Handling of traction demand above the motor envelope (§5.4).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::Mode)]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
     /// Follow the trace exactly; losses evaluated at the envelope; exceedances counted.
@@ -469,6 +490,7 @@ pub enum Mode {
 
 /// Motor terminal power convention (§5.6).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::PowerConvention)]
 #[serde(rename_all = "snake_case")]
 pub enum PowerConvention {
     /// Paper eq. 2-3: P_el = P_m/η motoring, P_m·η generating, 0 at zero power.
@@ -480,6 +502,7 @@ pub enum PowerConvention {
 
 /// How an `ipmsm` motor's loss is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::MotorEval)]
 #[serde(rename_all = "snake_case")]
 pub enum MotorEval {
     /// Solve the dq operating point at every interval (accuracy reference).
@@ -490,6 +513,7 @@ pub enum MotorEval {
 
 /// Optional, costly outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::OutputKind)]
 #[serde(rename_all = "snake_case")]
 pub enum OutputKind {
     /// Energy per loss mechanism and mean motor efficiency.
@@ -504,6 +528,7 @@ pub enum OutputKind {
 
 /// Grid of a precomputed loss / efficiency map.
 #[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::GridSpec)]
 #[serde(deny_unknown_fields)]
 pub struct GridSpec {
     /// Speed step [rpm].
@@ -525,6 +550,7 @@ impl Default for GridSpec {
 
 /// Bins of the operating-point histogram.
 #[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::HistogramSpec)]
 #[serde(deny_unknown_fields)]
 pub struct HistogramSpec {
     /// Speed bin width [rpm].
@@ -546,6 +572,7 @@ impl Default for HistogramSpec {
 
 /// Simulation options (§3.6).
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::OptionsSpec)]
 #[serde(deny_unknown_fields)]
 pub struct OptionsSpec {
     /// Envelope policy: `backward` (default), `clip` or `forward`.
@@ -614,6 +641,7 @@ impl Default for OptionsSpec {
 
 /// Result of `POST /v1/bus-fuel-economy`.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::BusFuelEconomyResponse)]
 pub struct BusFuelEconomyResponse {
     /// One entry per motor × cycle (motor-major, request order).
     pub results: Vec<CycleResult>,
@@ -633,6 +661,7 @@ pub struct BusFuelEconomyResponse {
 
 /// Result of one motor over one cycle (§6).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::CycleResult)]
 pub struct CycleResult {
     /// Motor id.
     pub motor: String,
@@ -699,6 +728,7 @@ pub struct CycleResult {
 /// Energy per mechanism over the cycle [kWh]. Closure: energy_in = wheel + gear + friction brakes
 /// + motor_charged + inverter + battery + aux (to rounding).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::LossBreakdown)]
 pub struct LossBreakdown {
     /// Net energy at the wheels Σ F·v̄·Δt (road load plus net kinetic/potential change) [kWh].
     pub wheel_kwh: f64,
@@ -733,6 +763,7 @@ pub struct LossBreakdown {
 
 /// Time share of moving intervals per (speed, torque) bin, Fig. 15 style.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::OpHistogram)]
 pub struct OpHistogram {
     /// Speed bin edges [rpm] (from 0).
     pub speed_edges_rpm: Vec<f64>,
@@ -748,6 +779,7 @@ pub struct OpHistogram {
 
 /// The histogram's modal bin.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::ModalBin)]
 pub struct ModalBin {
     /// Speed range [rpm].
     pub rpm: [f64; 2],
@@ -759,6 +791,7 @@ pub struct ModalBin {
 
 /// Per-interval traces (arrays of equal length).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::Traces)]
 pub struct Traces {
     /// Interval start time [s].
     pub t_s: Vec<f64>,
@@ -780,6 +813,7 @@ pub struct Traces {
 
 /// Efficiency map of one motor (η on the grid; null outside the envelope, 0 at zero power).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::MotorMapData)]
 pub struct MotorMapData {
     /// Motor id.
     pub motor: String,
@@ -795,6 +829,7 @@ pub struct MotorMapData {
 
 /// Comparison of the motors (paper eq. 11-13).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::Comparison)]
 pub struct Comparison {
     /// The first motor, reference of `fe_change_pct`.
     pub reference_motor: String,
@@ -810,6 +845,7 @@ pub struct Comparison {
 
 /// Desirability of one motor (eq. 12-13).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::Desirability)]
 pub struct Desirability {
     /// d_i per cycle (in `comparison.cycles` order) [-].
     pub d: Vec<f64>,
@@ -819,6 +855,7 @@ pub struct Desirability {
 
 /// Settings used for the run.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::Echo)]
 pub struct Echo {
     /// Envelope policy.
     pub mode: Mode,
@@ -842,6 +879,7 @@ pub struct Echo {
 
 /// `POST /v1/bus-fuel-economy/motor-map`: envelope, loss and efficiency maps of one motor.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = bus_fuel_economy::MotorMapRequest)]
 #[serde(deny_unknown_fields)]
 pub struct MotorMapRequest {
     /// The motor (any model of the main endpoint).
@@ -856,6 +894,7 @@ pub struct MotorMapRequest {
 
 /// Maps of one motor; values outside the envelope are null.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::MotorMapResponse)]
 pub struct MotorMapResponse {
     /// Motor id.
     pub motor: String,
@@ -881,6 +920,7 @@ pub struct MotorMapResponse {
 
 /// ipmsm loss components on the grid [W] (null outside the envelope).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bus_fuel_economy::LossComponentMaps)]
 pub struct LossComponentMaps {
     /// DC copper loss 1.5 R (i_d² + i_q²).
     pub cu_dc_w: Vec<Vec<Option<f64>>>,

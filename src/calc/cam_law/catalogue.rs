@@ -16,6 +16,7 @@ use super::law::Sample;
 
 /// A named classic motion law of Appendix A.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
+#[schema(as = cam_law::NamedLaw)]
 #[serde(rename_all = "snake_case")]
 pub enum NamedLaw {
     /// Constant velocity `S = x` (infinite acceleration at the ends; outside the 7-segment class).
@@ -48,6 +49,7 @@ pub enum NamedLaw {
 /// Dimensionless peak factors of a normalized law: `max|V|`, `max|A|`, `max|J|` (J excluding
 /// impulses at jumps). `None` means infinite (spec Appendix A table).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law::PeakFactors)]
 pub struct PeakFactors {
     /// `Cv = max|V|`.
     pub cv: f64,

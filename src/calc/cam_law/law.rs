@@ -144,6 +144,7 @@ impl BoundaryConditions {
 
 /// A quantity of the motion law.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
+#[schema(as = cam_law::Quantity)]
 #[serde(rename_all = "lowercase")]
 pub enum Quantity {
     /// Displacement `s` [U].
@@ -189,6 +190,7 @@ impl Sample {
 
 /// A knot `t_k` of the law (start of segment `k`, or `t_b` for `k = 7`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law::Knot)]
 pub struct Knot {
     /// Knot abscissa `t_k` [x].
     pub x: f64,
@@ -204,6 +206,7 @@ pub struct Knot {
 
 /// Exact peaks of the law (spec §3.2, no sampling).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law::Peaks)]
 pub struct Peaks {
     /// Peak of the first acceleration pulse `A1` [U/x²] (paper: A_pos; negative for a fall).
     pub a1: f64,
@@ -222,6 +225,7 @@ pub struct Peaks {
 
 /// An acceleration jump (jerk impulse) at a knot.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law::Jump)]
 pub struct Jump {
     /// Abscissa of the jump [x].
     pub x: f64,

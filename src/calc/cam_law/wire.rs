@@ -15,6 +15,7 @@ pub const MAX_POINTS: usize = 200_000;
 
 /// Request of `POST /v1/cam-law/evaluate`: exactly one of `coefficients` or `law`.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law::EvaluateRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
     "coefficients": [0.0645, 0.129, 0.1935, 0.0968, 0.2581, 0.2258, 0.0323],
@@ -58,6 +59,7 @@ pub struct EvaluateRequest {
 
 /// Boundary conditions (spec §2). Every field is optional.
 #[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law::ConstraintsIn)]
 #[serde(deny_unknown_fields)]
 pub struct ConstraintsIn {
     /// Segment start `t_a` [x]. Default: first abscissa (0 without an abscissa).
@@ -88,6 +90,7 @@ pub struct ConstraintsIn {
 
 /// Sample abscissae: exactly one of `values` or `grid`.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law::AbscissaIn)]
 #[serde(deny_unknown_fields)]
 pub struct AbscissaIn {
     /// Explicit abscissae [x], strictly increasing, 1..200 000 values, all inside
@@ -103,6 +106,7 @@ pub struct AbscissaIn {
 
 /// A uniform grid including both ends.
 #[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[schema(as = cam_law::GridIn)]
 #[serde(deny_unknown_fields)]
 pub struct GridIn {
     /// First abscissa [x].
@@ -118,6 +122,7 @@ pub struct GridIn {
 
 /// Free-text unit labels (not interpreted).
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cam_law::Units)]
 #[serde(deny_unknown_fields)]
 pub struct Units {
     /// Unit of the abscissa, e.g. "s" or "deg" (at most 32 characters).
@@ -149,6 +154,7 @@ impl Units {
 
 /// Warning codes (spec §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cam_law::Warning)]
 #[serde(rename_all = "snake_case")]
 pub enum Warning {
     /// The coefficients did not sum to 1 and were renormalized.
@@ -174,6 +180,7 @@ pub enum Warning {
 /// `v_max_abs = Cv·|Δs|/Δt`, `a_max_abs = Ca·|Δs|/Δt²` (absent: infinite, constant velocity),
 /// `jerk_max_abs_finite = Cj·|Δs|/Δt³` (absent: infinite).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law::PeaksOut)]
 pub struct PeaksOut {
     /// Peak of the first acceleration pulse `A1` [U/x²] (7-segment class only).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -200,6 +207,7 @@ pub struct PeaksOut {
 
 /// Sampled curves at exactly the requested abscissae (same order and length).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law::Curves)]
 pub struct Curves {
     /// Abscissae as given [x].
     pub x: Vec<f64>,
@@ -219,6 +227,7 @@ pub struct Curves {
 
 /// Response of `POST /v1/cam-law/evaluate` (spec §8b; law description as in §4).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law::EvaluateResponse)]
 pub struct EvaluateResponse {
     /// The named law evaluated, when the request gave `law`.
     #[serde(skip_serializing_if = "Option::is_none")]

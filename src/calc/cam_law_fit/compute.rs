@@ -550,7 +550,7 @@ pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, F
     let cap = budget
         .max_evaluations()
         .map_or(input.max_evaluations, |m| m.min(input.max_evaluations));
-    let run_budget = budget.with_max_evaluations(cap);
+    let run_budget = budget.clone().with_max_evaluations(cap);
     let fit_idx = channel_index(input.fit_on);
     // Validation guarantees the fit channel exists (supplied or derived).
     let data: &[f64] = input.channels[fit_idx].as_deref().unwrap_or(&[]);

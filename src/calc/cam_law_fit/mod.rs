@@ -19,7 +19,7 @@
 //! * Input range: 8..200 000 samples, strictly increasing abscissae inside `[t_a, t_b]` (±1e-9·Δt,
 //!   clamped), finite values of magnitude ≤ 1e12, budgets 1..10⁷ evaluations and 1..600 000 ms,
 //!   cost estimate `max_evaluations·N·(2w+1)` ≤ 2·10¹⁰ cell operations.
-//! * Achieved error (tests/paper_cam_law_fit.rs, benches/RESULTS.md): `auto` recovers every
+//! * Achieved error (tests/it/paper_cam_law_fit.rs, benches/RESULTS.md): `auto` recovers every
 //!   Table-3 law from noiseless samples (N = 300, acceleration and velocity, EN and DTW) to
 //!   ≤ 5e-14 coefficient error in 45–210 evaluations (0.4–1.7 ms on one core); the Table-1 law
 //!   with end rates to ≤ 1e-14 from any channel; the polynomial laws to the spec's best-known

@@ -22,6 +22,7 @@ pub const MAX_CURVE_COUNT: u64 = 100_000;
 /// Request of `POST /v1/fit-cam-law`: identify the 7 duration coefficients of the general
 /// modified-trapezoidal law from sampled motion of one segment (spec §2).
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::FitCamLawRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
     "abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": 8}},
@@ -83,6 +84,7 @@ pub struct FitCamLawRequest {
 
 /// Sample abscissae [x]: exactly one of `values` or `grid`.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::FitAbscissa)]
 #[serde(deny_unknown_fields)]
 pub struct FitAbscissa {
     /// Explicit abscissae [x]: strictly increasing, finite, 8..200 000 values, inside
@@ -98,6 +100,7 @@ pub struct FitAbscissa {
 
 /// A uniform grid including both ends.
 #[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::FitGrid)]
 #[serde(deny_unknown_fields)]
 pub struct FitGrid {
     /// First abscissa [x].
@@ -113,6 +116,7 @@ pub struct FitGrid {
 
 /// Measured channels, each of length N (same as the abscissa).
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::Channels)]
 #[serde(deny_unknown_fields)]
 pub struct Channels {
     /// Displacement samples `s_k` [U].
@@ -128,6 +132,7 @@ pub struct Channels {
 
 /// A measured quantity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::FitQuantity)]
 #[serde(rename_all = "snake_case")]
 pub enum FitQuantity {
     /// Displacement `s` [U].
@@ -140,6 +145,7 @@ pub enum FitQuantity {
 
 /// Boundary conditions of the segment (spec §2). Every field is optional.
 #[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::FitConstraints)]
 #[serde(deny_unknown_fields)]
 pub struct FitConstraints {
     /// Segment start `t_a` [x]. Default: first abscissa.
@@ -172,6 +178,7 @@ pub struct FitConstraints {
 
 /// Distance between model and data (spec §3.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::MetricName)]
 #[serde(rename_all = "snake_case")]
 pub enum MetricName {
     /// `sqrt(Σ(ŷ_k − y_k)²)` (paper Eq. 7), not divided by N.
@@ -184,6 +191,7 @@ pub enum MetricName {
 
 /// Objective settings.
 #[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::ObjectiveIn)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectiveIn {
     /// `euclidean` (default) or `dtw`.
@@ -198,6 +206,7 @@ pub struct ObjectiveIn {
 
 /// Optimizer (spec §3.5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::Method)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
     /// Deterministic multi-start least squares with zero-snapping (+ CMA-ES polish and IPOP
@@ -216,6 +225,7 @@ pub enum Method {
 
 /// Optimizer settings and budgets.
 #[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::OptimizerIn)]
 #[serde(deny_unknown_fields)]
 pub struct OptimizerIn {
     /// Method (default `auto`).
@@ -254,6 +264,7 @@ pub struct OptimizerIn {
 
 /// GA settings (paper Table 2; spec §3.5.1). Every field is optional.
 #[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::GaIn)]
 #[serde(deny_unknown_fields)]
 pub struct GaIn {
     /// Individuals per generation, 4..10 000 (paper 100).
@@ -291,6 +302,7 @@ pub struct GaIn {
 
 /// Optional outputs (spec §4).
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::OutputsIn)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsIn {
     /// Dense curves of the fitted law (default none).
@@ -310,6 +322,7 @@ pub struct OutputsIn {
 
 /// Dense-curve request.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = cam_law_fit::CurvesIn)]
 #[serde(deny_unknown_fields)]
 pub struct CurvesIn {
     /// Number of uniformly spaced points over `[t_a, t_b]`, 0..100 000 (0 = none; 1 gives `t_a`).
@@ -323,6 +336,7 @@ pub struct CurvesIn {
 
 /// Response of `POST /v1/fit-cam-law` (spec §4).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::FitCamLawResponse)]
 pub struct FitCamLawResponse {
     /// Identified normalized coefficients `ĉ0..ĉ6` (Σ = 1; paper c1..c7).
     pub coefficients: Vec<f64>,
@@ -363,6 +377,7 @@ pub struct FitCamLawResponse {
 
 /// Objective values (spec §3.6).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::ObjectiveOut)]
 pub struct ObjectiveOut {
     /// Metric used.
     pub metric: MetricName,
@@ -379,6 +394,7 @@ pub struct ObjectiveOut {
 
 /// EN and DTW of one channel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::ChannelErrors)]
 pub struct ChannelErrors {
     /// Euclidean norm of the difference [channel unit].
     pub euclidean: f64,
@@ -388,6 +404,7 @@ pub struct ChannelErrors {
 
 /// Errors of the fitted law per channel (paper Tables 5, 7, 9).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::ErrorTable)]
 pub struct ErrorTable {
     /// Displacement errors [U] (when the channel was supplied).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -405,6 +422,7 @@ pub struct ErrorTable {
 
 /// Nearest catalogue law by `max_k |ĉ_k − c_ref,k|` (spec §3.6).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::Classification)]
 pub struct Classification {
     /// Paper id and name, e.g. "L5 modified trapezoid".
     #[schema(example = "L5 modified trapezoid")]
@@ -415,6 +433,7 @@ pub struct Classification {
 
 /// How the optimizer ran (spec §4).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cam_law_fit::OptimizerReport)]
 pub struct OptimizerReport {
     /// Method used.
     pub method: Method,

@@ -32,7 +32,7 @@
 //!   in a frame normalised by an exact power of two (tested from 1e-90 to 1e90).
 //! * Geometry (C, cognate lengths, ranges, toggles, pose map, timing) is closed form and exact to
 //!   rounding: the spec's Table-1 and closed-form cases agree with an independent recomputation to
-//!   1e-12 and with the spec's printed 6-decimal values (tests/paper_cognates.rs).
+//!   1e-12 and with the spec's printed 6-decimal values (tests/it/paper_cognates.rs).
 //! * The cognates trace the original's points: constraint residuals ≤ 1e-13·L and independent
 //!   re-solve ≤ 1e-12·L where the cognate is away from its toggles (h/b ≥ 1e-2) on 3 000 random
 //!   linkages over 6 decades of scale; toward a toggle the re-solve is ill-conditioned (error

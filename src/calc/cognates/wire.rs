@@ -51,7 +51,11 @@ impl utoipa::PartialSchema for WireSign {
     }
 }
 
-impl ToSchema for WireSign {}
+impl ToSchema for WireSign {
+    fn name() -> std::borrow::Cow<'static, str> {
+        std::borrow::Cow::Borrowed("cognates.WireSign")
+    }
+}
 
 // ---------------------------------------------------------------------------------------------
 // Request
@@ -61,6 +65,7 @@ impl ToSchema for WireSign {}
 /// (`ground`, `crank`, `coupler`, `rocker`, `coupler_point`) or by one drawn configuration
 /// (`joints`), plus an optional snapshot input angle and the optional outputs in `options`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::CognatesRequest)]
 #[serde(deny_unknown_fields)]
 pub struct CognatesRequest {
     /// Ground pivots: `{A, B}` or `{A, length, angle_deg}` (dimension mode).
@@ -107,6 +112,7 @@ pub struct CognatesRequest {
 
 /// Ground pivots. `A` defaults to `[0, 0]`; give either `B` or `length` (with `angle_deg`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::GroundSpec)]
 #[serde(deny_unknown_fields)]
 pub struct GroundSpec {
     /// Input pivot A [length], default `[0, 0]`.
@@ -129,6 +135,7 @@ pub struct GroundSpec {
 
 /// Coupler point P, rigidly attached to the coupler, in exactly one of three forms.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::CouplerPoint)]
 #[serde(try_from = "CouplerPointRaw", untagged)]
 pub enum CouplerPoint {
     /// Paper form: distances to the coupler joints and the side.
@@ -210,6 +217,7 @@ impl TryFrom<CouplerPointRaw> for CouplerPoint {
 
 /// One drawn configuration (joints mode).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::JointsSpec)]
 #[serde(deny_unknown_fields)]
 pub struct JointsSpec {
     /// Input pivot A [length].
@@ -236,6 +244,7 @@ pub struct JointsSpec {
 
 /// Reference of `input_angle_deg`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::AngleReference)]
 #[serde(rename_all = "snake_case")]
 pub enum AngleReference {
     /// θ2, from the +x axis.
@@ -247,6 +256,7 @@ pub enum AngleReference {
 
 /// Sample spacing on limited-range circuits.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::Spacing)]
 #[serde(rename_all = "snake_case")]
 pub enum Spacing {
     /// Cosine spacing on limited-range circuits, uniform on full-rotation ones (O(N⁻²) chord error).
@@ -258,6 +268,7 @@ pub enum Spacing {
 
 /// How curves are traced.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::CurveMode)]
 #[serde(rename_all = "snake_case")]
 pub enum CurveMode {
     /// Closed circuits, switching branch at toggles (the whole curve).
@@ -269,6 +280,7 @@ pub enum CurveMode {
 
 /// A verification method (spec §4.9).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::VerifyKind)]
 #[serde(rename_all = "snake_case")]
 pub enum VerifyKind {
     /// Map every original sample to the cognates; constraint residuals and independent re-solve.
@@ -281,6 +293,7 @@ pub enum VerifyKind {
 
 /// Optional outputs (off by default, computed only when asked) and accuracy knobs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+#[schema(as = cognates::CognatesOptions)]
 #[serde(deny_unknown_fields, default)]
 pub struct CognatesOptions {
     /// Return sampled coupler curves of all three mechanisms.
@@ -327,6 +340,7 @@ impl Default for CognatesOptions {
 
 /// Response of `POST /v1/cognates`.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::CognatesResponse)]
 pub struct CognatesResponse {
     /// Third ground pivot C = A + k·(B − A) [length].
     #[serde(rename = "C")]
@@ -352,6 +366,7 @@ pub struct CognatesResponse {
 
 /// Ground triangle A-B-C similar to the coupler triangle D-E-P (A↔D, B↔E, C↔P).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::Similarity)]
 pub struct Similarity {
     /// |AC|/|AB| = d/b.
     #[serde(rename = "ratio_AC_AB")]
@@ -369,6 +384,7 @@ pub struct Similarity {
 
 /// Which member of the family.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::MechanismId)]
 #[serde(rename_all = "snake_case")]
 pub enum MechanismId {
     /// The given four-bar.
@@ -381,6 +397,7 @@ pub enum MechanismId {
 
 /// One four-bar of the family.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::MechanismOut)]
 pub struct MechanismOut {
     /// Which member.
     pub id: MechanismId,
@@ -420,6 +437,7 @@ pub struct MechanismOut {
 
 /// Link lengths by physical role [length].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::Links)]
 pub struct Links {
     /// Ground |O_out − O_in|.
     pub ground: f64,
@@ -446,6 +464,7 @@ pub struct Links {
 
 /// Coupler-triangle sides in similarity order (b_i : d_i : e_i = b : d : e) [length].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::SimilarSides)]
 pub struct SimilarSides {
     /// Side similar to the original coupler b.
     pub b: f64,
@@ -457,6 +476,7 @@ pub struct SimilarSides {
 
 /// Grashof class.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::GrashofClassOut)]
 #[serde(rename_all = "snake_case")]
 pub enum GrashofClassOut {
     /// s + l < p + q.
@@ -469,6 +489,7 @@ pub enum GrashofClassOut {
 
 /// Four-bar type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::LinkageTypeOut)]
 #[serde(rename_all = "snake_case")]
 pub enum LinkageTypeOut {
     /// Ground shortest (drag link).
@@ -487,6 +508,7 @@ pub enum LinkageTypeOut {
 
 /// Link role.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::LinkRoleOut)]
 #[serde(rename_all = "snake_case")]
 pub enum LinkRoleOut {
     /// Ground.
@@ -501,6 +523,7 @@ pub enum LinkRoleOut {
 
 /// Special shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::SpecialOut)]
 #[serde(rename_all = "snake_case")]
 pub enum SpecialOut {
     /// a = c, b = g.
@@ -513,6 +536,7 @@ pub enum SpecialOut {
 
 /// Grashof/Barker classification (spec §4.2).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::GrashofOut)]
 pub struct GrashofOut {
     /// Class.
     pub class: GrashofClassOut,
@@ -541,6 +565,7 @@ pub struct GrashofOut {
 
 /// Feasible input range (spec §4.3).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::InputRangeOut)]
 pub struct InputRangeOut {
     /// Intervals of φ relative to the own ground line [deg]; an interval through 180° ends above 180.
     #[schema(value_type = Vec<[f64; 2]>)]
@@ -558,6 +583,7 @@ pub struct InputRangeOut {
 
 /// Link of the original that a cognate link turns with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::OriginalLink)]
 pub enum OriginalLink {
     /// The original crank.
     #[serde(rename = "original.crank")]
@@ -572,6 +598,7 @@ pub enum OriginalLink {
 
 /// A cognate link turns with an original link at a constant angular offset.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::TurnsWith)]
 pub struct TurnsWith {
     /// The original link.
     pub turns_with: OriginalLink,
@@ -581,6 +608,7 @@ pub struct TurnsWith {
 
 /// Rotation (timing) map of a cognate (spec §4.7).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::RotationMap)]
 pub struct RotationMap {
     /// Cognate crank.
     pub crank: TurnsWith,
@@ -595,6 +623,7 @@ pub struct RotationMap {
 
 /// Status of a snapshot configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::SnapshotStatus)]
 #[serde(rename_all = "snake_case")]
 pub enum SnapshotStatus {
     /// Assembled.
@@ -609,6 +638,7 @@ pub enum SnapshotStatus {
 
 /// Joint positions of one configuration [length].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::JointsOut)]
 pub struct JointsOut {
     /// Input pivot.
     #[schema(value_type = [f64; 2])]
@@ -630,6 +660,7 @@ pub struct JointsOut {
 
 /// The snapshot configuration as seen by one mechanism (spec §4.4, §4.6).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::SnapshotOut)]
 pub struct SnapshotOut {
     /// Status of this mechanism's own input at this pose.
     pub status: SnapshotStatus,
@@ -657,6 +688,7 @@ pub struct SnapshotOut {
 
 /// One sampled circuit (or fixed-branch sweep) of a coupler curve.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::CurveOut)]
 pub struct CurveOut {
     /// Whether the polyline closes on itself (last point connects to the first).
     pub closed: bool,
@@ -682,6 +714,7 @@ fn is_zero(n: &usize) -> bool {
 
 /// Comparison metrics of one mechanism over all its circuits (spec §4.11).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::MetricsOut)]
 pub struct MetricsOut {
     /// ground + crank + coupler + rocker [length].
     pub link_length_sum: f64,
@@ -705,6 +738,7 @@ pub struct MetricsOut {
 
 /// Axis-aligned bounding box [length].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::Footprint)]
 pub struct Footprint {
     /// Lower-left corner.
     #[schema(value_type = [f64; 2])]
@@ -722,6 +756,7 @@ pub struct Footprint {
 
 /// Numerical certificate (spec §4.9); every distance in the caller's length unit.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::Verification)]
 pub struct Verification {
     /// Pose-map check (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -739,6 +774,7 @@ pub struct Verification {
 
 /// `sync`: every original sample mapped to the cognates (spec §4.9).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::SyncCheck)]
 pub struct SyncCheck {
     /// Largest |P_i − P| of the independent re-solve of each cognate at its own input and branch.
     pub max_dev: f64,
@@ -759,6 +795,7 @@ pub struct SyncCheck {
 
 /// `implicit`: the cognates' own traced points on the original's coupler-curve sextic.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::ImplicitCheck)]
 pub struct ImplicitCheck {
     /// Largest distance estimate |F|/|∇F|.
     pub max_dist: f64,
@@ -772,6 +809,7 @@ pub struct ImplicitCheck {
 
 /// `hausdorff`: symmetric Hausdorff distance between the traced polylines (vertex to segment).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::HausdorffCheck)]
 pub struct HausdorffCheck {
     /// Original vs cognate 1 (absent when a curve has no points).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -791,6 +829,7 @@ pub struct HausdorffCheck {
 
 /// A 1:1 geared five-bar that traces the same curve (spec §4.10).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::GearedFiveBar)]
 pub struct GearedFiveBar {
     /// Pivot names, e.g. `["A", "C"]`.
     pub pivot_names: [String; 2],
@@ -817,6 +856,7 @@ pub struct GearedFiveBar {
 
 /// A geared five-bar in the snapshot configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::FiveBarSnapshot)]
 pub struct FiveBarSnapshot {
     /// Crank 1 angle [deg].
     pub crank1_angle_deg: f64,
@@ -838,6 +878,7 @@ pub struct FiveBarSnapshot {
 
 /// A warning code (spec §5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = cognates::WarningCode)]
 #[serde(rename_all = "snake_case")]
 pub enum WarningCode {
     /// Grashof equality within tolerance: folded configurations, ambiguous branches.
@@ -862,6 +903,7 @@ pub enum WarningCode {
 
 /// A warning about fragile or special geometry.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::Warning)]
 pub struct Warning {
     /// Stable code.
     pub code: WarningCode,
@@ -879,6 +921,7 @@ pub struct Warning {
 
 /// Cost of the request.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[schema(as = cognates::Meta)]
 pub struct Meta {
     /// Curve points returned (all mechanisms).
     pub points_total: usize,

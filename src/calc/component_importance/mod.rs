@@ -36,7 +36,7 @@
 //! # Validity and accuracy
 //! * Input range: 2–2000 components, ≥ 1 edge, 1–1000 times > 0 h, β ∈ [0.05, 20], K ∈ 1..8.
 //!   Hours and 1/h are kept inside: fp² is not invariant to the unit of RI (spec §6 H4).
-//! * Paper graph (`tests/paper_component_importance.rs`): Table 1 betweenness exact, Table 2 T
+//! * Paper graph (`tests/it/paper_component_importance.rs`): Table 1 betweenness exact, Table 2 T
 //!   and Eqs. 21–22 to their 6 printed decimals, RI of Table 6 to its printed digits (M aside,
 //!   §3.11-5); the spec's reference values (VC1–VC6, 9 printed decimals) to 1e-9 relative or
 //!   5e-10 absolute; paper Tables 7–9 within the documented deviations of the paper (fp² 5.5e-7,

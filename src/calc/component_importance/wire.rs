@@ -11,6 +11,7 @@ use crate::numerics::SolverReport;
 
 /// Request: one fault graph, one or more operating ages.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::ComponentImportanceRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
     "components": [
@@ -50,6 +51,7 @@ pub struct ComponentImportanceRequest {
 
 /// One component (node of the fault graph).
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::ComponentSpec)]
 #[serde(deny_unknown_fields)]
 pub struct ComponentSpec {
     /// Unique label, 1–64 characters.
@@ -81,6 +83,7 @@ pub struct ComponentSpec {
 
 /// Weibull parameters.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::Weibull)]
 #[serde(deny_unknown_fields)]
 pub struct Weibull {
     /// Scale η [h] (same unit as `times_h`); finite, > 0.
@@ -93,6 +96,7 @@ pub struct Weibull {
 
 /// One failure mode of a component (paper Table 5).
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::FailureMode)]
 #[serde(deny_unknown_fields)]
 pub struct FailureMode {
     /// α: share of this mode among the component's faults [–], in [0, 1].
@@ -105,6 +109,7 @@ pub struct FailureMode {
 
 /// Replacements of F_i(t) and RI_i(t) at one time (keys are component ids).
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::TimeOverride)]
 #[serde(deny_unknown_fields)]
 pub struct TimeOverride {
     /// The time [h]; must be one of `times_h`.
@@ -120,6 +125,7 @@ pub struct TimeOverride {
 /// Constant weights ω_c of the two indices: a pair `[ω_c¹, ω_c²]` (probability, risk) or the
 /// entropy mode `{subjective: [w1, w2], entropy_at_h: t0}` (ω_c = ½(ω_subj + ω_entropy(t0))).
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::ConstantWeights)]
 #[serde(untagged)]
 pub enum ConstantWeights {
     /// `[ω_c¹, ω_c²]`, each > 0, sum 1.
@@ -136,6 +142,7 @@ impl Default for ConstantWeights {
 
 /// Entropy-based constant weights (spec §3.9).
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::EntropyWeights)]
 #[serde(deny_unknown_fields)]
 pub struct EntropyWeights {
     /// Subjective (e.g. Delphi) weights `[w1, w2]`, each > 0, sum 1.
@@ -146,6 +153,7 @@ pub struct EntropyWeights {
 
 /// Which simple paths the propagation sum runs over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::PathMethod)]
 #[serde(rename_all = "snake_case")]
 pub enum PathMethod {
     /// Simple paths only (paper); exact.
@@ -157,6 +165,7 @@ pub enum PathMethod {
 
 /// How hierarchy numbers are assigned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::LevelsMode)]
 #[serde(rename_all = "snake_case")]
 pub enum LevelsMode {
     /// ISM levels with sources lifted to level 1 (reproduces paper Table 2).
@@ -168,6 +177,7 @@ pub enum LevelsMode {
 
 /// Which edge betweenness is used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::BetweennessMode)]
 #[serde(rename_all = "snake_case")]
 pub enum BetweennessMode {
     /// All simple paths, own pair excluded (paper Table 1); exponential on cyclic graphs.
@@ -179,6 +189,7 @@ pub enum BetweennessMode {
 
 /// Method options. Every field is optional; the defaults reproduce the paper.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::Options)]
 #[serde(deny_unknown_fields)]
 pub struct Options {
     /// In-degree coefficient Q [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.25.
@@ -246,6 +257,7 @@ impl Default for Options {
 
 /// Optional outputs (off by default except the cheap indices).
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[schema(as = component_importance::Outputs)]
 #[serde(deny_unknown_fields, default)]
 pub struct Outputs {
     /// Return the time-independent structure (B, I, levels, T, Hc, HE): O(n + m) payload.
@@ -271,6 +283,7 @@ impl Default for Outputs {
 
 /// Response.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::ComponentImportanceResponse)]
 pub struct ComponentImportanceResponse {
     /// Component ids in input order (the order of every per-component array).
     pub components: Vec<String>,
@@ -292,6 +305,7 @@ pub struct ComponentImportanceResponse {
 
 /// Results at one time t.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::TimeResult)]
 pub struct TimeResult {
     /// The time t [h].
     pub time_h: f64,
@@ -340,6 +354,7 @@ pub struct TimeResult {
 /// Relative truncation bound ρ^K/(1−ρ) against the K = ∞ walk sum, ρ = max_i Σ_j P_ij;
 /// `null` when ρ ≥ 1 (bound void).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::TailBound)]
 pub struct TailBound {
     /// Bound for the probability index.
     pub probability: Option<f64>,
@@ -349,6 +364,7 @@ pub struct TailBound {
 
 /// A non-fatal finding.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::Warning)]
 pub struct Warning {
     /// Stable code, e.g. `ALPHA_SUM`, `ISOLATED_COMPONENTS`, `TRUNCATION_BOUND_VOID`.
     pub code: String,
@@ -361,6 +377,7 @@ pub struct Warning {
 
 /// Graph facts and cost.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::Meta)]
 pub struct Meta {
     /// Whether the graph is acyclic.
     pub is_dag: bool,
@@ -397,6 +414,7 @@ pub struct Meta {
 
 /// An edge value.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::EdgeValue)]
 pub struct EdgeValue {
     /// Source id.
     pub from: String,
@@ -408,6 +426,7 @@ pub struct EdgeValue {
 
 /// Time-independent structure (spec §4), edges in request order.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::Matrices)]
 pub struct Matrices {
     /// Edge betweenness B_ij (Table 1 for `all_simple_paths`).
     pub edge_betweenness: Vec<EdgeValue>,
@@ -433,6 +452,7 @@ pub struct Matrices {
 
 /// Standard centralities of the unweighted graph (spec §3.10).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::Centralities)]
 pub struct Centralities {
     /// Out-degree.
     pub out_degree: Vec<f64>,
@@ -448,6 +468,7 @@ pub struct Centralities {
 
 /// Kendall τ_b of each centrality against CI (`null` where undefined: a constant vector).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = component_importance::KendallTau)]
 pub struct KendallTau {
     /// τ_b(out-degree, CI).
     pub out_degree: Option<f64>,

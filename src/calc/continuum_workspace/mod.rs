@@ -33,7 +33,7 @@
 //! * Inputs: 2..8 rods on 1..4 linear guides (exactly 2 for sweeps), slender rods (L/d >= 20; 5..20
 //!   warned, < 5 rejected), loads up to `1e4 EI_ref/L_ref^2`. Presets use ASSUMED geometry (the paper
 //!   gives none) and say so in the response.
-//! * Achieved error (tests/paper_continuum_workspace.rs, benches/RESULTS.md): closed-form elastica
+//! * Achieved error (tests/it/paper_continuum_workspace.rs, benches/RESULTS.md): closed-form elastica
 //!   (with the branch fix) vs RK4 shooting agree to 1.6e-12 L on 60 random rods (spec: 1e-9 L);
 //!   FK at the default 32 RK4 steps is 2.8e-8 m, 4.3e-6 deg and 1.1e-5 N from the 4096-step
 //!   reference (error ~ steps^-4; spec 6.2 tolerances 1e-7 m, 1e-5 deg, 1e-4 N, met on all seven
@@ -93,8 +93,8 @@ pub fn run(
 ) -> Result<ContinuumWorkspaceResponse, CalcFailure> {
     let input = Input::try_from(&req)?;
     let budget = match input.time_limit {
-        Some(t) => budget.capped(t),
-        None => *budget,
+        Some(t) => budget.clone().capped(t),
+        None => budget.clone(),
     };
     let out = compute::compute(&input, &budget)?;
     Ok(respond(&input, out, &budget))

@@ -10,6 +10,7 @@ use crate::numerics::SolverReport;
 
 /// What to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::Mode)]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
     /// Forward kinematics at one input.
@@ -22,6 +23,7 @@ pub enum Mode {
 
 /// A named design with ASSUMED geometry (spec 6.2); the response states the geometry.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::PresetName)]
 pub enum PresetName {
     /// Design 1.
     #[serde(rename = "keops_d1")]
@@ -45,6 +47,7 @@ pub enum PresetName {
 
 /// The request.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::ContinuumWorkspaceRequest)]
 #[serde(deny_unknown_fields)]
 pub struct ContinuumWorkspaceRequest {
     /// `fk`, `workspace` or `assembly_modes`.
@@ -89,6 +92,7 @@ pub struct ContinuumWorkspaceRequest {
 /// Mechanism design (spec 3.1): either `preset` alone (optionally with `sigma_allow_pa`) or
 /// `actuators` + `rods`.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::DesignRequest)]
 #[serde(deny_unknown_fields)]
 pub struct DesignRequest {
     /// Named preset with ASSUMED geometry (extension, spec 6.2).
@@ -114,6 +118,7 @@ pub struct DesignRequest {
 
 /// One linear guide.
 #[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::ActuatorRequest)]
 #[serde(deny_unknown_fields)]
 pub struct ActuatorRequest {
     /// Point on the guide `o_j` [m].
@@ -129,6 +134,7 @@ pub struct ActuatorRequest {
 
 /// One rod.
 #[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::RodRequest)]
 #[serde(deny_unknown_fields)]
 pub struct RodRequest {
     /// Index `j(i)` of the actuator carrying the clamp.
@@ -167,6 +173,7 @@ pub struct RodRequest {
 
 /// Dead load on the platform.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::LoadRequest)]
 #[serde(deny_unknown_fields)]
 pub struct LoadRequest {
     /// Force `F` at P [N]; `|F| <= 1e4 EI_ref/L_ref^2`.
@@ -181,6 +188,7 @@ pub struct LoadRequest {
 
 /// Solver settings (spec 3.2).
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::SolverRequest)]
 #[serde(deny_unknown_fields)]
 pub struct SolverRequest {
     /// Base RK4 steps per rod (raised by the load rule of spec 4.1).
@@ -203,6 +211,7 @@ pub struct SolverRequest {
 
 /// Which equilibrium the FK starts from (spec 4.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::StartKind)]
 #[serde(rename_all = "snake_case")]
 pub enum StartKind {
     /// Continue from the stress-free home (mode AM1).
@@ -215,6 +224,7 @@ pub enum StartKind {
 
 /// A solver state for warm starts.
 #[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::SolverState)]
 #[serde(deny_unknown_fields)]
 pub struct SolverState {
     /// Unknown vector `[mb0_1, nbx_1, nby_1, ..., px/L_ref, py/L_ref, theta_EE]` (length 3N+3).
@@ -223,6 +233,7 @@ pub struct SolverState {
 
 /// FK start.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::StartRequest)]
 #[serde(deny_unknown_fields)]
 pub struct StartRequest {
     /// `home` (default), `guess` or `assembly_mode`.
@@ -244,6 +255,7 @@ pub struct StartRequest {
 
 /// Optional FK outputs.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::OutputsRequest)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsRequest {
     /// Run the stability test (spec 4.5).
@@ -262,6 +274,7 @@ pub struct OutputsRequest {
 
 /// Seed of a workspace wave.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::SeedKind)]
 #[serde(rename_all = "snake_case")]
 pub enum SeedKind {
     /// Home continuation to the seed node (default).
@@ -276,6 +289,7 @@ pub enum SeedKind {
 
 /// Seed of the sweep.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::SeedRequest)]
 #[serde(deny_unknown_fields)]
 pub struct SeedRequest {
     /// `home`, `guess`, `assembly_mode` or `all_stable_modes`.
@@ -295,6 +309,7 @@ pub struct SeedRequest {
 
 /// Jump limits of one sub-step.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::JumpLimits)]
 #[serde(deny_unknown_fields)]
 pub struct JumpLimits {
     /// Largest platform rotation per sub-step [deg].
@@ -309,6 +324,7 @@ pub struct JumpLimits {
 
 /// Stability test per node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::StabilityCheckName)]
 #[serde(rename_all = "snake_case")]
 pub enum StabilityCheckName {
     /// Full test (spec 4.5).
@@ -321,6 +337,7 @@ pub enum StabilityCheckName {
 
 /// Rod-crossing limit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::RodCrossing)]
 #[serde(rename_all = "snake_case")]
 pub enum RodCrossing {
     /// Do not check.
@@ -331,6 +348,7 @@ pub enum RodCrossing {
 
 /// Workspace limits.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::WorkspaceLimits)]
 #[serde(deny_unknown_fields)]
 pub struct WorkspaceLimits {
     /// Minimum carriage gap [m] (clamp points of carriage 2 minus those of carriage 1, along guide
@@ -350,6 +368,7 @@ pub struct WorkspaceLimits {
 
 /// Area method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::AreaMethod)]
 #[serde(rename_all = "snake_case")]
 pub enum AreaMethod {
     /// Area of the union of the cell polygons (rasterised; correct for folded maps).
@@ -360,6 +379,7 @@ pub enum AreaMethod {
 
 /// Workspace sweep settings (spec 4.7).
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::WorkspaceRequest)]
 #[serde(deny_unknown_fields)]
 pub struct WorkspaceRequest {
     /// Grid `[n1, n2]`, 2..401 each, n1*n2 <= 40401.
@@ -430,6 +450,7 @@ pub struct WorkspaceRequest {
 
 /// Assembly-mode search settings (spec 4.6).
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[schema(as = continuum_workspace::AssemblyModesRequest)]
 #[serde(deny_unknown_fields)]
 pub struct AssemblyModesRequest {
     /// `N_grid`: psi and |k| grid points per rod; `(2 N_grid)^(2N) <= 1e8` for N rods.
@@ -458,6 +479,7 @@ pub struct AssemblyModesRequest {
 
 /// Assembly-mode search settings actually used.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::ModeSearchOut)]
 pub struct ModeSearchOut {
     /// `N_grid`.
     #[schema(minimum = 1, maximum = 50)]
@@ -474,6 +496,7 @@ pub struct ModeSearchOut {
 
 /// The response: one shape per mode.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::ContinuumWorkspaceResponse)]
 #[serde(untagged)]
 pub enum ContinuumWorkspaceResponse {
     /// mode = fk.
@@ -486,6 +509,7 @@ pub enum ContinuumWorkspaceResponse {
 
 /// Outcome of an FK solve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::FkStatus)]
 #[serde(rename_all = "snake_case")]
 pub enum FkStatus {
     /// Converged and well conditioned.
@@ -498,6 +522,7 @@ pub enum FkStatus {
 
 /// Platform pose.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::PlatformOut)]
 pub struct PlatformOut {
     /// Position of P [m].
     pub position_m: [f64; 2],
@@ -507,6 +532,7 @@ pub struct PlatformOut {
 
 /// Per-rod FK results.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::RodOut)]
 pub struct RodOut {
     /// Rod force `n_i` [N] = force of the platform on the rod tip (omitted when indeterminate).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -525,6 +551,7 @@ pub struct RodOut {
 
 /// Stability of an FK solution.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::StabilityOut)]
 pub struct StabilityOut {
     /// margin > 1e-8.
     pub stable: bool,
@@ -539,6 +566,7 @@ pub struct StabilityOut {
 
 /// FK diagnostics.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::DiagnosticsOut)]
 pub struct DiagnosticsOut {
     /// Newton iterations of the final solve (the total over all continuation steps is in
     /// `report.iterations`).
@@ -559,6 +587,7 @@ pub struct DiagnosticsOut {
 
 /// Preset statement.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::PresetOut)]
 pub struct PresetOut {
     /// Preset name.
     pub name: PresetName,
@@ -577,6 +606,7 @@ pub struct PresetOut {
 
 /// mode = fk.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::FkResponse)]
 pub struct FkResponse {
     /// Always `fk`.
     pub mode: Mode,
@@ -612,6 +642,7 @@ pub struct FkResponse {
 
 /// Joint-space grid.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::GridOut)]
 pub struct GridOut {
     /// `lambda1` values [m].
     pub lambda1_m: Vec<f64>,
@@ -622,6 +653,7 @@ pub struct GridOut {
 /// Per-node arrays, row-major `n1 x n2` (index `i * n2 + j`, `i` over `lambda1`); null where not
 /// accepted.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::NodesOut)]
 pub struct NodesOut {
     /// Status codes.
     pub status: Vec<&'static str>,
@@ -642,6 +674,7 @@ pub struct NodesOut {
 
 /// Workspace metrics of one wave (spec 4.8).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::MetricsOut)]
 pub struct MetricsOut {
     /// Accepted nodes.
     pub n_accepted: u64,
@@ -667,6 +700,7 @@ pub struct MetricsOut {
 
 /// Seed of a wave.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::SeedOut)]
 pub struct SeedOut {
     /// Seed kind.
     pub kind: SeedKind,
@@ -687,6 +721,7 @@ pub struct SeedOut {
 
 /// One wave (one assembly mode).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::WaveOut)]
 pub struct WaveOut {
     /// Seed.
     pub seed: SeedOut,
@@ -702,6 +737,7 @@ pub struct WaveOut {
 
 /// mode = workspace.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::WorkspaceResponse)]
 pub struct WorkspaceResponse {
     /// Always `workspace`.
     pub mode: Mode,
@@ -726,6 +762,7 @@ pub struct WorkspaceResponse {
 
 /// One assembly mode.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::AssemblyModeOut)]
 pub struct AssemblyModeOut {
     /// Platform pose.
     pub pose: PlatformOut,
@@ -746,6 +783,7 @@ pub struct AssemblyModeOut {
 
 /// mode = assembly_modes.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::AssemblyModesResponse)]
 pub struct AssemblyModesResponse {
     /// Always `assembly_modes`.
     pub mode: Mode,

@@ -22,6 +22,7 @@ pub const PROFILE_POINTS_MIN: u32 = 8;
 
 /// A non-fatal warning: stable code and human message.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, ToSchema)]
+#[schema(as = irefc::Warning)]
 pub struct Warning {
     /// Stable code, e.g. `NEAR_UNDERCUT`, `RB_BELOW_PAPER_MIN`, `ROLLING_FRICTION_HIGH`.
     #[schema(example = "RB_BELOW_PAPER_MIN")]
@@ -75,6 +76,7 @@ pub fn geometry_warnings(g: &Geometry) -> Vec<Warning> {
 
 /// Elastic material of a body.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema)]
+#[schema(as = irefc::Material)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
     /// Young's modulus E [MPa].
@@ -124,6 +126,7 @@ impl Material {
 
 /// Profile point sets of both wheels (spec irefc_geometry "profile point sets").
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::Profiles)]
 pub struct Profiles {
     /// Points per wheel.
     pub n_points: u32,
@@ -151,6 +154,7 @@ impl Profiles {
 
 /// Derived geometry (spec irefc_geometry "Outputs"), shared by both endpoints.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::GeometryOut)]
 pub struct GeometryOut {
     /// Eccentricity of each mesh e = r2/Z2 [mm].
     pub e_mm: f64,

@@ -7,6 +7,7 @@ use crate::calc::irefc::wire::{GeometryOut, Warning};
 
 /// Loss model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::EfficiencyModel)]
 #[serde(rename_all = "snake_case")]
 pub enum EfficiencyModel {
     /// The paper's equations exactly as printed (signed slip speed); reproduces its Table 1.
@@ -33,6 +34,7 @@ impl EfficiencyModel {
 
 /// Optional outputs.
 #[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[schema(as = irefc::efficiency::EfficiencyInclude)]
 #[serde(deny_unknown_fields)]
 pub struct EfficiencyInclude {
     /// Per-element table (default true).
@@ -41,6 +43,7 @@ pub struct EfficiencyInclude {
 
 /// Request of `POST /v1/irefc-efficiency`. Configuration: carrier input, crown fixed, cam output.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = irefc::efficiency::IrefcEfficiencyRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"r2_mm":20,"Z2":26,"chi":1.4,"rb_mm":2,"power_W":1500,"speed_rpm":1500,
     "rolling_friction_mm":1.0,"sliding_friction":0.1,"model":"paper_table","phase_deg":0,"n_phase":1,
@@ -92,6 +95,7 @@ pub struct IrefcEfficiencyRequest {
 
 /// One loaded element (efficiency paper Table 1 row).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::EfficiencyElement)]
 pub struct EfficiencyElement {
     /// Element index k (paper row k + 1).
     pub k: u32,
@@ -135,6 +139,7 @@ pub struct EfficiencyElement {
 
 /// Totals over the loaded elements.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::EfficiencyTotals)]
 pub struct EfficiencyTotals {
     /// Σ NS [W].
     #[serde(rename = "NS_total_W")]
@@ -155,6 +160,7 @@ pub struct EfficiencyTotals {
 
 /// Mean, minimum and maximum over the cage phases.
 #[derive(Debug, Clone, Copy, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::Stat)]
 pub struct Stat {
     /// Mean (midpoint rule over the phase).
     pub mean: f64,
@@ -166,6 +172,7 @@ pub struct Stat {
 
 /// Mean, minimum and maximum over the cage phases, null where undefined.
 #[derive(Debug, Clone, Copy, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::NullableStat)]
 pub struct NullableStat {
     /// Mean (midpoint rule over the phase); null when undefined.
     pub mean: Option<f64>,
@@ -177,6 +184,7 @@ pub struct NullableStat {
 
 /// Statistics over `n_phase` equally spaced cage phases (midpoints).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::PhaseStats)]
 pub struct PhaseStats {
     /// Phases evaluated.
     pub n_phase: u32,
@@ -191,6 +199,7 @@ pub struct PhaseStats {
 
 /// Cost.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::EfficiencyMeta)]
 pub struct EfficiencyMeta {
     /// Wall-clock compute time [ms].
     pub compute_ms: f64,
@@ -198,6 +207,7 @@ pub struct EfficiencyMeta {
 
 /// Response of `POST /v1/irefc-efficiency`.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::efficiency::IrefcEfficiencyResponse)]
 pub struct IrefcEfficiencyResponse {
     /// Loss model used.
     pub model: EfficiencyModel,

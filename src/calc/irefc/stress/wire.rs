@@ -8,6 +8,7 @@ use crate::numerics::SolverReport;
 
 /// Single design or the paper's "structured array" sweep.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[schema(as = irefc::stress::StressMode)]
 #[serde(rename_all = "snake_case")]
 pub enum StressMode {
     /// One design (r2, Z2, χ, rb).
@@ -18,6 +19,7 @@ pub enum StressMode {
 
 /// Which link carries the output torque.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[schema(as = irefc::stress::OutputLink)]
 #[serde(rename_all = "snake_case")]
 pub enum OutputLink {
     /// Cam output, crown fixed (T_cam = T_out).
@@ -29,6 +31,7 @@ pub enum OutputLink {
 
 /// How the torque is shared over the elements when an element sits at φ2.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[schema(as = irefc::stress::LoadSharing)]
 #[serde(rename_all = "snake_case")]
 pub enum LoadSharing {
     /// The paper: F(φ2) = Fmax·sin α with Fmax from the phase-0 element set (eqs 16–17).
@@ -51,6 +54,7 @@ impl LoadSharing {
 
 /// Optional outputs; expensive ones are off by default and not computed unless requested.
 #[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[schema(as = irefc::stress::StressInclude)]
 #[serde(deny_unknown_fields)]
 pub struct StressInclude {
     /// Per-element force table of the phase-0 element set (default true; single mode only).
@@ -65,6 +69,7 @@ pub struct StressInclude {
 
 /// Integer range `from..=to` with step 1.
 #[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[schema(as = irefc::stress::IntRange)]
 #[serde(deny_unknown_fields)]
 pub struct IntRange {
     /// First value (inclusive).
@@ -77,6 +82,7 @@ pub struct IntRange {
 
 /// Real range `from, from + step, … ≤ to` (values computed as from + i·step).
 #[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[schema(as = irefc::stress::StepRange)]
 #[serde(deny_unknown_fields)]
 pub struct StepRange {
     /// First value (inclusive).
@@ -92,6 +98,7 @@ pub struct StepRange {
 
 /// The "structured array": ranges of Z2 and χ, optional lists of rb and r2.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = irefc::stress::SweepSpec)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
     /// Number of rolling elements Z2, step 1.
@@ -107,6 +114,7 @@ pub struct SweepSpec {
 
 /// Request of `POST /v1/irefc-stress`.
 #[derive(Debug, Clone, Deserialize, ToSchema)]
+#[schema(as = irefc::stress::IrefcStressRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"mode":"single","r2_mm":20,"Z2":26,"chi":1.4,"rb_mm":2,"lb_mm":4,"torque_Nm":119.366207,
     "output_link":"cam","wheel_material":{"E_MPa":210000,"nu":0.3},"roller_material":{"E_MPa":210000,"nu":0.3},
@@ -172,6 +180,7 @@ pub struct IrefcStressRequest {
 
 /// One element of the phase-0 set (force paper "temporary array").
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::ElementOut)]
 pub struct ElementOut {
     /// Element index k (φ2 = 360k/Z2).
     pub k: u32,
@@ -188,6 +197,7 @@ pub struct ElementOut {
 
 /// The maximum contact stress of one wheel and the state there (spec step 7).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::WheelMax)]
 pub struct WheelMax {
     /// Element angle of the maximum [deg]; null when the torque is zero (no argmax).
     pub phi2_deg: Option<f64>,
@@ -218,6 +228,7 @@ pub struct WheelMax {
 
 /// Maxima of both wheels.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::MaxOut)]
 pub struct MaxOut {
     /// Cam contact (point A).
     pub cam: WheelMax,
@@ -229,6 +240,7 @@ pub struct MaxOut {
 
 /// Curves over the φ2 grid (`include.curves`), thinned by `curves_stride`.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::Curves)]
 pub struct Curves {
     /// Element angle φ2 [deg].
     pub phi2_deg: Vec<f64>,
@@ -249,6 +261,7 @@ pub struct Curves {
 
 /// Settings and cost of a single-design computation.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::StressMeta)]
 pub struct StressMeta {
     /// Requested grid step [deg] (the grid uses 180/n_intervals, n_intervals = round(180/step)).
     pub step_deg: f64,
@@ -267,6 +280,7 @@ pub struct StressMeta {
 
 /// Response of mode "single".
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::StressSingleResponse)]
 pub struct StressSingleResponse {
     /// Always "single".
     pub mode: StressMode,
@@ -308,6 +322,7 @@ pub struct StressSingleResponse {
 
 /// Why a sweep combination has no result.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::Reason)]
 pub struct Reason {
     /// `UNDERCUT`, `ELEMENT_OVERLAP`, `NON_FINITE`, or `NOT_EVALUATED` (budget ran out first).
     pub code: String,
@@ -317,6 +332,7 @@ pub struct Reason {
 
 /// One combination of the sweep (spec "Sweep" record).
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::SweepRecord)]
 pub struct SweepRecord {
     /// Number of rolling elements.
     #[serde(rename = "Z2")]
@@ -373,6 +389,7 @@ pub struct SweepRecord {
 
 /// Settings and cost of a sweep.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::SweepMeta)]
 pub struct SweepMeta {
     /// Requested grid step [deg].
     pub step_deg: f64,
@@ -396,6 +413,7 @@ pub struct SweepMeta {
 
 /// Response of mode "sweep".
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::StressSweepResponse)]
 pub struct StressSweepResponse {
     /// Always "sweep".
     pub mode: StressMode,
@@ -419,6 +437,7 @@ pub struct StressSweepResponse {
 
 /// Response of `POST /v1/irefc-stress`: one of the two shapes, by `mode`.
 #[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = irefc::stress::IrefcStressResponse)]
 #[serde(untagged)]
 pub enum IrefcStressResponse {
     /// Mode "single".

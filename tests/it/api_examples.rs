@@ -3,7 +3,7 @@
 //! `api/examples.json` maps each file to its endpoint; a file missing from the list, or a POST
 //! endpoint without an example, fails the test.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 //! endpoint is covered as soon as its example is listed in `api/examples.json` (which
 //! tests/api_examples.rs requires).
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

@@ -2,7 +2,7 @@
 //! gets the right problem+json answer with pointers to the offending fields, and a spent budget
 //! returns the best-so-far with an honest `stop_reason`.
 
-mod common;
+use crate::common;
 
 use common::post_json;
 use serde_json::{Value, json};

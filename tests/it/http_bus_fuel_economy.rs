@@ -2,7 +2,7 @@
 //! optional outputs only on request, and every kind of bad request gets the right problem+json
 //! answer with a pointer to the offending field.
 
-mod common;
+use crate::common;
 
 use common::{post_json, send_to};
 use mechcalc::AppState;

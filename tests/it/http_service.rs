@@ -1,7 +1,7 @@
 //! The service contract shared by every endpoint: discovery, docs, and problem+json for
 //! malformed, mistyped, oversized and misrouted requests.
 
-mod common;
+use crate::common;
 
 use common::{config, get, send, send_to};
 use mechcalc::AppState;

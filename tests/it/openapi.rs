@@ -1,5 +1,5 @@
 //! `openapi.yaml` at the top level is generated from code; this test fails when it drifts.
-//! Regenerate with `MECHCALC_UPDATE_OPENAPI=1 cargo test --test openapi` (or
+//! Regenerate with `MECHCALC_UPDATE_OPENAPI=1 cargo test --test it openapi` (or
 //! `cargo run -- --print-openapi > openapi.yaml`).
 
 use std::path::Path;
@@ -17,7 +17,7 @@ fn openapi_yaml_matches_code() {
     assert!(
         on_disk == generated,
         "openapi.yaml is out of date with the code; regenerate it with \
-         `MECHCALC_UPDATE_OPENAPI=1 cargo test --test openapi` and commit it"
+         `MECHCALC_UPDATE_OPENAPI=1 cargo test --test it openapi` and commit it"
     );
 }
 

@@ -20,8 +20,7 @@ use mechcalc::calc::{CalcFailure, ProblemClass};
 use mechcalc::numerics::Budget;
 use serde_json::{Value, json};
 
-#[path = "support/cam_table1.rs"]
-mod cam_table1;
+use crate::support::cam_table1;
 use cam_table1::TABLE1_BC;
 
 /// Spec §5.2: 1e-9 absolute on s, v, a.

@@ -1,7 +1,7 @@
 //! `POST /v1/cam-law/evaluate` over HTTP: the law comes back, and every kind of bad request gets
 //! the right problem+json answer with a pointer to the offending field.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

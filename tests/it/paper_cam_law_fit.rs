@@ -19,8 +19,7 @@ use mechcalc::calc::cam_law_fit::{self, FitCamLawRequest};
 use mechcalc::numerics::{Budget, StopReason};
 use serde_json::{Value, json};
 
-#[path = "support/cam_table1.rs"]
-mod cam_table1;
+use crate::support::cam_table1;
 use cam_table1::TABLE1_BC;
 
 fn heavy() -> bool {

@@ -2,7 +2,7 @@
 //! the right problem+json answer (400/415/422) with a pointer to the offending field and the
 //! spec's `code`.
 
-mod common;
+use crate::common;
 
 use common::post_json;
 use serde_json::{Value, json};

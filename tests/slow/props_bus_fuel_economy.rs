@@ -11,8 +11,7 @@ use mechcalc::numerics::Budget;
 use proptest::prelude::*;
 use serde_json::{Value, json};
 
-#[path = "support/bus_demo_motor.rs"]
-mod bus_demo_motor;
+use crate::support::bus_demo_motor;
 
 fn cfg(cases: u32) -> ProptestConfig {
     ProptestConfig {

@@ -10,8 +10,7 @@ use mechcalc::calc::bus_fuel_economy::{BusFuelEconomyRequest, BusFuelEconomyResp
 use mechcalc::numerics::Budget;
 use serde_json::{Value, json};
 
-#[path = "support/bus_demo_motor.rs"]
-mod bus_demo_motor;
+use crate::support::bus_demo_motor;
 use bus_demo_motor::{demo_efficiency_map, demo_ipmsm};
 
 const CYCLES: [&str; 3] = ["manhattan", "hwfet", "hdudds"];

@@ -2,7 +2,7 @@
 //! fields removed, strings replaced, arrays emptied) and sent to the router. Whatever the module,
 //! the answer must be a 200 with finite numbers or a 4xx problem+json: never a 500.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

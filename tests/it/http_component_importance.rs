@@ -2,7 +2,7 @@
 //! ranking, and every kind of bad request gets the right problem+json answer with pointers to
 //! the offending fields (spec §2 rejections).
 
-mod common;
+use crate::common;
 
 use common::{post_json, send_to};
 use mechcalc::AppState;
@@ -60,7 +60,7 @@ async fn ranks_the_machining_center() {
 async fn documented_schema_example_is_valid() {
     let doc = serde_json::to_value(mechcalc::http::openapi()).expect("openapi");
     let example = doc
-        .pointer("/components/schemas/ComponentImportanceRequest/example")
+        .pointer("/components/schemas/component_importance.ComponentImportanceRequest/example")
         .expect("request example in the schema")
         .clone();
     let r = post_json(PATH, &example).await;

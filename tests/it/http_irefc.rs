@@ -2,7 +2,7 @@
 //! bad request gets the right problem+json answer (type, spec code, pointers). Mutated `api/irefc`
 //! examples never give a 500.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

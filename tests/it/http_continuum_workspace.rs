@@ -2,7 +2,7 @@
 //! omitted unless asked, and every kind of bad request gets the right problem+json answer
 //! (400/415/422) with pointers to the offending fields and the module's `code`.
 
-mod common;
+use crate::common;
 
 use common::post_json;
 use serde_json::{Value, json};

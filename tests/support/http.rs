@@ -1,5 +1,4 @@
 //! Helpers shared by the HTTP tests: drive the router in process, no socket.
-#![allow(dead_code)]
 
 use axum::body::Body;
 use axum::http::{HeaderMap, Request, StatusCode};

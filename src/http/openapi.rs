@@ -1,0 +1,323 @@
+//! The OpenAPI document: generated from the handlers and wire types, then completed in one pass
+//! from the same tables the validators use, and built once per process.
+//!
+//! * Schema names are module-qualified (`cognates.Meta`); [`Registry`] records every schema a
+//!   route brings and reports two different Rust types that map to one name (utoipa would keep
+//!   one of them silently).
+//! * Bounds (`minimum`, `maximum`, `exclusiveMinimum`, `exclusiveMaximum`) are written from the
+//!   modules' [`schema_bounds`](crate::calc::schema_bounds) tables; a bound written anywhere else
+//!   is reported by [`document_problems`].
+//! * Internally tagged request enums (`{"model": "constant", ...}`) are rewritten so the tag is a
+//!   property of each variant's own closed object and the `oneOf` carries a discriminator: utoipa
+//!   renders them as `allOf[{closed object}, {tag}]`, which no instance can satisfy.
+
+use std::collections::BTreeMap;
+use std::sync::OnceLock;
+
+use axum::routing::MethodRouter;
+use serde_json::{Map, Value, json};
+use utoipa::openapi::path::Paths;
+use utoipa::openapi::{RefOr, schema::Schema};
+use utoipa_axum::router::OpenApiRouter;
+
+use crate::calc::{Range, SchemaBound};
+
+use super::AppState;
+
+/// What `routes!` hands over: the route's schemas, its paths and its method router.
+pub type RouteParts = (Vec<(String, RefOr<Schema>)>, Paths, MethodRouter<AppState>);
+
+/// The router under construction plus every schema name seen so far, to detect two Rust types
+/// that map to one schema name.
+pub struct Registry {
+    router: OpenApiRouter<AppState>,
+    seen: BTreeMap<String, String>,
+    conflicts: Vec<String>,
+}
+
+impl Registry {
+    /// Start from the document's fixed parts.
+    #[must_use]
+    pub fn new(router: OpenApiRouter<AppState>) -> Self {
+        Self {
+            router,
+            seen: BTreeMap::new(),
+            conflicts: Vec::new(),
+        }
+    }
+
+    /// Add one route (the output of `routes!`), recording its schemas.
+    #[must_use]
+    pub fn route(mut self, parts: RouteParts) -> Self {
+        for (name, schema) in &parts.0 {
+            let body = serde_json::to_string(schema).unwrap_or_default();
+            match self.seen.get(name) {
+                Some(prev) if *prev != body => self.conflicts.push(name.clone()),
+                Some(_) => {}
+                None => {
+                    self.seen.insert(name.clone(), body);
+                }
+            }
+        }
+        self.router = self.router.routes(parts);
+        self
+    }
+
+    /// The router, and the schema names claimed by more than one type.
+    #[must_use]
+    pub fn finish(self) -> (OpenApiRouter<AppState>, Vec<String>) {
+        let mut c = self.conflicts;
+        c.sort();
+        c.dedup();
+        (self.router, c)
+    }
+}
+
+/// The finished document, as JSON, built once.
+pub fn document() -> &'static Value {
+    static DOC: OnceLock<Value> = OnceLock::new();
+    DOC.get_or_init(|| build().0)
+}
+
+/// Problems of the generated document that a test must see: schema-name conflicts, bounds whose
+/// schema or property does not exist, and bounds written as literals instead of from a table.
+#[must_use]
+pub fn document_problems() -> Vec<String> {
+    build().1
+}
+
+fn build() -> (Value, Vec<String>) {
+    let (api, conflicts) = super::api_parts();
+    let mut problems: Vec<String> = conflicts
+        .into_iter()
+        .map(|n| format!("schema name `{n}` is used by two different types"))
+        .collect();
+    let mut doc = serde_json::to_value(&api).unwrap_or(Value::Null);
+    if let Some(schemas) = doc
+        .pointer_mut("/components/schemas")
+        .and_then(Value::as_object_mut)
+    {
+        problems.extend(literal_bounds(schemas));
+        problems.extend(apply_bounds(schemas, &crate::calc::schema_bounds()));
+        close_tagged_enums(schemas);
+    }
+    (doc, problems)
+}
+
+/// Bounds present before the table is applied: every one is a literal in a `#[schema]`
+/// attribute, except the `minimum: 0` utoipa writes for unsigned integers (which serde enforces).
+fn literal_bounds(schemas: &Map<String, Value>) -> Vec<String> {
+    let mut out = Vec::new();
+    for (name, schema) in schemas {
+        let Some(props) = schema.get("properties").and_then(Value::as_object) else {
+            continue;
+        };
+        for (prop, body) in props {
+            for (path, s) in [("", body), ("/items", &body["items"])] {
+                for key in ["minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"] {
+                    let Some(v) = s.get(key) else { continue };
+                    let unsigned_zero =
+                        key == "minimum" && v.as_f64() == Some(0.0) && type_is(s, "integer");
+                    if !unsigned_zero {
+                        out.push(format!(
+                            "{name}.{prop}{path}: `{key}` is written as a literal; declare it in the \
+                             module's schema_bounds! table"
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn type_is(schema: &Value, ty: &str) -> bool {
+    match schema.get("type") {
+        Some(Value::String(s)) => s == ty,
+        Some(Value::Array(a)) => a.iter().any(|t| t == ty),
+        _ => false,
+    }
+}
+
+/// Writes each bound into its property's schema; returns the bounds that name no property.
+fn apply_bounds(schemas: &mut Map<String, Value>, bounds: &[SchemaBound]) -> Vec<String> {
+    let mut missing = Vec::new();
+    for b in bounds {
+        let target = schemas
+            .get_mut(b.schema.as_ref())
+            .and_then(|s| s.get_mut("properties"))
+            .and_then(|p| p.get_mut(b.property))
+            .and_then(|p| if b.items { p.get_mut("items") } else { Some(p) })
+            .and_then(Value::as_object_mut);
+        match target {
+            Some(t) => write_range(t, &b.range),
+            None => missing.push(format!(
+                "bound for {}.{}{} names no property of the document",
+                b.schema,
+                b.property,
+                if b.items { "[]" } else { "" }
+            )),
+        }
+    }
+    missing
+}
+
+/// A bound as JSON Schema 2020-12 keywords; integer ranges are written as integers.
+pub fn write_range(t: &mut Map<String, Value>, r: &Range) {
+    for k in ["minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"] {
+        t.remove(k);
+    }
+    let num = |x: f64| -> Value {
+        if r.integer && x.fract() == 0.0 && x.abs() < 9.0e15 {
+            // Exact: |x| < 2^53 and whole.
+            json!(x as i64)
+        } else {
+            json!(x)
+        }
+    };
+    if r.has_lo() {
+        t.insert(
+            (if r.lo_open {
+                "exclusiveMinimum"
+            } else {
+                "minimum"
+            })
+            .to_owned(),
+            num(r.lo),
+        );
+    }
+    if r.has_hi() {
+        t.insert(
+            (if r.hi_open {
+                "exclusiveMaximum"
+            } else {
+                "maximum"
+            })
+            .to_owned(),
+            num(r.hi),
+        );
+    }
+}
+
+/// Rewrites `oneOf[allOf[{$ref: X}, {properties: {tag: {enum: [v]}}}], ...]` (utoipa's rendering of
+/// an internally tagged enum with newtype variants) so that each variant is one closed object with
+/// the tag among its own properties, and adds a discriminator when every variant is a reference.
+fn close_tagged_enums(schemas: &mut Map<String, Value>) {
+    let names: Vec<String> = schemas.keys().cloned().collect();
+    let refs = reference_counts(schemas);
+    for name in names {
+        let Some(variants) = schemas
+            .get(&name)
+            .and_then(|s| s.get("oneOf"))
+            .and_then(Value::as_array)
+            .cloned()
+        else {
+            continue;
+        };
+        let mut tag_name: Option<String> = None;
+        let mut new_variants = Vec::with_capacity(variants.len());
+        let mut mapping = Map::new();
+        let mut all_refs = true;
+        for v in &variants {
+            let Some((target, tag, value, tag_schema)) = tagged_ref_variant(v) else {
+                all_refs &= v.get("$ref").is_some();
+                new_variants.push(v.clone());
+                continue;
+            };
+            tag_name.get_or_insert_with(|| tag.clone());
+            // Merge the tag into the referenced schema when only this enum uses it; else into a copy.
+            let merged_name = if refs.get(&target).copied().unwrap_or(0) <= 1 {
+                target.clone()
+            } else {
+                format!("{target}.{value}")
+            };
+            let mut merged = schemas.get(&target).cloned().unwrap_or_else(|| json!({}));
+            if let Some(obj) = merged.as_object_mut() {
+                let props = obj
+                    .entry("properties")
+                    .or_insert_with(|| json!({}))
+                    .as_object_mut();
+                if let Some(props) = props {
+                    let mut tag_schema = tag_schema.clone();
+                    if let Some(t) = tag_schema.as_object_mut() {
+                        t.entry("description").or_insert_with(|| {
+                            json!(format!("Variant tag: always `{value}` for this variant."))
+                        });
+                    }
+                    let mut with_tag = Map::new();
+                    with_tag.insert(tag.clone(), tag_schema);
+                    with_tag.extend(std::mem::take(props));
+                    *props = with_tag;
+                }
+                let req = obj.entry("required").or_insert_with(|| json!([]));
+                if let Some(req) = req.as_array_mut()
+                    && !req.iter().any(|r| r == &Value::String(tag.clone()))
+                {
+                    req.insert(0, Value::String(tag.clone()));
+                }
+                if let Some(d) = v.get("description") {
+                    obj.entry("description").or_insert_with(|| d.clone());
+                }
+            }
+            schemas.insert(merged_name.clone(), merged);
+            let reference = format!("#/components/schemas/{merged_name}");
+            mapping.insert(value, Value::String(reference.clone()));
+            new_variants.push(json!({ "$ref": reference }));
+        }
+        let Some(tag) = tag_name else { continue };
+        if let Some(obj) = schemas.get_mut(&name).and_then(Value::as_object_mut) {
+            obj.insert("oneOf".to_owned(), Value::Array(new_variants));
+            if all_refs {
+                obj.insert(
+                    "discriminator".to_owned(),
+                    json!({ "propertyName": tag, "mapping": mapping }),
+                );
+            }
+        }
+    }
+}
+
+/// `(referenced schema, tag property, tag value, tag property schema)` of an `allOf` variant.
+fn tagged_ref_variant(v: &Value) -> Option<(String, String, String, Value)> {
+    let parts = v.get("allOf")?.as_array()?;
+    let [first, second] = parts.as_slice() else {
+        return None;
+    };
+    let target = first
+        .get("$ref")?
+        .as_str()?
+        .strip_prefix("#/components/schemas/")?
+        .to_owned();
+    let props = second.get("properties")?.as_object()?;
+    let (tag, tag_schema) = props.iter().next().filter(|_| props.len() == 1)?;
+    let value = tag_schema
+        .get("enum")?
+        .as_array()?
+        .first()?
+        .as_str()?
+        .to_owned();
+    Some((target, tag.clone(), value, tag_schema.clone()))
+}
+
+/// How many times each component schema is referenced anywhere in the components.
+fn reference_counts(schemas: &Map<String, Value>) -> BTreeMap<String, usize> {
+    fn walk(v: &Value, out: &mut BTreeMap<String, usize>) {
+        match v {
+            Value::Object(m) => {
+                if let Some(Value::String(r)) = m.get("$ref")
+                    && let Some(n) = r.strip_prefix("#/components/schemas/")
+                {
+                    *out.entry(n.to_owned()).or_default() += 1;
+                }
+                m.values().for_each(|x| walk(x, out));
+            }
+            Value::Array(a) => a.iter().for_each(|x| walk(x, out)),
+            _ => {}
+        }
+    }
+    let mut out = BTreeMap::new();
+    for s in schemas.values() {
+        walk(s, &mut out);
+    }
+    out
+}
