@@ -19,7 +19,7 @@ pub mod pool;
 pub mod problem;
 pub mod state;
 
-mod finite;
+pub mod finite;
 
 use std::time::{Duration, Instant};
 

@@ -8,4 +8,6 @@
 
 pub mod bus_demo_motor;
 pub mod cam_table1;
+pub mod finite;
 pub mod http;
+pub mod proptest_cfg;
