@@ -187,24 +187,36 @@ async fn log_request(req: Request, next: Next) -> Response {
 /// Serialize a calculation's response as JSON, refusing to send a non-finite number (a bug:
 /// logged, answered with 500).
 pub fn respond<T: Serialize>(value: &T) -> Result<Response, ApiError> {
-    if let Some(pointer) = finite::first_non_finite(value) {
+    encode(value).map(json_response)
+}
+
+/// The JSON body of a response: checked for non-finite numbers (one allocation-free pass), then
+/// written once into a buffer. Runs inside the compute job, so large answers are encoded on the
+/// bounded compute pool, not on the threads that accept connections.
+pub fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
+    if !finite::all_finite(value) {
+        let pointer = finite::first_non_finite(value).unwrap_or_default();
         tracing::error!(%pointer, "calculation produced a non-finite number");
         return Err(ApiError::internal());
     }
-    let body = serde_json::to_vec(value).map_err(|e| {
+    serde_json::to_vec(value).map_err(|e| {
         tracing::error!(error = %e, "response serialization failed");
         ApiError::internal()
-    })?;
+    })
+}
+
+/// An `application/json` response from an encoded body.
+fn json_response(body: Vec<u8>) -> Response {
     let mut r = body.into_response();
     r.headers_mut().insert(
         header::CONTENT_TYPE,
         HeaderValue::from_static("application/json"),
     );
-    Ok(r)
+    r
 }
 
 /// Run a module's calculation on the compute pool with a budget of `limit` (capped by the server
-/// maximum), map its failure to problem+json and respond.
+/// maximum), encode its answer there too, map its failure to problem+json and respond.
 pub async fn run_calc<T, F>(
     state: &AppState,
     limit: Option<Duration>,
@@ -214,6 +226,13 @@ where
     T: Serialize + Send + 'static,
     F: FnOnce(&Budget) -> Result<T, CalcFailure> + Send + 'static,
 {
-    let out = state.pool.run(limit, job).await??;
-    respond(&out)
+    let body = state
+        .pool
+        .run(limit, move |budget| {
+            job(budget)
+                .map_err(ApiError::from)
+                .and_then(|out| encode(&out))
+        })
+        .await??;
+    Ok(json_response(body))
 }
