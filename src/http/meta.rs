@@ -137,6 +137,23 @@ fn json_bytes(body: &'static [u8]) -> Response {
     r
 }
 
+/// Prometheus metrics of this process (text exposition format), built from the `metrics`
+/// facade: requests by route and status, latency histograms, job times by lane, compute-slot
+/// and queue occupancy, cancelled jobs, budget stops, rejections.
+pub async fn metrics(State(state): State<AppState>) -> Response {
+    let pool = &state.pool;
+    metrics::gauge!("mechcalc_compute_slots").set(pool.slots() as f64);
+    metrics::gauge!("mechcalc_compute_slots_free").set(pool.available_slots() as f64);
+    metrics::gauge!("mechcalc_queue_depth_waiting").set(pool.waiting() as f64);
+    let body = super::telemetry::render();
+    let mut r = body.into_response();
+    r.headers_mut().insert(
+        header::CONTENT_TYPE,
+        HeaderValue::from_static("text/plain; version=0.0.4; charset=utf-8"),
+    );
+    r
+}
+
 const DOCS_HTML: &str = r##"<!doctype html>
 <html lang="en">
 <head>

@@ -13,26 +13,28 @@ pub mod component_importance;
 pub mod continuum_workspace;
 pub mod irefc;
 pub mod json;
+pub mod layers;
 pub mod meta;
 pub mod openapi;
 pub mod pool;
 pub mod problem;
+pub mod serve;
 pub mod state;
+pub mod telemetry;
 
 pub mod finite;
 
-use std::time::{Duration, Instant};
-
 use axum::Router;
 use axum::body::Body;
-use axum::extract::{DefaultBodyLimit, Request};
+use axum::extract::DefaultBodyLimit;
 use axum::http::{HeaderValue, Method, Uri, header};
-use axum::middleware::{self, Next};
+use axum::middleware;
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
 use serde::Serialize;
 use tower_http::catch_panic::CatchPanicLayer;
-use tracing::Instrument;
+use tower_http::request_id::{PropagateRequestIdLayer, SetRequestIdLayer};
+use tower_http::set_header::SetResponseHeaderLayer;
 use utoipa::OpenApi;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
@@ -55,6 +57,13 @@ pub enum ProblemResponses {
         content_type = "application/problem+json"
     )]
     MalformedJson(Problem),
+    /// The body did not arrive within the body timeout.
+    #[response(
+        status = 408,
+        description = "Request body timeout (`/problems/request-timeout`)",
+        content_type = "application/problem+json"
+    )]
+    RequestTimeout(Problem),
     /// The body exceeds the configured size limit.
     #[response(
         status = 413,
@@ -145,8 +154,10 @@ pub fn openapi() -> utoipa::openapi::OpenApi {
 pub fn app(state: AppState) -> Router {
     let (router, _api) = api_router().0.split_for_parts();
     let body_limit = state.config.max_body_bytes;
-    router
+    let cors = layers::cors(&state.config.cors_origins);
+    let mut app = router
         .route("/openapi.json", get(meta::openapi_json))
+        .route("/metrics", get(meta::metrics))
         .route("/docs", get(meta::docs))
         .route("/docs/", get(meta::docs))
         .route("/docs/swagger-ui-bundle.js", get(meta::swagger_js))
@@ -156,7 +167,18 @@ pub fn app(state: AppState) -> Router {
         .with_state(state)
         .layer(DefaultBodyLimit::max(body_limit))
         .layer(CatchPanicLayer::custom(panic_response))
-        .layer(middleware::from_fn(log_request))
+        .layer(middleware::from_fn(layers::log_request));
+    for (name, value) in layers::hardening_headers() {
+        app = app.layer(SetResponseHeaderLayer::if_not_present(name, value));
+    }
+    if let Some(cors) = cors {
+        app = app.layer(cors);
+    }
+    app.layer(PropagateRequestIdLayer::new(layers::REQUEST_ID))
+        .layer(SetRequestIdLayer::new(
+            layers::REQUEST_ID,
+            layers::MakeId::default(),
+        ))
 }
 
 async fn not_found(uri: Uri) -> ApiError {
@@ -170,18 +192,6 @@ async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
 fn panic_response(payload: Box<dyn std::any::Any + Send + 'static>) -> Response<Body> {
     tracing::error!(panic = %pool::panic_message(payload), "handler panicked");
     ApiError::internal().into_response()
-}
-
-/// One structured log line per request: method, path, status, latency. Bodies are never logged.
-async fn log_request(req: Request, next: Next) -> Response {
-    let method = req.method().clone();
-    let path = req.uri().path().to_owned();
-    let span = tracing::info_span!("request", %method, %path);
-    let start = Instant::now();
-    let resp = next.run(req).instrument(span).await;
-    let latency_ms = start.elapsed().as_secs_f64() * 1e3;
-    tracing::info!(%method, %path, status = resp.status().as_u16(), latency_ms, "request");
-    resp
 }
 
 /// Serialize a calculation's response as JSON, refusing to send a non-finite number (a bug:
@@ -217,21 +227,42 @@ fn json_response(body: Vec<u8>) -> Response {
 
 /// Run a module's calculation on the compute pool with a budget of `limit` (capped by the server
 /// maximum), encode its answer there too, map its failure to problem+json and respond.
+///
+/// `demand` is the request's time limit (`Option<Duration>`) or a [`pool::Demand`] that also
+/// carries the module's cost estimate. An answer larger than `--max-response-bytes` is refused
+/// with a 422 (`/problems/too-large`); modules that can tell the size before computing refuse
+/// earlier, naming the option to change.
 pub async fn run_calc<T, F>(
     state: &AppState,
-    limit: Option<Duration>,
+    demand: impl Into<pool::Demand>,
     job: F,
 ) -> Result<Response, ApiError>
 where
     T: Serialize + Send + 'static,
     F: FnOnce(&Budget) -> Result<T, CalcFailure> + Send + 'static,
 {
+    let max_bytes = state.config.max_response_bytes;
     let body = state
         .pool
-        .run(limit, move |budget| {
+        .run(demand, move |budget| {
             job(budget)
                 .map_err(ApiError::from)
                 .and_then(|out| encode(&out))
+                .and_then(|body| {
+                    if body.len() > max_bytes {
+                        Err(ApiError::from(CalcFailure::general(
+                            crate::calc::ProblemClass::TooLarge,
+                            "RESPONSE_TOO_LARGE",
+                            format!(
+                                "the answer is {} bytes, over the service's limit of {max_bytes} \
+                                 bytes; request fewer points or fewer optional outputs",
+                                body.len()
+                            ),
+                        )))
+                    } else {
+                        Ok(body)
+                    }
+                })
         })
         .await??;
     Ok(json_response(body))
