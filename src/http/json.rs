@@ -120,7 +120,7 @@ fn decode_slots() -> &'static tokio::sync::Semaphore {
     })
 }
 
-impl<T: DeserializeOwned + Send + 'static> FromRequest<AppState> for ApiJson<T> {
+impl<T: DeserializeOwned + utoipa::ToSchema + Send + 'static> FromRequest<AppState> for ApiJson<T> {
     type Rejection = ApiError;
 
     async fn from_request(req: Request, state: &AppState) -> Result<Self, Self::Rejection> {
@@ -147,8 +147,15 @@ impl<T: DeserializeOwned + Send + 'static> FromRequest<AppState> for ApiJson<T> 
                     ))
                 }
             })?;
-        if bytes.len() <= INLINE_DECODE_BYTES {
-            return decode(&bytes).map(ApiJson);
+        let schema = T::name();
+        let inline = bytes.len() <= INLINE_DECODE_BYTES;
+        let decode_and_check = move || {
+            let v = decode(&bytes)?;
+            super::shape::check(&schema, &bytes)?;
+            Ok(ApiJson(v))
+        };
+        if inline {
+            return decode_and_check();
         }
         // A large body takes milliseconds to decode: do it off the threads that serve
         // connections, at most `DECODE_SLOTS` at once.
@@ -156,7 +163,7 @@ impl<T: DeserializeOwned + Send + 'static> FromRequest<AppState> for ApiJson<T> 
             .acquire()
             .await
             .map_err(|_| ApiError::internal())?;
-        tokio::task::spawn_blocking(move || decode(&bytes).map(ApiJson))
+        tokio::task::spawn_blocking(decode_and_check)
             .await
             .map_err(|_| ApiError::internal())?
     }

@@ -19,6 +19,7 @@ pub mod openapi;
 pub mod pool;
 pub mod problem;
 pub mod serve;
+pub mod shape;
 pub mod state;
 pub mod telemetry;
 
