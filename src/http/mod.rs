@@ -28,7 +28,7 @@ pub mod finite;
 use axum::Router;
 use axum::body::Body;
 use axum::extract::DefaultBodyLimit;
-use axum::http::{HeaderValue, Method, Uri, header};
+use axum::http::{HeaderName, HeaderValue, Method, Uri, header};
 use axum::middleware;
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
@@ -243,28 +243,41 @@ where
     F: FnOnce(&Budget) -> Result<T, CalcFailure> + Send + 'static,
 {
     let max_bytes = state.config.max_response_bytes;
-    let body = state
+    let arrived = std::time::Instant::now();
+    let (body, compute, encoding, started) = state
         .pool
         .run(demand, move |budget| {
-            job(budget)
-                .map_err(ApiError::from)
-                .and_then(|out| encode(&out))
-                .and_then(|body| {
-                    if body.len() > max_bytes {
-                        Err(ApiError::from(CalcFailure::general(
-                            crate::calc::ProblemClass::TooLarge,
-                            "RESPONSE_TOO_LARGE",
-                            format!(
-                                "the answer is {} bytes, over the service's limit of {max_bytes} \
-                                 bytes; request fewer points or fewer optional outputs",
-                                body.len()
-                            ),
-                        )))
-                    } else {
-                        Ok(body)
-                    }
-                })
+            let started = std::time::Instant::now();
+            let out = job(budget).map_err(ApiError::from)?;
+            let computed = std::time::Instant::now();
+            let body = encode(&out)?;
+            drop(out);
+            if body.len() > max_bytes {
+                return Err(ApiError::from(CalcFailure::general(
+                    crate::calc::ProblemClass::TooLarge,
+                    "RESPONSE_TOO_LARGE",
+                    format!(
+                        "the answer is {} bytes, over the service's limit of {max_bytes} \
+                         bytes; request fewer points or fewer optional outputs",
+                        body.len()
+                    ),
+                )));
+            }
+            Ok((body, computed - started, computed.elapsed(), started))
         })
         .await??;
-    Ok(json_response(body))
+    let mut r = json_response(body);
+    // Server-Timing (W3C): where the time of this answer went, for clients and benchmarks.
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let queue = started.saturating_duration_since(arrived);
+    if let Ok(v) = HeaderValue::from_str(&format!(
+        "queue;dur={:.3}, compute;dur={:.3}, encode;dur={:.3}",
+        ms(queue),
+        ms(compute),
+        ms(encoding)
+    )) {
+        r.headers_mut()
+            .insert(HeaderName::from_static("server-timing"), v);
+    }
+    Ok(r)
 }

@@ -7,8 +7,10 @@
 //!   exceeds its time budget is refused at once instead of after waiting for nothing.
 //! * **Cheap lane.** Requests known to be cheap (a closed-form evaluation: the route's recent jobs
 //!   took well under a millisecond and the body is small) do not queue behind sweeps: they run on
-//!   a small separate lane (`cheap_slots` at once, on tokio's blocking threads). Their CPU is
-//!   bounded by that lane's size × their (short) duration.
+//!   a small separate lane (twice the slots at once, on tokio's blocking threads), or, below half a
+//!   millisecond, inline on the thread serving the request (at most cores − 1 at once, so one
+//!   connection thread is always free). Their CPU is bounded by that lane's size × their (short)
+//!   duration.
 //! * **Budget.** Each job receives a [`Budget`]: the request's own time limit (capped by the
 //!   server's maximum) counted from the request's arrival, so queueing spends it too; the threads
 //!   its parallel parts may use (`--threads-per-job`, on the same rayon pool); and a cancellation
@@ -30,6 +32,9 @@ use super::problem::ApiError;
 
 /// A route whose recent jobs took less than this (mean) is served on the cheap lane.
 const CHEAP_JOB: Duration = Duration::from_millis(2);
+/// A cheap route whose recent jobs took less than this runs inline, on the thread that serves the
+/// request (no hand-off to another thread: the hand-off alone costs tens of microseconds).
+const INLINE_JOB: Duration = Duration::from_micros(500);
 /// Bodies above this size never take the cheap lane (decoding alone may take milliseconds).
 const CHEAP_BODY_BYTES: usize = 64 * 1024;
 /// Weight of the newest observation in the running mean of job times.
@@ -80,6 +85,17 @@ pub struct RequestInfo {
     pub body_bytes: usize,
 }
 
+/// Where a job runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Lane {
+    /// On the thread serving the request (sub-millisecond jobs).
+    Inline,
+    /// On the cheap lane (tokio's blocking threads, `cheap` permits).
+    Cheap,
+    /// On the rayon compute pool behind the admission semaphore.
+    Heavy,
+}
+
 /// Semaphore-bounded access to the compute pool.
 #[derive(Clone)]
 pub struct ComputePool {
@@ -90,6 +106,8 @@ struct Inner {
     slots: Arc<Semaphore>,
     n_slots: usize,
     cheap: Arc<Semaphore>,
+    /// Jobs running inline on the connection threads at once (always leaves one thread free).
+    inline: Arc<Semaphore>,
     waiting: AtomicUsize,
     queue_depth: usize,
     max_budget: Duration,
@@ -144,6 +162,12 @@ impl ComputePool {
                 slots: Arc::new(Semaphore::new(slots)),
                 n_slots: slots,
                 cheap: Arc::new(Semaphore::new(2 * slots)),
+                inline: Arc::new(Semaphore::new(
+                    std::thread::available_parallelism()
+                        .map_or(1, std::num::NonZeroUsize::get)
+                        .saturating_sub(1)
+                        .max(1),
+                )),
                 waiting: AtomicUsize::new(0),
                 queue_depth,
                 max_budget,
@@ -265,20 +289,26 @@ impl ComputePool {
         }
     }
 
-    /// Whether a request on `info` with `cost` takes the cheap lane.
-    fn is_cheap(&self, cost: Cost, info: &RequestInfo) -> bool {
+    /// The lane of a request on `info` with `cost`.
+    fn lane(&self, cost: Cost, info: &RequestInfo) -> Lane {
+        let recent_us = self
+            .inner
+            .route_us
+            .lock()
+            .ok()
+            .and_then(|m| m.get(&info.route).copied());
+        let small = info.body_bytes <= CHEAP_BODY_BYTES;
+        let inline = small && recent_us.is_some_and(|us| us < INLINE_JOB.as_secs_f64() * 1e6);
         match cost {
-            Cost::Cheap => true,
-            Cost::Heavy => false,
+            Cost::Heavy => Lane::Heavy,
+            Cost::Cheap | Cost::Unknown if inline => Lane::Inline,
+            Cost::Cheap => Lane::Cheap,
             Cost::Unknown => {
-                info.body_bytes <= CHEAP_BODY_BYTES
-                    && self
-                        .inner
-                        .route_us
-                        .lock()
-                        .ok()
-                        .and_then(|m| m.get(&info.route).copied())
-                        .is_some_and(|us| us < CHEAP_JOB.as_secs_f64() * 1e6)
+                if small && recent_us.is_some_and(|us| us < CHEAP_JOB.as_secs_f64() * 1e6) {
+                    Lane::Cheap
+                } else {
+                    Lane::Heavy
+                }
             }
         }
     }
@@ -327,16 +357,26 @@ impl ComputePool {
             .time_limit
             .map_or(self.inner.max_budget, |r| r.min(self.inner.max_budget));
         let info = REQUEST_INFO.try_with(Clone::clone).unwrap_or_default();
-        let heavy = !self.is_cheap(demand.cost, &info);
-        let permit = if heavy {
-            self.acquire(limit).await?
-        } else {
+        let mut lane = self.lane(demand.cost, &info);
+        let inline_permit = match lane {
+            Lane::Inline => Arc::clone(&self.inner.inline).try_acquire_owned().ok(),
+            _ => None,
+        };
+        if lane == Lane::Inline && inline_permit.is_none() {
+            lane = Lane::Cheap;
+        }
+        let heavy = lane == Lane::Heavy;
+        let permit = match (lane, inline_permit) {
+            (Lane::Inline, Some(p)) => p,
+            (Lane::Heavy, _) => self.acquire(limit).await?,
             // Cheap jobs last microseconds: wait for the cheap lane rather than queue behind
             // sweeps.
-            match tokio::time::timeout(limit, Arc::clone(&self.inner.cheap).acquire_owned()).await {
+            _ => match tokio::time::timeout(limit, Arc::clone(&self.inner.cheap).acquire_owned())
+                .await
+            {
                 Ok(Ok(p)) => p,
                 _ => return Err(ApiError::overloaded(1)),
-            }
+            },
         };
         let mut cancel = CancelOnDrop {
             flag: Arc::new(AtomicBool::new(false)),
@@ -364,10 +404,10 @@ impl ComputePool {
             // The receiver is gone only when the request was dropped; nobody wants the answer.
             let _ = tx.send((out, elapsed, stopped_early));
         };
-        if heavy {
-            rayon::spawn(task);
-        } else {
-            drop(tokio::task::spawn_blocking(task));
+        match lane {
+            Lane::Heavy => rayon::spawn(task),
+            Lane::Cheap => drop(tokio::task::spawn_blocking(task)),
+            Lane::Inline => task(),
         }
         let out = rx.await;
         cancel.done = true;

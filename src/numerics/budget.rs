@@ -25,9 +25,12 @@ pub struct Budget {
     cancel: Option<Arc<AtomicBool>>,
 }
 
-/// The threads a job may use when nobody says otherwise: the machine's cores.
+/// The threads a job may use when nobody says otherwise: the machine's cores (read once: the
+/// query reads cgroup files and costs tens of microseconds).
 fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES
+        .get_or_init(|| std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get))
 }
 
 impl Budget {
