@@ -19,11 +19,36 @@ struct Cli {
     /// Print the OpenAPI document (YAML) and exit.
     #[arg(long)]
     print_openapi: bool,
+    #[command(subcommand)]
+    command: Option<Command>,
 }
 
-#[tokio::main]
-async fn main() -> std::process::ExitCode {
+#[derive(Debug, clap::Subcommand)]
+enum Command {
+    /// Run one calculation (or an NDJSON batch) without a server: JSON request in (a file or
+    /// standard input), JSON (or `--svg`) out; problem details on stderr and exit code 2 for a
+    /// refused request.
+    Run(mechcalc::cli::RunArgs),
+}
+
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
+    if let Some(Command::Run(args)) = &cli.command {
+        return mechcalc::cli::run(args, cli.config);
+    }
+    match tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(rt) => rt.block_on(serve(cli)),
+        Err(e) => {
+            eprintln!("cannot start the runtime: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+async fn serve(cli: Cli) -> std::process::ExitCode {
     if cli.print_openapi {
         return match mechcalc::http::openapi().to_yaml() {
             Ok(y) => {

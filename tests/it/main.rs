@@ -8,6 +8,7 @@ mod support;
 use support::http as common;
 
 mod api_examples;
+mod cli;
 mod contract;
 mod contract_bounds;
 mod http_bus_fuel_economy;
