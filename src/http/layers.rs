@@ -95,6 +95,7 @@ pub async fn log_request(req: Request, next: Next) -> Response {
     let info = RequestInfo {
         route: route.clone(),
         body_bytes,
+        progress: None,
     };
     let resp = REQUEST_INFO
         .scope(info, next.run(req).instrument(span))

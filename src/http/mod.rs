@@ -21,6 +21,7 @@ pub mod problem;
 pub mod serve;
 pub mod shape;
 pub mod state;
+pub mod stream;
 pub mod telemetry;
 
 pub mod finite;
@@ -168,6 +169,7 @@ pub fn app(state: AppState) -> Router {
         .with_state(state)
         .layer(DefaultBodyLimit::max(body_limit))
         .layer(CatchPanicLayer::custom(panic_response))
+        .layer(middleware::from_fn(stream::event_stream))
         .layer(middleware::from_fn(layers::log_request));
     for (name, value) in layers::hardening_headers() {
         app = app.layer(SetResponseHeaderLayer::if_not_present(name, value));

@@ -76,13 +76,15 @@ tokio::task_local! {
     pub static REQUEST_INFO: RequestInfo;
 }
 
-/// Route and body size of the request in flight.
-#[derive(Debug, Clone, Default)]
+/// Route and body size of the request in flight, and where its progress goes.
+#[derive(Clone, Default)]
 pub struct RequestInfo {
     /// The matched route (e.g. `/v1/cognates`), or empty.
     pub route: String,
     /// Declared body size [bytes], if known.
     pub body_bytes: usize,
+    /// Progress sink of a streaming request (`Accept: text/event-stream`).
+    pub progress: Option<Arc<crate::numerics::budget::ProgressSink>>,
 }
 
 /// Where a job runs.
@@ -383,9 +385,12 @@ impl ComputePool {
             done: false,
         };
         self.register(&cancel.flag);
-        let budget = Budget::starting_at(arrived, limit)
+        let mut budget = Budget::starting_at(arrived, limit)
             .with_threads(self.threads_per_job())
             .with_cancel_flag(Arc::clone(&cancel.flag));
+        if let Some(sink) = &info.progress {
+            budget = budget.with_progress(Arc::clone(sink));
+        }
         let span = tracing::Span::current();
         let (tx, rx) = tokio::sync::oneshot::channel();
         let gauge = if heavy {
