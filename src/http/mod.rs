@@ -127,6 +127,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
     openapi::Registry::new(OpenApiRouter::with_openapi(ApiDoc::openapi()))
         .route(routes!(meta::healthz))
         .route(routes!(meta::index))
+        .route(routes!(meta::examples))
         .route(routes!(cam_law::evaluate))
         .route(routes!(cam_law_fit::fit))
         .route(routes!(cognates::construct))
@@ -158,6 +159,7 @@ pub fn app(state: AppState) -> Router {
     let body_limit = state.config.max_body_bytes;
     let cors = layers::cors(&state.config.cors_origins);
     let mut app = router
+        .route("/", get(meta::page))
         .route("/openapi.json", get(meta::openapi_json))
         .route("/metrics", get(meta::metrics))
         .route("/docs", get(meta::docs))
