@@ -5,6 +5,7 @@
 //! * [`http`]: the axum service around them; [`app`] builds the router (tests drive it with no
 //!   socket).
 //! * [`config`]: flags and environment variables of the binary.
+//! * [`plot`]: SVG pictures of answers (`Accept: image/svg+xml`).
 //! * [`cli`]: `mechcalc run`, one calculation from the command line without a server.
 
 // Units are written in brackets in doc comments ("time [s]", "displacement [U]"), as the style
@@ -16,5 +17,6 @@ pub mod cli;
 pub mod config;
 pub mod http;
 pub mod numerics;
+pub mod plot;
 
 pub use http::{AppState, app};

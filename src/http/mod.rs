@@ -16,6 +16,7 @@ pub mod json;
 pub mod layers;
 pub mod meta;
 pub mod openapi;
+pub mod picture;
 pub mod pool;
 pub mod problem;
 pub mod serve;
@@ -59,6 +60,13 @@ pub enum ProblemResponses {
         content_type = "application/problem+json"
     )]
     MalformedJson(Problem),
+    /// The endpoint has no picture (`Accept: image/svg+xml`).
+    #[response(
+        status = 406,
+        description = "No representation in the accepted media type (`/problems/not-acceptable`)",
+        content_type = "application/problem+json"
+    )]
+    NotAcceptable(Problem),
     /// The body did not arrive within the body timeout.
     #[response(
         status = 408,
@@ -171,6 +179,7 @@ pub fn app(state: AppState) -> Router {
         .with_state(state)
         .layer(DefaultBodyLimit::max(body_limit))
         .layer(CatchPanicLayer::custom(panic_response))
+        .layer(middleware::from_fn(picture::picture))
         .layer(middleware::from_fn(stream::event_stream))
         .layer(middleware::from_fn(layers::log_request));
     for (name, value) in layers::hardening_headers() {

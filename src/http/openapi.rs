@@ -122,6 +122,7 @@ fn build() -> (Value, Vec<String>) {
     {
         allow_null_for_optional_request_fields(schemas, &request_roots);
     }
+    document_alternative_media_types(&mut doc);
     (doc, problems)
 }
 
@@ -446,5 +447,36 @@ fn admit_null(body: &mut Value) {
             "oneOf".to_owned(),
             json!([{ "allOf": parts }, { "type": "null" }]),
         );
+    }
+}
+
+/// Every calculation can also answer as an event stream (progress, then the JSON answer) and,
+/// where it has a picture, as SVG; the 200 response of each POST operation says so.
+fn document_alternative_media_types(doc: &mut Value) {
+    let Some(paths) = doc.get_mut("paths").and_then(Value::as_object_mut) else {
+        return;
+    };
+    for (route, item) in paths.iter_mut() {
+        let Some(content) = item
+            .pointer_mut("/post/responses/200/content")
+            .and_then(Value::as_object_mut)
+        else {
+            continue;
+        };
+        content.insert(
+            "text/event-stream".to_owned(),
+            json!({"schema": {"type": "string", "description":
+                "With `Accept: text/event-stream`: Server-Sent Events `progress` ({fraction, best?, \
+                 elapsed_ms}) while the calculation runs, then one `result` event whose data is the \
+                 JSON answer above (or one `problem` event with the problem details)."}}),
+        );
+        if crate::plot::has_picture(route) {
+            content.insert(
+                "image/svg+xml".to_owned(),
+                json!({"schema": {"type": "string", "description":
+                    "With `Accept: image/svg+xml`: the answer's picture (SVG; axes carry quantity \
+                     and unit)."}}),
+            );
+        }
     }
 }

@@ -189,6 +189,17 @@ impl ApiError {
         e
     }
 
+    /// 406: the endpoint has no representation in the media type the client accepts.
+    pub fn not_acceptable(route: &str) -> Self {
+        Self::new(
+            StatusCode::NOT_ACCEPTABLE,
+            "not-acceptable",
+            "Not acceptable",
+            "NOT_ACCEPTABLE",
+            format!("{route} answers application/json (and text/event-stream); it has no picture"),
+        )
+    }
+
     /// 408: the request body did not arrive within the body timeout.
     pub fn request_timeout(timeout_ms: u64) -> Self {
         Self::new(

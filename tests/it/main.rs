@@ -29,3 +29,4 @@ mod paper_cognates;
 mod paper_component_importance;
 mod paper_continuum_workspace;
 mod paper_irefc;
+mod pictures;
