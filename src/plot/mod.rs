@@ -7,8 +7,13 @@
 //! Axes carry quantity and unit; colours come from the Okabe–Ito palette, which stays
 //! distinguishable for colour-blind readers, and series also differ by marker or dash.
 
+mod bus_fuel_economy;
 mod cam_law;
+mod cam_law_fit;
 mod cognates;
+mod component_importance;
+mod continuum_workspace;
+mod irefc;
 pub mod style;
 
 use serde_json::Value;
@@ -46,9 +51,44 @@ const PICTURES: &[Picture] = &[
         render: cam_law::render,
     },
     Picture {
+        route: "/v1/fit-cam-law",
+        prepare: cam_law_fit::prepare,
+        render: cam_law_fit::render,
+    },
+    Picture {
         route: "/v1/cognates",
         prepare: cognates::prepare,
         render: cognates::render,
+    },
+    Picture {
+        route: "/v1/component-importance",
+        prepare: component_importance::prepare,
+        render: component_importance::render,
+    },
+    Picture {
+        route: "/v1/bus-fuel-economy",
+        prepare: bus_fuel_economy::prepare,
+        render: bus_fuel_economy::render,
+    },
+    Picture {
+        route: "/v1/bus-fuel-economy/motor-map",
+        prepare: bus_fuel_economy::prepare_map,
+        render: bus_fuel_economy::render_map,
+    },
+    Picture {
+        route: "/v1/irefc-stress",
+        prepare: irefc::prepare_stress,
+        render: irefc::render_stress,
+    },
+    Picture {
+        route: "/v1/irefc-efficiency",
+        prepare: irefc::prepare_efficiency,
+        render: irefc::render_efficiency,
+    },
+    Picture {
+        route: "/v1/continuum-workspace",
+        prepare: continuum_workspace::prepare,
+        render: continuum_workspace::render,
     },
 ];
 

@@ -12,15 +12,7 @@ use mechcalc::{AppState, app};
 use tower::ServiceExt;
 
 /// Endpoints whose picture is still being drawn (transitional: the list must end empty).
-const PENDING_PICTURES: &[&str] = &[
-    "/v1/fit-cam-law",
-    "/v1/component-importance",
-    "/v1/bus-fuel-economy",
-    "/v1/bus-fuel-economy/motor-map",
-    "/v1/irefc-stress",
-    "/v1/irefc-efficiency",
-    "/v1/continuum-workspace",
-];
+const PENDING_PICTURES: &[&str] = &[];
 
 async fn svg_of(endpoint: &str, body: &serde_json::Value) -> (u16, String, String) {
     let req = Request::builder()
