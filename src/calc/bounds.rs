@@ -197,8 +197,7 @@ macro_rules! schema_bounds {
                 {
                     // Fails to compile when the field does not exist.
                     let _ = |x: &$ty| { let _ = &x.$field; };
-                    let property: &'static str = stringify!($field);
-                    $( let property: &'static str = $wire; )?
+                    let property: &'static str = [$($wire,)? stringify!($field)][0];
                     let items = false $( || stringify!($items) == "items" )?;
                     v.push($crate::calc::bounds::SchemaBound {
                         schema: <$ty as ::utoipa::ToSchema>::name(),

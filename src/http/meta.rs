@@ -23,7 +23,6 @@ pub struct Health {
     #[schema(example = "0.1.0")]
     pub version: &'static str,
     /// Compute slots free right now.
-    #[schema(minimum = 0)]
     pub compute_slots_free: usize,
 }
 

@@ -265,10 +265,8 @@ pub struct SolverReport {
     /// How the solver stopped.
     pub stop_reason: StopReason,
     /// Iterations (generations, Newton steps, sweep nodes) performed.
-    #[schema(minimum = 0)]
     pub iterations: u64,
     /// Model/objective evaluations performed.
-    #[schema(minimum = 0)]
     pub evaluations: u64,
     /// Wall-clock time spent in the solver [ms].
     pub elapsed_ms: f64,

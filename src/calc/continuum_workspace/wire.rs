@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::calc::Range;
 use crate::numerics::SolverReport;
 
 /// What to compute.
@@ -85,7 +86,7 @@ pub struct ContinuumWorkspaceRequest {
     pub assembly_modes: Option<AssemblyModesRequest>,
     /// Wall-clock limit for this request [ms] (extension; capped by the service limit).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 120_000, example = 10_000)]
+    #[schema(example = 10_000)]
     pub time_limit_ms: Option<u64>,
 }
 
@@ -112,7 +113,7 @@ pub struct DesignRequest {
     pub home_inputs_m: Option<Vec<f64>>,
     /// Allowable bending stress [Pa]: FK warnings and default workspace stress limit.
     #[serde(default)]
-    #[schema(minimum = 0.0, example = 1.2e9)]
+    #[schema(example = 1.2e9)]
     pub sigma_allow_pa: Option<f64>,
 }
 
@@ -138,7 +139,7 @@ pub struct ActuatorRequest {
 #[serde(deny_unknown_fields)]
 pub struct RodRequest {
     /// Index `j(i)` of the actuator carrying the clamp.
-    #[schema(minimum = 0, maximum = 3, example = 0)]
+    #[schema(example = 0)]
     pub actuator: usize,
     /// Clamp offset `c_i` on the carriage [m].
     #[serde(default)]
@@ -149,21 +150,21 @@ pub struct RodRequest {
     #[schema(example = -60.0)]
     pub clamp_angle_deg: f64,
     /// Rod length `L_i` [m].
-    #[schema(exclusive_minimum = 0.0, example = 0.5)]
+    #[schema(example = 0.5)]
     pub length_m: f64,
     /// Solid round section diameter `d_i` [m] (L/d >= 20 recommended, >= 5 required).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, example = 0.004)]
+    #[schema(example = 0.004)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub diameter_m: Option<f64>,
     /// Bending stiffness `EI_i` [N m^2] (alternative to the diameter; overrides `E pi d^4/64`).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, example = 2.63894)]
+    #[schema(example = 2.63894)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ei_nm2: Option<f64>,
     /// Young's modulus `E_i` [Pa] (default 2.1e11).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, example = 2.1e11)]
+    #[schema(example = 2.1e11)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub youngs_modulus_pa: Option<f64>,
     /// Platform point `r_i` in the platform frame [m].
@@ -193,15 +194,15 @@ pub struct LoadRequest {
 pub struct SolverRequest {
     /// Base RK4 steps per rod (raised by the load rule of spec 4.1).
     #[serde(default)]
-    #[schema(minimum = 4, maximum = 4096, example = 32)]
+    #[schema(example = 32)]
     pub rk4_steps: Option<u32>,
     /// Newton stop on the scaled residual (inf-norm).
     #[serde(default)]
-    #[schema(minimum = 1e-14, maximum = 1e-4, example = 1e-10)]
+    #[schema(example = 1e-10)]
     pub tol: Option<f64>,
     /// Newton iterations per solve.
     #[serde(default)]
-    #[schema(minimum = 5, maximum = 200, example = 50)]
+    #[schema(example = 50)]
     pub max_iter: Option<u32>,
     /// Add axial compliance `EA = E pi d^2/4` (recommended for N >= 4).
     #[serde(default)]
@@ -244,12 +245,12 @@ pub struct StartRequest {
     pub state: Option<SolverState>,
     /// Assembly-mode index in the margin-sorted list (kind = assembly_mode; default 0).
     #[serde(default)]
-    #[schema(minimum = 0, example = 0)]
+    #[schema(example = 0)]
     pub index: Option<usize>,
     /// Override of the number of equal continuation steps from home (extension; default
     /// `max(10, ceil(max |dlambda| / (0.01 L_ref)))`).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 10_000, example = 30)]
+    #[schema(example = 30)]
     pub continuation_steps: Option<u32>,
 }
 
@@ -264,11 +265,11 @@ pub struct OutputsRequest {
     pub stability: Option<bool>,
     /// Segments per rod `M` of the stability test.
     #[serde(default)]
-    #[schema(minimum = 10, maximum = 400, example = 40)]
+    #[schema(example = 40)]
     pub stability_segments: Option<u32>,
     /// Sample points per rod of the returned shapes (0 = none).
     #[serde(default)]
-    #[schema(minimum = 0, maximum = 1000, example = 0)]
+    #[schema(example = 0)]
     pub rod_shape_points: Option<u32>,
 }
 
@@ -303,7 +304,6 @@ pub struct SeedRequest {
     pub state: Option<SolverState>,
     /// Assembly-mode index (kind = assembly_mode; default 0).
     #[serde(default)]
-    #[schema(minimum = 0)]
     pub index: Option<usize>,
 }
 
@@ -314,11 +314,11 @@ pub struct SeedRequest {
 pub struct JumpLimits {
     /// Largest platform rotation per sub-step [deg].
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 180.0, example = 5.0)]
+    #[schema(example = 5.0)]
     pub angle_deg: Option<f64>,
     /// Largest platform displacement per sub-step as a multiple of the input change.
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 1000.0, example = 5.0)]
+    #[schema(example = 5.0)]
     pub position_factor: Option<f64>,
 }
 
@@ -358,7 +358,6 @@ pub struct WorkspaceLimits {
     pub min_actuator_gap_m: Option<f64>,
     /// Allowable bending stress [Pa]; null = `design.sigma_allow_pa` or none.
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0)]
     pub sigma_allow_pa: Option<f64>,
     /// `ignore` (default) or `reject`.
     #[serde(default)]
@@ -403,17 +402,17 @@ pub struct WorkspaceRequest {
     pub predictor: Option<bool>,
     /// Largest number of sub-steps, a power of two 1..64 (default 8).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 64, example = 8)]
+    #[schema(example = 8)]
     pub max_substeps: Option<u32>,
     /// Attempts per node 1..8 (default 4).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 8, example = 4)]
+    #[schema(example = 4)]
     pub max_tries: Option<u32>,
     /// Newton iterations per sub-step solve, capped by `solver.max_iter` (default 20; extension:
     /// a sub-step started from the tangent predictor converges in 2-7 iterations, a solve still
     /// wandering after 20 is abandoned for smaller sub-steps).
     #[serde(default)]
-    #[schema(minimum = 5, maximum = 200, example = 20)]
+    #[schema(example = 20)]
     pub substep_max_iter: Option<u32>,
     /// Jump limits per sub-step.
     #[serde(default)]
@@ -421,7 +420,7 @@ pub struct WorkspaceRequest {
     pub jump_limits: Option<JumpLimits>,
     /// Largest accepted condition number of the scaled Jacobian (default 1e12).
     #[serde(default)]
-    #[schema(minimum = 10.0, maximum = 1e18, example = 1e12)]
+    #[schema(example = 1e12)]
     pub cond_max: Option<f64>,
     /// `full` (default), `det_sign` or `none`.
     #[serde(default)]
@@ -429,7 +428,7 @@ pub struct WorkspaceRequest {
     pub stability_check: Option<StabilityCheckName>,
     /// Segments per rod of the stability test (default 20 in sweeps).
     #[serde(default)]
-    #[schema(minimum = 10, maximum = 400, example = 20)]
+    #[schema(example = 20)]
     pub stability_segments: Option<u32>,
     /// Physical limits.
     #[serde(default)]
@@ -437,7 +436,7 @@ pub struct WorkspaceRequest {
     pub limits: Option<WorkspaceLimits>,
     /// Threshold of the quasi-translational area [deg] (default 1).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 180.0, example = 1.0)]
+    #[schema(example = 1.0)]
     pub quasi_translational_deg: Option<f64>,
     /// `union` (default) or `sum`.
     #[serde(default)]
@@ -458,20 +457,20 @@ pub struct AssemblyModesRequest {
     /// 4 rods, 2 for 5 or more); the search that picks the start of a design without a
     /// stress-free home defaults to min(6, that).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 50, example = 9)]
+    #[schema(example = 9)]
     pub n_grid: Option<u32>,
     /// `Tol` on the normalised grid residual, dimensionless (default 0.5; 0.45 for the start of a
     /// design without a stress-free home).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 10.0, example = 0.5)]
+    #[schema(example = 0.5)]
     pub tol: Option<f64>,
     /// Coarse cell size (default 2).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 100, example = 2)]
+    #[schema(example = 2)]
     pub cell: Option<u32>,
     /// Maximum Newton refinements (default 4000).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 20_000, example = 4000)]
+    #[schema(example = 4000)]
     pub max_refine: Option<u32>,
 }
 
@@ -482,15 +481,12 @@ pub struct AssemblyModesRequest {
 #[schema(as = continuum_workspace::ModeSearchOut)]
 pub struct ModeSearchOut {
     /// `N_grid`.
-    #[schema(minimum = 1, maximum = 50)]
     pub n_grid: u64,
     /// `Tol` on the normalised grid residual, dimensionless.
     pub tol: f64,
     /// Coarse cell size in grid indices.
-    #[schema(minimum = 1, maximum = 100)]
     pub cell: u64,
     /// Newton refinement cap.
-    #[schema(minimum = 1, maximum = 20_000)]
     pub max_refine: u64,
 }
 
@@ -809,4 +805,64 @@ pub struct AssemblyModesResponse {
     pub preset: Option<PresetOut>,
     /// Cost and stop reason.
     pub report: SolverReport,
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+crate::schema_bounds! {
+    ContinuumWorkspaceRequest {
+        time_limit_ms: Range::INTEGER.min(1.0).max(120000.0),
+    },
+    DesignRequest {
+        sigma_allow_pa: Range::FINITE.min(0.0),
+    },
+    RodRequest {
+        actuator: Range::INTEGER.min(0.0).max(3.0),
+        length_m: Range::FINITE.gt(0.0),
+        diameter_m: Range::FINITE.gt(0.0),
+        ei_nm2: Range::FINITE.gt(0.0),
+        youngs_modulus_pa: Range::FINITE.gt(0.0),
+    },
+    SolverRequest {
+        rk4_steps: Range::INTEGER.min(4.0).max(4096.0),
+        tol: Range::FINITE.min(1e-14).max(1e-4),
+        max_iter: Range::INTEGER.min(5.0).max(200.0),
+    },
+    StartRequest {
+        index: Range::INTEGER.min(0.0),
+        continuation_steps: Range::INTEGER.min(1.0).max(10000.0),
+    },
+    OutputsRequest {
+        stability_segments: Range::INTEGER.min(10.0).max(400.0),
+        rod_shape_points: Range::INTEGER.min(0.0).max(1000.0),
+    },
+    SeedRequest {
+        index: Range::INTEGER.min(0.0),
+    },
+    JumpLimits {
+        angle_deg: Range::FINITE.gt(0.0).max(180.0),
+        position_factor: Range::FINITE.gt(0.0).max(1000.0),
+    },
+    WorkspaceLimits {
+        sigma_allow_pa: Range::FINITE.gt(0.0),
+    },
+    WorkspaceRequest {
+        max_substeps: Range::INTEGER.min(1.0).max(64.0),
+        max_tries: Range::INTEGER.min(1.0).max(8.0),
+        substep_max_iter: Range::INTEGER.min(5.0).max(200.0),
+        cond_max: Range::FINITE.min(10.0).max(1e18),
+        stability_segments: Range::INTEGER.min(10.0).max(400.0),
+        quasi_translational_deg: Range::FINITE.gt(0.0).max(180.0),
+    },
+    AssemblyModesRequest {
+        n_grid: Range::INTEGER.min(1.0).max(50.0),
+        tol: Range::FINITE.gt(0.0).max(10.0),
+        cell: Range::INTEGER.min(1.0).max(100.0),
+        max_refine: Range::INTEGER.min(1.0).max(20000.0),
+    },
+    ModeSearchOut {
+        n_grid: Range::INTEGER.min(1.0).max(50.0),
+        cell: Range::INTEGER.min(1.0).max(100.0),
+        max_refine: Range::INTEGER.min(1.0).max(20000.0),
+    },
 }
