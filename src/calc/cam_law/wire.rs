@@ -260,20 +260,33 @@ pub struct EvaluateResponse {
     pub units: Option<Units>,
 }
 
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
+/// A boundary value (`t_a`, `t_b`, `s_a`, `s_b`, end rates): finite and at most
+/// [`MAX_MAGNITUDE`](super::law::MAX_MAGNITUDE) in magnitude (spec §6 item 9).
+pub const BOUNDARY_VALUE: Range = Range::FINITE
+    .min(-super::law::MAX_MAGNITUDE)
+    .max(super::law::MAX_MAGNITUDE);
+/// A duration coefficient `ĉ_i`: finite and non-negative.
+pub const COEFFICIENT: Range = Range::FINITE.min(0.0);
+/// Points of a uniform abscissa grid.
+pub const GRID_COUNT: Range = Range::int(2, MAX_POINTS as i64);
+
+// The documented bounds of this module's wire types: the validator (input.rs) checks the same
+// constants, and tests/it/contract_bounds.rs probes both.
 crate::schema_bounds! {
+    EvaluateRequest {
+        coefficients @items: COEFFICIENT,
+    },
     ConstraintsIn {
-        t_a: Range::FINITE.min(-1e12).max(1e12),
-        t_b: Range::FINITE.min(-1e12).max(1e12),
-        s_a: Range::FINITE.min(-1e12).max(1e12),
-        s_b: Range::FINITE.min(-1e12).max(1e12),
-        v_a: Range::FINITE.min(-1e12).max(1e12),
-        v_b: Range::FINITE.min(-1e12).max(1e12),
-        a_a: Range::FINITE.min(-1e12).max(1e12),
-        a_b: Range::FINITE.min(-1e12).max(1e12),
+        t_a: BOUNDARY_VALUE,
+        t_b: BOUNDARY_VALUE,
+        s_a: BOUNDARY_VALUE,
+        s_b: BOUNDARY_VALUE,
+        v_a: BOUNDARY_VALUE,
+        v_b: BOUNDARY_VALUE,
+        a_a: BOUNDARY_VALUE,
+        a_b: BOUNDARY_VALUE,
     },
     GridIn {
-        count: Range::INTEGER.min(2.0).max(200000.0),
+        count: GRID_COUNT,
     },
 }
