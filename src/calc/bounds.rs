@@ -167,7 +167,8 @@ fn num(x: f64) -> String {
 pub struct SchemaBound {
     /// The schema name of the wire type (`ToSchema::name`), e.g. `cognates.Links`.
     pub schema: Cow<'static, str>,
-    /// The property as it appears on the wire.
+    /// The property as it appears on the wire, or a JSON pointer into the schema starting with
+    /// `/` (for fields of enum variants, which are rendered inline).
     pub property: &'static str,
     /// The bound applies to each item of an array property, not to the property itself.
     pub items: bool,

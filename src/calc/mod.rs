@@ -31,6 +31,7 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         cam_law::wire::schema_bounds(),
         cam_law_fit::wire::schema_bounds(),
         cognates::wire::schema_bounds(),
+        cognates::wire::variant_bounds(),
         component_importance::wire::schema_bounds(),
         continuum_workspace::wire::schema_bounds(),
         irefc::wire::schema_bounds(),

@@ -165,10 +165,17 @@ fn type_is(schema: &Value, ty: &str) -> bool {
 fn apply_bounds(schemas: &mut Map<String, Value>, bounds: &[SchemaBound]) -> Vec<String> {
     let mut missing = Vec::new();
     for b in bounds {
+        // A property name, or a JSON pointer into the schema (fields of enum variants, which
+        // utoipa renders inline: `/oneOf/0/properties/d`).
         let target = schemas
             .get_mut(b.schema.as_ref())
-            .and_then(|s| s.get_mut("properties"))
-            .and_then(|p| p.get_mut(b.property))
+            .and_then(|s| {
+                if b.property.starts_with('/') {
+                    s.pointer_mut(b.property)
+                } else {
+                    s.get_mut("properties").and_then(|p| p.get_mut(b.property))
+                }
+            })
             .and_then(|p| if b.items { p.get_mut("items") } else { Some(p) })
             .and_then(Value::as_object_mut);
         match target {

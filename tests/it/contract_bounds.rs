@@ -100,7 +100,12 @@ fn walk(doc: &Value, schema: &Value, instance: &Value, pointer: &str, out: &mut 
         }
     }
     match instance {
-        Value::Number(_) if is_type(s, "number") || is_type(s, "integer") => {
+        // A number restricted to listed values (`enum`) is documented by that list.
+        Value::Number(_)
+            if (is_type(s, "number") || is_type(s, "integer"))
+                && s.get("enum").is_none()
+                && s.get("const").is_none() =>
+        {
             let bound = |k: &str, ek: &str| {
                 s.get(k)
                     .and_then(Value::as_f64)

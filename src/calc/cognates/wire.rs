@@ -929,22 +929,63 @@ pub struct Meta {
     pub compute_us: u64,
 }
 
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
+/// Largest magnitude accepted for any coordinate or length: keeps `|B − A|` and every product of
+/// two lengths finite (1e100² = 1e200 < f64::MAX), far beyond any physical unit choice.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+/// A link length [length]: positive and at most [`MAX_MAGNITUDE`].
+pub const LENGTH: Range = Range::FINITE.gt(0.0).max(MAX_MAGNITUDE);
+/// A distance that may be zero [length].
+pub const NON_NEGATIVE_LENGTH: Range = Range::FINITE.min(0.0).max(MAX_MAGNITUDE);
+/// A coordinate or signed length [length].
+pub const COORDINATE: Range = Range::FINITE.min(-MAX_MAGNITUDE).max(MAX_MAGNITUDE);
+/// Samples per circuit N (spec §3).
+pub const POINTS_PER_CIRCUIT: Range = Range::int(16, 100_000);
+/// Relative tolerance of the Grashof classification (spec §3).
+pub const GRASHOF_RTOL: Range = Range::closed(0.0, 1e-3);
+
+// The documented bounds of this module's wire types: the validator (input.rs) checks the same
+// constants, and tests/it/contract_bounds.rs probes both.
 crate::schema_bounds! {
     CognatesRequest {
-        crank: Range::FINITE.gt(0.0),
-        coupler: Range::FINITE.gt(0.0),
-        rocker: Range::FINITE.gt(0.0),
+        crank: LENGTH,
+        coupler: LENGTH,
+        rocker: LENGTH,
     },
     GroundSpec {
-        length: Range::FINITE.gt(0.0),
+        a @items as "A": COORDINATE,
+        b @items as "B": COORDINATE,
+        length: LENGTH,
     },
     JointsSpec {
-        a as "A": Range::FINITE.min(0.0),
+        a @items as "A": COORDINATE,
+        b @items as "B": COORDINATE,
+        d @items as "D": COORDINATE,
+        e @items as "E": COORDINATE,
+        p @items as "P": COORDINATE,
     },
     CognatesOptions {
-        points_per_circuit: Range::INTEGER.min(16.0).max(100000.0),
-        grashof_rtol: Range::FINITE.min(0.0).max(0.001),
+        points_per_circuit: POINTS_PER_CIRCUIT,
+        grashof_rtol: GRASHOF_RTOL,
     },
+}
+
+/// Bounds of the coupler-point forms (fields of enum variants, rendered inline in the document).
+#[must_use]
+pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
+    let name = <CouplerPoint as ToSchema>::name();
+    [
+        ("/oneOf/0/properties/d", NON_NEGATIVE_LENGTH),
+        ("/oneOf/0/properties/e", NON_NEGATIVE_LENGTH),
+        ("/oneOf/1/properties/u", COORDINATE),
+        ("/oneOf/1/properties/v", COORDINATE),
+        ("/oneOf/2/properties/p", NON_NEGATIVE_LENGTH),
+    ]
+    .into_iter()
+    .map(|(property, range)| crate::calc::SchemaBound {
+        schema: name.clone(),
+        property,
+        items: false,
+        range,
+    })
+    .collect()
 }
