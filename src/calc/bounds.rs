@@ -176,6 +176,20 @@ pub struct SchemaBound {
     pub range: Range,
 }
 
+impl SchemaBound {
+    /// A bound at a JSON pointer inside the schema of `T` (fields of enum variants and items of
+    /// untagged alternatives, which the document renders inline).
+    #[must_use]
+    pub fn at<T: utoipa::ToSchema>(pointer: &'static str, range: Range) -> Self {
+        Self {
+            schema: T::name(),
+            property: pointer,
+            items: false,
+            range,
+        }
+    }
+}
+
 /// Declares the documented bounds of a module's wire types, one line per field; expands to
 /// `pub fn schema_bounds() -> Vec<SchemaBound>`. Each field is checked to exist at compile time.
 ///

@@ -33,6 +33,7 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         cognates::wire::schema_bounds(),
         cognates::wire::variant_bounds(),
         component_importance::wire::schema_bounds(),
+        component_importance::wire::variant_bounds(),
         continuum_workspace::wire::schema_bounds(),
         irefc::wire::schema_bounds(),
         irefc::stress::wire::schema_bounds(),

@@ -15,27 +15,14 @@ use serde_json::{Value, json};
 
 /// Fields whose rejection depends on other fields (`endpoint`, pointer): the rule is in the
 /// field's description in the document.
+#[rustfmt::skip]
 const CROSS_FIELD: &[(&str, &str, &str)] = &[
-    (
-        "/v1/cam-law/evaluate",
-        "/constraints/t_b",
-        "t_b > t_a, with t_b − t_a resolvable at the offset",
-    ),
-    (
-        "/v1/cam-law/evaluate",
-        "/abscissa/values/0",
-        "abscissae increase and lie in [t_a, t_b]",
-    ),
-    (
-        "/v1/cam-law/evaluate",
-        "/abscissa/grid/start",
-        "the grid lies in [t_a, t_b]",
-    ),
-    (
-        "/v1/cam-law/evaluate",
-        "/abscissa/grid/end",
-        "end > start, and the grid lies in [t_a, t_b]",
-    ),
+    ("/v1/cam-law/evaluate", "/constraints/t_b", "t_b > t_a, with t_b − t_a resolvable at the offset"),
+    ("/v1/cam-law/evaluate", "/abscissa/values/0", "abscissae increase and lie in [t_a, t_b]"),
+    ("/v1/cam-law/evaluate", "/abscissa/grid/start", "the grid lies in [t_a, t_b]"),
+    ("/v1/cam-law/evaluate", "/abscissa/grid/end", "end > start, and the grid lies in [t_a, t_b]"),
+    ("/v1/component-importance", "/overrides/0/time_h", "one of times_h"),
+    ("/v1/component-importance", "/options/o_out", "q_in + o_out = 1"),
 ];
 
 /// A number in an example request with its documented bound, if any.

@@ -126,14 +126,7 @@ impl Issues {
     fn bounded(&mut self, pointer: &str, name: &str, x: f64, range: Range, what: &str) -> bool {
         if range.contains(x) {
             true
-        } else if x.is_finite() && x > range.hi {
-            self.push(
-                "INVALID_INPUT",
-                pointer,
-                format!("{name} must be {range}, got {x:e}"),
-            );
-            false
-        } else if x.is_finite() && x < range.lo && range.lo < 0.0 {
+        } else if x.is_finite() && (x > range.hi || (x < range.lo && range.lo < 0.0)) {
             self.push(
                 "INVALID_INPUT",
                 pointer,

@@ -972,20 +972,12 @@ crate::schema_bounds! {
 /// Bounds of the coupler-point forms (fields of enum variants, rendered inline in the document).
 #[must_use]
 pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
-    let name = <CouplerPoint as ToSchema>::name();
-    [
-        ("/oneOf/0/properties/d", NON_NEGATIVE_LENGTH),
-        ("/oneOf/0/properties/e", NON_NEGATIVE_LENGTH),
-        ("/oneOf/1/properties/u", COORDINATE),
-        ("/oneOf/1/properties/v", COORDINATE),
-        ("/oneOf/2/properties/p", NON_NEGATIVE_LENGTH),
+    use crate::calc::SchemaBound;
+    vec![
+        SchemaBound::at::<CouplerPoint>("/oneOf/0/properties/d", NON_NEGATIVE_LENGTH),
+        SchemaBound::at::<CouplerPoint>("/oneOf/0/properties/e", NON_NEGATIVE_LENGTH),
+        SchemaBound::at::<CouplerPoint>("/oneOf/1/properties/u", COORDINATE),
+        SchemaBound::at::<CouplerPoint>("/oneOf/1/properties/v", COORDINATE),
+        SchemaBound::at::<CouplerPoint>("/oneOf/2/properties/p", NON_NEGATIVE_LENGTH),
     ]
-    .into_iter()
-    .map(|(property, range)| crate::calc::SchemaBound {
-        schema: name.clone(),
-        property,
-        items: false,
-        range,
-    })
-    .collect()
 }

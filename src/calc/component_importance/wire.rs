@@ -477,7 +477,15 @@ pub struct KendallTau {
 
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
+/// An operating time [h]: positive (t = 0 makes every index 0, spec §6 H1).
+pub const TIME_H: Range = Range::FINITE.gt(0.0);
+/// A constant weight of the probability/risk pair: positive (the pair sums to 1).
+pub const WEIGHT: Range = Range::FINITE.gt(0.0);
+
 crate::schema_bounds! {
+    ComponentImportanceRequest {
+        times_h @items: TIME_H,
+    },
     Options {
         max_simple_paths: Range::FINITE.min(1000.0).max(100_000_000.0),
     },
@@ -499,4 +507,13 @@ crate::schema_bounds! {
         o_out: Range::FINITE.min(0.0).max(1.0),
         path_cap: Range::INTEGER.min(1.0).max(8.0),
     },
+}
+
+/// Bounds inside the untagged constant-weights alternatives (rendered inline).
+#[must_use]
+pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
+    vec![crate::calc::SchemaBound::at::<ConstantWeights>(
+        "/oneOf/0/items",
+        WEIGHT,
+    )]
 }
