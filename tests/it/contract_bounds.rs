@@ -23,6 +23,10 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/cam-law/evaluate", "/abscissa/grid/end", "end > start, and the grid lies in [t_a, t_b]"),
     ("/v1/component-importance", "/overrides/0/time_h", "one of times_h"),
     ("/v1/component-importance", "/options/o_out", "q_in + o_out = 1"),
+    ("/v1/fit-cam-law", "/constraints/t_b", "t_b > t_a"),
+    ("/v1/fit-cam-law", "/abscissa/grid/end", "end > start"),
+    ("/v1/irefc-stress", "/sweep/Z2/to", "to ≥ from"),
+    ("/v1/irefc-stress", "/sweep/chi/to", "to ≥ from"),
 ];
 
 /// A number in an example request with its documented bound, if any.

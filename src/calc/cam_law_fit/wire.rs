@@ -460,19 +460,28 @@ pub struct OptimizerReport {
 
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
+/// A sampled value (data channel, boundary value): finite and within the law's magnitude cap
+/// (rescale the unit beyond it); the same bound as the evaluator's boundary values.
+pub const DATA_VALUE: Range = crate::calc::cam_law::wire::BOUNDARY_VALUE;
+
 crate::schema_bounds! {
+    Channels {
+        displacement @items: DATA_VALUE,
+        velocity @items: DATA_VALUE,
+        acceleration @items: DATA_VALUE,
+    },
     FitGrid {
         count: Range::INTEGER.min(8.0).max(200000.0),
     },
     FitConstraints {
-        t_a: Range::FINITE.min(-1e12).max(1e12),
-        t_b: Range::FINITE.min(-1e12).max(1e12),
-        s_a: Range::FINITE.min(-1e12).max(1e12),
-        s_b: Range::FINITE.min(-1e12).max(1e12),
-        v_a: Range::FINITE.min(-1e12).max(1e12),
-        v_b: Range::FINITE.min(-1e12).max(1e12),
-        a_a: Range::FINITE.min(-1e12).max(1e12),
-        a_b: Range::FINITE.min(-1e12).max(1e12),
+        t_a: DATA_VALUE,
+        t_b: DATA_VALUE,
+        s_a: DATA_VALUE,
+        s_b: DATA_VALUE,
+        v_a: DATA_VALUE,
+        v_b: DATA_VALUE,
+        a_a: DATA_VALUE,
+        a_b: DATA_VALUE,
     },
     ObjectiveIn {
         dtw_window: Range::INTEGER.min(0.0).max(200000.0),
