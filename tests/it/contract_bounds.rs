@@ -27,6 +27,14 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/fit-cam-law", "/abscissa/grid/end", "end > start"),
     ("/v1/irefc-stress", "/sweep/Z2/to", "to ≥ from"),
     ("/v1/irefc-stress", "/sweep/chi/to", "to ≥ from"),
+    ("/v1/continuum-workspace", "/inputs_m/0", "within the actuator's stroke"),
+    ("/v1/continuum-workspace", "/design/rods/0/actuator", "an index of design.actuators"),
+    ("/v1/bus-fuel-economy", "/motors/0/lq_h", "lq_h ≥ ld_h"),
+    ("/v1/bus-fuel-economy", "/motors/0/n_max_rpm", "above the cycles' top motor speed"),
+    ("/v1/bus-fuel-economy/motor-map", "/motor/lq_h", "lq_h ≥ ld_h"),
+    ("/v1/continuum-workspace", "/design/rods/0/diameter_m", "slenderness length_m / diameter_m ≥ 5"),
+    ("/v1/continuum-workspace", "/load/moment_nm", "within 1e4 F_ref L_ref of the design's own scale"),
+    ("/v1/continuum-workspace", "/load/force_n/0", "within 1e4 F_ref of the design's own scale"),
 ];
 
 /// A number in an example request with its documented bound, if any.

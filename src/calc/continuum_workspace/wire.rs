@@ -395,8 +395,8 @@ pub struct WorkspaceRequest {
     pub seed: Option<SeedRequest>,
     /// 4 (default) or 8 neighbours.
     #[serde(default)]
-    #[schema(example = 4)]
-    pub neighbours: Option<u32>,
+    #[schema(nullable = false, example = 4)]
+    pub neighbours: Option<Neighbours>,
     /// Tangent predictor (default true).
     #[serde(default)]
     pub predictor: Option<bool>,
@@ -809,60 +809,167 @@ pub struct AssemblyModesResponse {
 
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
+/// Largest accepted coordinate, stroke or length magnitude [m]: the scales the service is
+/// tested at run from 1e-6 m to 1e6 m; beyond, products such as EI or B x n leave the range
+/// where the scaled residual is meaningful.
+pub const MAX_COORD_M: f64 = 1e6;
+/// A coordinate, stroke end or actuator input [m].
+pub const COORDINATE_M: Range = Range::FINITE.min(-MAX_COORD_M).max(MAX_COORD_M);
+/// A rod length [m] (see [`MAX_COORD_M`]).
+pub const LENGTH_M: Range = Range::FINITE.min(1e-7).max(MAX_COORD_M);
+/// A rod diameter [m] (EI ~ d^4 must stay a normal float).
+pub const DIAMETER_M: Range = Range::FINITE.min(1e-9).max(MAX_COORD_M);
+/// Young's modulus [Pa] (gels to beyond diamond).
+pub const YOUNGS_MODULUS_PA: Range = Range::closed(1.0, 1e13);
+/// Bending stiffness given directly [N m^2].
+pub const EI_NM2: Range = Range::closed(1e-30, 1e20);
+/// Allowable stress [Pa].
+pub const SIGMA_ALLOW_PA: Range = Range::FINITE.min(f64::MIN_POSITIVE).max(1e15);
+
+/// RK4 steps per rod (spec 4.1).
+pub const RK4_STEPS: Range = Range::int(4, 4096);
+/// Newton tolerance on the scaled residual (spec 4.2).
+pub const SOLVER_TOL: Range = Range::closed(1e-14, 1e-4);
+/// Newton iterations per solve.
+pub const SOLVER_MAX_ITER: Range = Range::int(5, 200);
+/// Continuation steps from home.
+pub const CONTINUATION_STEPS: Range = Range::int(1, 10_000);
+/// Segments per rod of the stability test (spec 4.5).
+pub const STABILITY_SEGMENTS: Range = Range::int(10, 400);
+/// Sample points per returned rod shape.
+pub const ROD_SHAPE_POINTS: Range = Range::int(0, 1000);
+/// Coarse grid of the assembly-mode search (spec 4.6).
+pub const N_GRID: Range = Range::int(1, 50);
+/// Clustering tolerance of the assembly-mode search.
+pub const ASSEMBLY_MODES_TOL: Range = Range::closed(f64::MIN_POSITIVE, 10.0);
+/// Search-cell size of the assembly-mode search.
+pub const CELL: Range = Range::int(1, 100);
+/// Largest number of refined cells of the assembly-mode search.
+pub const MAX_REFINE: Range = Range::int(1, 20_000);
+/// Substeps of one workspace edge.
+pub const MAX_SUBSTEPS: Range = Range::int(1, 64);
+/// Attempts per workspace node.
+pub const MAX_TRIES: Range = Range::int(1, 8);
+/// Newton iterations per substep.
+pub const SUBSTEP_MAX_ITER: Range = Range::int(5, 200);
+/// Largest accepted jump of the platform angle between neighbours [deg].
+pub const JUMP_LIMITS_ANGLE_DEG: Range = Range::closed(1e-6, 180.0);
+/// Largest accepted position jump, in units of the grid step.
+pub const JUMP_LIMITS_POSITION_FACTOR: Range = Range::closed(1e-6, 1000.0);
+/// Largest accepted Jacobian condition number.
+pub const COND_MAX: Range = Range::closed(10.0, 1e18);
+/// Parasitic-angle threshold of the quasi-translational area [deg].
+pub const QUASI_TRANSLATIONAL_DEG: Range = Range::closed(1e-9, 180.0);
+/// Nodes per side of the workspace grid (spec 4.7).
+pub const GRID_SIDE: Range = Range::int(2, 401);
+
 crate::schema_bounds! {
     ContinuumWorkspaceRequest {
-        time_limit_ms: Range::INTEGER.min(1.0).max(120000.0),
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
+        inputs_m @items: COORDINATE_M,
     },
     DesignRequest {
-        sigma_allow_pa: Range::FINITE.min(0.0),
+        sigma_allow_pa: SIGMA_ALLOW_PA,
+        home_inputs_m @items: COORDINATE_M,
+    },
+    ActuatorRequest {
+        origin_m @items: COORDINATE_M,
+        stroke_m @items: COORDINATE_M,
     },
     RodRequest {
         actuator: Range::INTEGER.min(0.0).max(3.0),
-        length_m: Range::FINITE.gt(0.0),
-        diameter_m: Range::FINITE.gt(0.0),
-        ei_nm2: Range::FINITE.gt(0.0),
-        youngs_modulus_pa: Range::FINITE.gt(0.0),
+        offset_m @items: COORDINATE_M,
+        attach_m @items: COORDINATE_M,
+        length_m: LENGTH_M,
+        diameter_m: DIAMETER_M,
+        ei_nm2: EI_NM2,
+        youngs_modulus_pa: YOUNGS_MODULUS_PA,
     },
     SolverRequest {
-        rk4_steps: Range::INTEGER.min(4.0).max(4096.0),
-        tol: Range::FINITE.min(1e-14).max(1e-4),
-        max_iter: Range::INTEGER.min(5.0).max(200.0),
+        rk4_steps: RK4_STEPS,
+        tol: SOLVER_TOL,
+        max_iter: SOLVER_MAX_ITER,
     },
     StartRequest {
         index: Range::INTEGER.min(0.0),
-        continuation_steps: Range::INTEGER.min(1.0).max(10000.0),
+        continuation_steps: CONTINUATION_STEPS,
     },
     OutputsRequest {
-        stability_segments: Range::INTEGER.min(10.0).max(400.0),
-        rod_shape_points: Range::INTEGER.min(0.0).max(1000.0),
+        stability_segments: STABILITY_SEGMENTS,
+        rod_shape_points: ROD_SHAPE_POINTS,
     },
     SeedRequest {
         index: Range::INTEGER.min(0.0),
     },
     JumpLimits {
-        angle_deg: Range::FINITE.gt(0.0).max(180.0),
-        position_factor: Range::FINITE.gt(0.0).max(1000.0),
+        angle_deg: JUMP_LIMITS_ANGLE_DEG,
+        position_factor: JUMP_LIMITS_POSITION_FACTOR,
     },
     WorkspaceLimits {
-        sigma_allow_pa: Range::FINITE.gt(0.0),
+        min_actuator_gap_m: COORDINATE_M,
+        sigma_allow_pa: SIGMA_ALLOW_PA,
     },
     WorkspaceRequest {
-        max_substeps: Range::INTEGER.min(1.0).max(64.0),
-        max_tries: Range::INTEGER.min(1.0).max(8.0),
-        substep_max_iter: Range::INTEGER.min(5.0).max(200.0),
-        cond_max: Range::FINITE.min(10.0).max(1e18),
-        stability_segments: Range::INTEGER.min(10.0).max(400.0),
-        quasi_translational_deg: Range::FINITE.gt(0.0).max(180.0),
+        grid @items: GRID_SIDE,
+        max_substeps: MAX_SUBSTEPS,
+        max_tries: MAX_TRIES,
+        substep_max_iter: SUBSTEP_MAX_ITER,
+        cond_max: COND_MAX,
+        stability_segments: STABILITY_SEGMENTS,
+        quasi_translational_deg: QUASI_TRANSLATIONAL_DEG,
     },
     AssemblyModesRequest {
-        n_grid: Range::INTEGER.min(1.0).max(50.0),
-        tol: Range::FINITE.gt(0.0).max(10.0),
-        cell: Range::INTEGER.min(1.0).max(100.0),
-        max_refine: Range::INTEGER.min(1.0).max(20000.0),
+        n_grid: N_GRID,
+        tol: ASSEMBLY_MODES_TOL,
+        cell: CELL,
+        max_refine: MAX_REFINE,
     },
     ModeSearchOut {
-        n_grid: Range::INTEGER.min(1.0).max(50.0),
-        cell: Range::INTEGER.min(1.0).max(100.0),
-        max_refine: Range::INTEGER.min(1.0).max(20000.0),
+        n_grid: N_GRID,
+        cell: CELL,
+        max_refine: MAX_REFINE,
     },
+}
+
+/// Bounds of nested arrays (rendered inline).
+#[must_use]
+pub fn nested_bounds() -> Vec<crate::calc::SchemaBound> {
+    vec![crate::calc::SchemaBound::at::<WorkspaceRequest>(
+        "/properties/ranges_m/items/items",
+        COORDINATE_M,
+    )]
+}
+
+/// Neighbourhood of the workspace wave: the integer 4 or 8.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "u32")]
+pub struct Neighbours(pub u32);
+
+impl TryFrom<u32> for Neighbours {
+    type Error = String;
+    fn try_from(n: u32) -> Result<Self, String> {
+        if n == 4 || n == 8 {
+            Ok(Self(n))
+        } else {
+            Err(format!("must be 4 or 8, got {n}"))
+        }
+    }
+}
+
+impl utoipa::PartialSchema for Neighbours {
+    fn schema() -> utoipa::openapi::RefOr<utoipa::openapi::schema::Schema> {
+        utoipa::openapi::schema::ObjectBuilder::new()
+            .schema_type(utoipa::openapi::schema::SchemaType::new(
+                utoipa::openapi::schema::Type::Integer,
+            ))
+            .enum_values(Some([4, 8]))
+            .description(Some("4 or 8 neighbours."))
+            .into()
+    }
+}
+
+impl ToSchema for Neighbours {
+    fn name() -> std::borrow::Cow<'static, str> {
+        std::borrow::Cow::Borrowed("continuum_workspace.Neighbours")
+    }
 }
