@@ -98,6 +98,9 @@ fn build() -> (Value, Vec<String>) {
         .and_then(Value::as_object_mut)
     {
         problems.extend(literal_bounds(schemas));
+        for s in schemas.values_mut() {
+            unsigned_32_bit_range(s);
+        }
         problems.extend(apply_bounds(schemas, &crate::calc::schema_bounds()));
         close_tagged_enums(schemas);
     }
@@ -485,5 +488,25 @@ fn document_alternative_media_types(doc: &mut Value) {
                      and unit)."}}),
             );
         }
+    }
+}
+
+/// utoipa writes `u32` as `format: int32, minimum: 0`, and validators read `int32` as at most
+/// 2^31 − 1, while the service accepts every `u32`: say `int64` with the true maximum instead
+/// (a table bound, applied afterwards, narrows it further where the module has one).
+fn unsigned_32_bit_range(v: &mut Value) {
+    match v {
+        Value::Object(m) => {
+            let unsigned32 = m.get("format").and_then(Value::as_str) == Some("int32")
+                && m.get("minimum").and_then(Value::as_f64) == Some(0.0)
+                && type_is(&Value::Object(m.clone()), "integer");
+            if unsigned32 {
+                m.insert("format".to_owned(), json!("int64"));
+                m.entry("maximum").or_insert(json!(u32::MAX));
+            }
+            m.values_mut().for_each(unsigned_32_bit_range);
+        }
+        Value::Array(a) => a.iter_mut().for_each(unsigned_32_bit_range),
+        _ => {}
     }
 }

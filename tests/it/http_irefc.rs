@@ -126,6 +126,31 @@ async fn range_errors_list_every_field_with_code_bad_range() {
     }
 }
 
+/// Scalar Z2 and χ are ignored in a sweep (a warning says so) but still held to their documented
+/// ranges: a request the published schema rejects is not answered 200.
+#[tokio::test]
+async fn ignored_scalars_of_a_sweep_are_still_range_checked() {
+    let mut v = example("stress_sweep");
+    v["chi"] = json!(6.0);
+    v["Z2"] = json!(2);
+    let r = post_json(STRESS, &v).await;
+    let p = r.problem(422);
+    assert_eq!(p["code"], "BAD_RANGE");
+    let ptrs = r.pointers();
+    for q in ["/chi", "/Z2"] {
+        assert!(ptrs.iter().any(|x| x == q), "{q} missing in {ptrs:?}");
+    }
+    v["chi"] = json!(1.5);
+    v["Z2"] = json!(30);
+    let r = post_json(STRESS, &v).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    assert!(
+        r.json()["warnings"]
+            .as_array()
+            .is_some_and(|w| w.iter().any(|x| x["code"] == "FIELD_IGNORED"))
+    );
+}
+
 #[tokio::test]
 async fn infeasible_designs_carry_the_spec_codes() {
     let mut v = example("stress_single");

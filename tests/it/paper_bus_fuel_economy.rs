@@ -650,3 +650,78 @@ fn section8_efficiency_map_conversion() {
         assert!(a.warnings.iter().any(|w| w.contains("extrapolated")));
     }
 }
+
+/// A launch and a hard stop that exceed the constant motor's envelope both ways (the issue 17
+/// case): 0 → 20 m/s in 6 s, 20 s cruise, 20 → 0 m/s in 3 s.
+fn launch_and_stop() -> Value {
+    let mut t = vec![0.0];
+    let mut v = vec![0.0];
+    for k in 1..=6 {
+        t.push(f64::from(k));
+        v.push(20.0 * f64::from(k) / 6.0);
+    }
+    for k in 1..=20 {
+        t.push(6.0 + f64::from(k));
+        v.push(20.0);
+    }
+    for k in 1..=3 {
+        t.push(26.0 + f64::from(k));
+        v.push(20.0 * (1.0 - f64::from(k) / 3.0));
+    }
+    json!({"name": "launch_and_stop", "time_s": t, "speed_mps": v})
+}
+
+/// Issue 17: a constant-efficiency motor beyond its envelope is charged its loss at the torque it
+/// delivers (spec §5.4, "Loss evaluation beyond the envelope"), in every mode and both
+/// directions: the `loss` convention costs at least the `paper` one, the motor's mean efficiency
+/// is its η, and the loss equals |P_m|(1/η − 1) summed over the delivered power. Map and ipmsm
+/// models are evaluated at the clamp and the answer counts those intervals.
+#[test]
+fn issue_17_constant_motor_loss_at_delivered_torque() {
+    let eta = 0.848;
+    let motor = json!({"id": "c", "model": "constant", "efficiency": eta, "t_peak_nm": 300, "n_max_rpm": 6000});
+    for mode in ["backward", "clip", "forward"] {
+        let answer = |conv: &str| {
+            run_json(json!({
+                "cycles": [launch_and_stop()], "motors": [motor.clone()],
+                "options": {"mode": mode, "power_convention": conv, "regen_limit": false,
+                            "outputs": ["loss_breakdown"]}
+            }))
+            .results
+            .remove(0)
+        };
+        let (loss, paper) = (answer("loss"), answer("paper"));
+        assert!(
+            loss.n_regen_limited == 0 && loss.friction_brake_kwh == 0.0,
+            "{mode}"
+        );
+        assert!(
+            loss.energy_in_kwh >= paper.energy_in_kwh - 1e-12,
+            "{mode}: E_in(loss) {} < E_in(paper) {}",
+            loss.energy_in_kwh,
+            paper.energy_in_kwh
+        );
+        assert_eq!(
+            loss.n_loss_clamped, 0,
+            "{mode}: the constant model is never clamped"
+        );
+        let b = loss.loss_breakdown.expect("asked for");
+        // mean = Σ|P_m|Δt / (Σ|P_m|Δt + Σ loss Δt) is η exactly when every interval's loss is
+        // |P_m|(1/η − 1) at the delivered power (a clamped loss made it 0.853 for η = 0.848).
+        let mean = b.mean_motor_efficiency.expect("the motor worked");
+        assert_relative_eq!(mean, eta, max_relative = 1e-12);
+        assert!(
+            loss.n_over_envelope > 0,
+            "{mode}: the launch exceeds the envelope"
+        );
+        assert_relative_eq!(b.motor_charged_kwh, b.motor_model_kwh, max_relative = 1e-12);
+    }
+    // The hard stop brakes beyond −T_max of the demo IPMSM too: evaluated at the clamp, counted.
+    let ipmsm = run_json(json!({
+        "cycles": [launch_and_stop()], "motors": [demo_ipmsm_json("ipm", 0.002)],
+        "options": {"regen_limit": false, "power_convention": "loss"}
+    }))
+    .results
+    .remove(0);
+    assert!(ipmsm.n_loss_clamped > 0, "{}", ipmsm.n_loss_clamped);
+}

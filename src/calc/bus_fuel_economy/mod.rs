@@ -308,6 +308,7 @@ fn result_wire(
         },
         n_regen_limited: s.n_regen_limited,
         n_envelope_fallback: s.n_fallback,
+        n_loss_clamped: s.n_loss_clamped,
         max_motor_torque_demand_nm: s.max_t_demand,
         max_motor_speed_rpm: rad_s_to_rpm(input.vehicle.motor_speed(s.max_speed)),
         friction_brake_kwh: kwh(s.brake),

@@ -220,6 +220,12 @@ pub enum MotorEvaluator<'a> {
 }
 
 impl MotorEvaluator<'_> {
+    /// Whether the loss is evaluated at the torque clamped to the envelope beyond it (maps and
+    /// ipmsm), rather than at the delivered torque (constant efficiency).
+    pub const fn clamps_beyond_envelope(&self) -> bool {
+        !matches!(self, Self::Constant { .. })
+    }
+
     /// T_max(ω) [N·m] (0 above the admissible speed).
     pub fn t_max(&mut self, w: f64) -> f64 {
         match self {
@@ -254,8 +260,10 @@ impl MotorEvaluator<'_> {
     /// (it reproduces the §10 example and the §9 accuracy table to the printed digits).
     pub fn loss(&mut self, w: f64, t_del: f64, t: f64, t_max: f64, want_parts: bool) -> LossEval {
         match self {
+            // The constant model holds at any torque: the delivered one, never the clamp
+            // (spec §5.4, "Loss evaluation beyond the envelope").
             Self::Constant { eta, .. } => LossEval {
-                loss: (t * w).abs() * (1.0 / *eta - 1.0),
+                loss: (t_del * w).abs() * (1.0 / *eta - 1.0),
                 eta_const: Some(*eta),
                 ..LossEval::default()
             },

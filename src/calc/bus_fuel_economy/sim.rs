@@ -195,6 +195,9 @@ pub struct SimOutcome {
     pub n_regen_limited: u64,
     /// ipmsm envelope fallbacks.
     pub n_fallback: u64,
+    /// Moving intervals whose loss was evaluated at the torque clamped to ±T_max (map and ipmsm
+    /// models beyond the envelope).
+    pub n_loss_clamped: u64,
     /// Forward fixed point not converged in 50 iterations.
     pub n_forward_unconverged: u64,
     /// Largest motor torque demand [N·m].
@@ -318,10 +321,14 @@ pub fn simulate(
             0.0
         };
         brake.add(p_brake * dt);
-        // Motor loss at the clamped torque (spec §5.4/5.5).
+        // Motor loss (spec §5.4/5.5): maps and ipmsm at the torque clamped to the envelope,
+        // the constant model at the delivered torque.
         let t_eval = t_del.clamp(-t_max, t_max);
         let le = if vbar > 0.0 {
             out.evaluations += 1;
+            if t_eval != t_del && motor.clamps_beyond_envelope() {
+                out.n_loss_clamped += 1;
+            }
             motor.loss(w, t_del, t_eval, t_max, set.breakdown)
         } else {
             super::motor::LossEval::default()

@@ -695,6 +695,10 @@ pub struct CycleResult {
     /// Intervals where the dq operating point could not be solved inside the envelope and the
     /// envelope point's loss was used (ipmsm only; normally 0).
     pub n_envelope_fallback: u64,
+    /// Moving intervals whose motor loss was evaluated at the torque clamped to ±T_max(ω)
+    /// (loss and efficiency maps and ipmsm, beyond the envelope in either direction; always 0 for
+    /// the constant model, which is evaluated at the delivered torque).
+    pub n_loss_clamped: u64,
     /// Largest motor torque demand T_M [N·m].
     pub max_motor_torque_demand_nm: f64,
     /// Largest motor speed over the (achieved) samples [rpm].

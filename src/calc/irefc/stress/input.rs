@@ -316,6 +316,14 @@ impl StressInput {
                         )
                     }));
                 };
+                // Ignored, but still held to their documented ranges: a request the published
+                // schema rejects is rejected here too.
+                if let Some(v) = req.z2 {
+                    check_z2(&mut is, "/Z2", v);
+                }
+                if let Some(v) = req.chi {
+                    check_chi(&mut is, "/chi", v);
+                }
                 if req.z2.is_some() || req.chi.is_some() {
                     warnings.push(Warning::new(
                         "FIELD_IGNORED",
