@@ -16,6 +16,7 @@ pub mod common;
 pub mod component_importance;
 pub mod continuum_workspace;
 pub mod irefc;
+pub mod machining_size;
 pub mod problem;
 
 pub use bounds::{Range, SchemaBound};
