@@ -109,11 +109,6 @@ impl BoostParams {
     /// Features drawn per tree from `d` candidates: ⌊colsample·d⌋ (the validator rejects 0).
     #[must_use]
     pub fn features_per_tree(&self, d: usize) -> usize {
-        #[expect(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            reason = "a floor of a value in [0, d]"
-        )]
         let k = (self.colsample_bytree * d as f64).floor() as usize;
         k.clamp(1, d.max(1))
     }
@@ -121,11 +116,6 @@ impl BoostParams {
     /// Rows drawn per tree from `n` training rows: max(1, ⌊subsample·n⌋).
     #[must_use]
     pub fn rows_per_tree(&self, n: usize) -> usize {
-        #[expect(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            reason = "a floor of a value in [0, n]"
-        )]
         let k = (self.subsample * n as f64).floor() as usize;
         k.clamp(1, n.max(1))
     }

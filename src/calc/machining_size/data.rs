@@ -133,11 +133,6 @@ pub fn train_test_split(n: usize, test_fraction: f64, seed: u64) -> (Vec<u32>, V
 /// ⌊(1 − test_fraction)·n⌋, the size of the training split.
 #[must_use]
 pub fn n_train_rows(n: usize, test_fraction: f64) -> usize {
-    #[expect(
-        clippy::cast_possible_truncation,
-        clippy::cast_sign_loss,
-        reason = "a floor of a value in [0, n]"
-    )]
     let k = ((1.0 - test_fraction) * n as f64).floor() as usize;
     k.min(n)
 }
@@ -219,6 +214,18 @@ pub fn mean_sd(v: &[f64]) -> (f64, f64) {
     }
     let ss: f64 = v.iter().map(|x| (x - mean) * (x - mean)).sum();
     (mean, (ss / (n - 1) as f64).sqrt())
+}
+
+/// Sample standard deviation (ddof = 1) computed on x/max|x|, so that no square overflows
+/// whatever the magnitude of the values; 0 for fewer than two values.
+#[must_use]
+pub fn scaled_sd(v: &[f64]) -> f64 {
+    let m = v.iter().fold(0.0f64, |a, &x| a.max(x.abs()));
+    if m == 0.0 || !m.is_finite() {
+        return 0.0;
+    }
+    let s: Vec<f64> = v.iter().map(|&x| x / m).collect();
+    mean_sd(&s).1 * m
 }
 
 #[cfg(test)]

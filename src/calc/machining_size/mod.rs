@@ -2,5 +2,10 @@
 
 pub mod boost;
 pub mod data;
+pub mod document;
 pub mod model;
 pub mod rng;
+pub mod shap;
+pub mod gra;
+pub mod pca;
+pub mod smogn;

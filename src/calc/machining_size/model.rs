@@ -210,10 +210,6 @@ impl Model {
     pub fn prepare_row(&self, x: &[f64]) -> Vec<f64> {
         match self.routing {
             Routing::F64 => x.to_vec(),
-            #[expect(
-                clippy::cast_possible_truncation,
-                reason = "rounding to f32 is the point: XGBoost compares float(x) with float(θ)"
-            )]
             Routing::F32 => x.iter().map(|&v| f64::from(v as f32)).collect(),
         }
     }
