@@ -26,5 +26,9 @@ pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validato
 /// document.
 #[must_use]
 pub fn schema_bounds() -> Vec<SchemaBound> {
-    [crate::numerics::budget::schema_bounds()].concat()
+    [
+        crate::numerics::budget::schema_bounds(),
+        machining_size::schema_bounds(),
+    ]
+    .concat()
 }

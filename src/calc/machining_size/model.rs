@@ -214,6 +214,17 @@ impl Model {
         }
     }
 
+    /// [`Model::prepare_row`] in place.
+    #[must_use]
+    pub fn prepare_owned(&self, mut x: Vec<f64>) -> Vec<f64> {
+        if self.routing == Routing::F32 {
+            for v in &mut x {
+                *v = f64::from(*v as f32);
+            }
+        }
+        x
+    }
+
     /// Prediction for a prepared row (see [`Model::prepare_row`]): base + Σ tree outputs, the sum
     /// accumulated from 0 in tree order.
     #[must_use]
