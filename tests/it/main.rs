@@ -28,3 +28,4 @@ mod paper_cognates;
 mod paper_component_importance;
 mod paper_continuum_workspace;
 mod paper_irefc;
+mod paper_machining_size;
