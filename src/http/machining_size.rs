@@ -35,7 +35,10 @@ pub async fn train(
     ApiJson(req): ApiJson<TrainRequest>,
 ) -> Result<Response, ApiError> {
     let limit = req.time_limit();
-    run_calc(&state, limit, move |budget| machining_size::run_train(req, budget)).await
+    run_calc(&state, limit, move |budget| {
+        machining_size::run_train(req, budget)
+    })
+    .await
 }
 
 /// Predict with a model (ours or an XGBoost JSON model) and explain the predictions.
@@ -60,7 +63,10 @@ pub async fn predict(
     ApiJson(req): ApiJson<PredictRequest>,
 ) -> Result<Response, ApiError> {
     let limit = req.time_limit();
-    run_calc(&state, limit, move |budget| machining_size::run_predict(req, budget)).await
+    run_calc(&state, limit, move |budget| {
+        machining_size::run_predict(req, budget)
+    })
+    .await
 }
 
 /// Data diagnostics of the paper: constant columns, PCA, grey relational grades, SMOGN preview.
@@ -83,5 +89,8 @@ pub async fn analyze(
     ApiJson(req): ApiJson<AnalyzeRequest>,
 ) -> Result<Response, ApiError> {
     let limit = req.time_limit();
-    run_calc(&state, limit, move |budget| machining_size::run_analyze(req, budget)).await
+    run_calc(&state, limit, move |budget| {
+        machining_size::run_analyze(req, budget)
+    })
+    .await
 }

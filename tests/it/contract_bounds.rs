@@ -15,7 +15,18 @@ use serde_json::{Value, json};
 
 /// Fields whose rejection depends on other fields (`endpoint`, pointer): the rule is in the
 /// field's description in the document.
-const CROSS_FIELD: &[(&str, &str, &str)] = &[];
+const CROSS_FIELD: &[(&str, &str, &str)] = &[
+    (
+        "/v1/machining-size/train",
+        "/params/colsample_bytree",
+        "⌊colsample_bytree·d⌋ ≥ 1, d = features left after dropping constant columns",
+    ),
+    (
+        "/v1/machining-size/train",
+        "/params/min_child_weight",
+        "the training split needs ≥ 2·max(1, min_child_weight) rows",
+    ),
+];
 
 /// A number in an example request with its documented bound, if any.
 #[derive(Debug, Clone)]

@@ -11,8 +11,8 @@ use mechcalc::calc::machining_size::shap::{
 };
 
 use crate::support::machining_size::{
-    brute_interventional, brute_path_dependent, fixture, max_abs_diff, model_of, nums,
-    paper_data, rows, table2, train_on,
+    brute_interventional, brute_path_dependent, fixture, max_abs_diff, model_of, nums, paper_data,
+    rows, table2, train_on,
 };
 
 /// Spec §7.1: x = [1, 2, 3, 4], y = [1, 2, 3, 10], one feature, exact method.
@@ -59,24 +59,46 @@ fn spec_7_1_tiny_hand_checkable_cases() {
         ..t1()
     };
     let cases: [(&str, BoostParams, [f64; 4], [f64; 4], f64); 4] = [
-        ("T1", t1(), [2.5, 2.5, 2.5, 7.0], [-1.125, -1.125, -1.125, 3.375], 3.625),
+        (
+            "T1",
+            t1(),
+            [2.5, 2.5, 2.5, 7.0],
+            [-1.125, -1.125, -1.125, 3.375],
+            3.625,
+        ),
         (
             "T2",
             t2,
-            [2.765_306_122_4, 2.765_306_122_4, 2.765_306_122_4, 7.055_555_555_6],
-            [-1.072_562_358_3, -1.072_562_358_3, -1.072_562_358_3, 3.217_687_074_8],
+            [
+                2.765_306_122_4,
+                2.765_306_122_4,
+                2.765_306_122_4,
+                7.055_555_555_6,
+            ],
+            [
+                -1.072_562_358_3,
+                -1.072_562_358_3,
+                -1.072_562_358_3,
+                3.217_687_074_8,
+            ],
             3.837_868_480_7,
         ),
         (
             "T3",
-            BoostParams { gamma: 26.9, ..t1() },
+            BoostParams {
+                gamma: 26.9,
+                ..t1()
+            },
             [2.5, 2.5, 2.5, 7.0],
             [-1.125, -1.125, -1.125, 3.375],
             3.625,
         ),
         (
             "T3'",
-            BoostParams { gamma: 27.1, ..t1() },
+            BoostParams {
+                gamma: 27.1,
+                ..t1()
+            },
             [4.0; 4],
             [0.0; 4],
             4.0,
@@ -86,9 +108,17 @@ fn spec_7_1_tiny_hand_checkable_cases() {
         let m = tiny(&params);
         for (i, x) in [1.0, 2.0, 3.0, 4.0].into_iter().enumerate() {
             let p = m.predict_prepared(&[x]);
-            assert!((p - pred[i]).abs() < 5e-11, "{name} prediction {i}: {p} vs {}", pred[i]);
+            assert!(
+                (p - pred[i]).abs() < 5e-11,
+                "{name} prediction {i}: {p} vs {}",
+                pred[i]
+            );
             let s = shap_of(&m, x);
-            assert!((s - phi[i]).abs() < 5e-11, "{name} φ {i}: {s} vs {}", phi[i]);
+            assert!(
+                (s - phi[i]).abs() < 5e-11,
+                "{name} φ {i}: {s} vs {}",
+                phi[i]
+            );
         }
         let e = m.expected_value();
         assert!((e - phi0).abs() < 5e-11, "{name} φ0: {e} vs {phi0}");
@@ -123,7 +153,9 @@ fn case(name: &str) -> serde_json::Value {
 }
 
 fn predictions(m: &Model, x: &Matrix) -> Vec<f64> {
-    (0..x.n_rows()).map(|r| m.predict_prepared(&x.row(r))).collect()
+    (0..x.n_rows())
+        .map(|r| m.predict_prepared(&x.row(r)))
+        .collect()
 }
 
 /// Spec §7.2: exact training on the centred target agrees with XGBoost 3.2.0 exact to its f32
@@ -153,7 +185,9 @@ fn spec_7_2_hist_equals_exact_and_xgboost_hist() {
     let train: Vec<f64> = d
         .train_rows
         .iter()
-        .map(|&r| hist.predict_prepared(&x.row(r as usize)) - exact.predict_prepared(&x.row(r as usize)))
+        .map(|&r| {
+            hist.predict_prepared(&x.row(r as usize)) - exact.predict_prepared(&x.row(r as usize))
+        })
         .collect();
     let worst = train.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     assert!(worst < 1e-15, "hist vs exact on training rows: {worst:e}");
@@ -176,12 +210,18 @@ fn gamma_pruning_matches_xgboost() {
         gamma: 2e-3,
         ..table2(60)
     };
-    let m = model_of(train_on(&x, &d.centred, &d.train_rows, &params, 1), d.names.len());
+    let m = model_of(
+        train_on(&x, &d.centred, &d.train_rows, &params, 1),
+        d.names.len(),
+    );
     let c = case("exact_depth3_gamma");
     let diff = max_abs_diff(&predictions(&m, &x), &nums(&c["predictions"]));
     eprintln!("gamma case vs xgboost: max |Δprediction| = {diff:e}");
     assert!(diff < 1e-7, "max |Δ| = {diff:e}");
-    assert_eq!(m.effective_trees() as u64, c["effective_trees"].as_u64().expect("n"));
+    assert_eq!(
+        m.effective_trees() as u64,
+        c["effective_trees"].as_u64().expect("n")
+    );
 }
 
 /// Spec §7.3: SHAP of our 400-tree model equals XGBoost's pred_contribs of its own model (the two
@@ -250,7 +290,10 @@ fn imported_xgboost_model_predicts_as_xgboost() {
 fn spec_7_3_shap_of_an_imported_model() {
     let (m, s) = imported();
     let x: Vec<Vec<f64>> = rows(&s["rows"]).iter().map(|r| m.prepare_row(r)).collect();
-    let bg: Vec<Vec<f64>> = rows(&s["background"]).iter().map(|r| m.prepare_row(r)).collect();
+    let bg: Vec<Vec<f64>> = rows(&s["background"])
+        .iter()
+        .map(|r| m.prepare_row(r))
+        .collect();
     let contribs = rows(&s["pred_contribs"]);
     let shap_pd = rows(&s["shap_values"]);
     let shap_iv = rows(&s["shap_interventional_values"]);
@@ -259,8 +302,14 @@ fn spec_7_3_shap_of_an_imported_model() {
     let wt = InterventionalWeights::new(m.max_depth());
     let phi0_bg = bg.iter().map(|r| m.predict_prepared(r)).sum::<f64>() / bg.len() as f64;
     let ev = s["shap_expected_value"].as_f64().expect("ev");
-    assert!((m.expected_value() - ev).abs() < 1e-5, "{} vs {ev}", m.expected_value());
-    let ev_iv = s["shap_interventional_expected_value"].as_f64().expect("ev");
+    assert!(
+        (m.expected_value() - ev).abs() < 1e-5,
+        "{} vs {ev}",
+        m.expected_value()
+    );
+    let ev_iv = s["shap_interventional_expected_value"]
+        .as_f64()
+        .expect("ev");
     assert!((phi0_bg - ev_iv).abs() < 1e-5, "{phi0_bg} vs {ev_iv}");
     let mut worst = [0.0f64; 6];
     for (k, row) in x.iter().enumerate() {
@@ -285,8 +334,14 @@ fn spec_7_3_shap_of_an_imported_model() {
          local {:e}, vs brute force {:e}",
         worst[0], worst[1], worst[2], worst[3], worst[4], worst[5]
     );
-    assert!(worst[0] < 1e-6 && worst[1] < 1e-6 && worst[3] < 1e-6, "{worst:?}");
-    assert!(worst[2] < 1e-12 && worst[4] < 1e-12 && worst[5] < 1e-12, "{worst:?}");
+    assert!(
+        worst[0] < 1e-6 && worst[1] < 1e-6 && worst[3] < 1e-6,
+        "{worst:?}"
+    );
+    assert!(
+        worst[2] < 1e-12 && worst[4] < 1e-12 && worst[5] < 1e-12,
+        "{worst:?}"
+    );
     // Interaction values: shap's d × d and xgboost's (d+1) × (d+1) with the bias last.
     let shap_int = s["shap_interaction_values"].as_array().expect("array");
     let xgb_int = s["pred_interactions"].as_array().expect("array");

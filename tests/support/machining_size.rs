@@ -83,7 +83,13 @@ pub fn table2(n_estimators: usize) -> BoostParams {
 }
 
 /// Trains `params` on `rows` of the matrix with targets `y` (every column a candidate).
-pub fn train_on(x: &Matrix, y: &[f64], rows: &[u32], params: &BoostParams, threads: usize) -> Boosted {
+pub fn train_on(
+    x: &Matrix,
+    y: &[f64],
+    rows: &[u32],
+    params: &BoostParams,
+    threads: usize,
+) -> Boosted {
     let features: Vec<usize> = (0..x.n_cols()).collect();
     let index = match params.method {
         Method::Exact => SplitIndex::Exact(ExactIndex::build(x, &features, threads)),
@@ -171,7 +177,9 @@ pub fn brute_interventional(model: &Model, x: &[f64], background: &[Vec<f64>]) -
         background
             .iter()
             .map(|r| {
-                let z: Vec<f64> = (0..x.len()).map(|i| if s[i] { x[i] } else { r[i] }).collect();
+                let z: Vec<f64> = (0..x.len())
+                    .map(|i| if s[i] { x[i] } else { r[i] })
+                    .collect();
                 model.predict_prepared(&z)
             })
             .sum::<f64>()
@@ -182,5 +190,8 @@ pub fn brute_interventional(model: &Model, x: &[f64], background: &[Vec<f64>]) -
 /// Largest absolute difference of two equally long slices.
 pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }

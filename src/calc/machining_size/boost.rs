@@ -138,9 +138,7 @@ impl ExactIndex {
             let col = x.col(f);
             let mut idx = super::data::all_rows(n);
             idx.sort_unstable_by(|&a, &b| {
-                col[a as usize]
-                    .total_cmp(&col[b as usize])
-                    .then(a.cmp(&b))
+                col[a as usize].total_cmp(&col[b as usize]).then(a.cmp(&b))
             });
             idx
         });
@@ -474,7 +472,7 @@ fn grow(
             });
             let b = &mut nodes[id];
             b.split = Some(Split {
-                feature: data.features[cols[k]],
+                feature: data.features[k],
                 threshold: c.cand.threshold,
                 gain: c.cand.gain,
             });
@@ -597,8 +595,7 @@ fn scan_exact(
             let nr = st.n[s] - a.nl;
             let (hl, hr) = (f64::from(a.nl), f64::from(nr));
             if hl >= p.min_child_weight && hr >= p.min_child_weight {
-                let gain =
-                    p.score(a.gl, hl) + p.score(st.g[s] - a.gl, hr) - st.parent_score[s];
+                let gain = p.score(a.gl, hl) + p.score(st.g[s] - a.gl, hr) - st.parent_score[s];
                 if better(gain, a.best.as_ref()) {
                     a.best = Some(Cand {
                         gain,
@@ -841,7 +838,10 @@ mod tests {
         let root = b.trees[0].nodes[0];
         assert_eq!(root.threshold, 3.5);
         assert!((root.loss_change - 27.0).abs() < 1e-12);
-        let pred: Vec<f64> = [1.0, 2.0, 3.0, 4.0].iter().map(|&x| predict(&b, x)).collect();
+        let pred: Vec<f64> = [1.0, 2.0, 3.0, 4.0]
+            .iter()
+            .map(|&x| predict(&b, x))
+            .collect();
         for (p, e) in pred.iter().zip([2.5, 2.5, 2.5, 7.0]) {
             assert!((p - e).abs() < 1e-12, "{pred:?}");
         }
@@ -885,6 +885,73 @@ mod tests {
         });
         assert_eq!(b.trees[0].nodes[0].threshold, 4.0);
         assert!((predict(&b, 3.0) - 2.5).abs() < 1e-12);
+    }
+
+    /// Every node's cover equals the training rows that reach it by traversal, whatever the
+    /// column sample (regression: a sampled feature's position was mapped twice).
+    #[test]
+    fn covers_match_routing_with_column_sampling() {
+        let mut r = rng::stream(5, 0);
+        let n = 200;
+        let rows: Vec<Vec<f64>> = (0..n)
+            .map(|_| {
+                (0..6)
+                    .map(|_| (rng::uniform(&mut r) * 8.0).floor())
+                    .collect()
+            })
+            .collect();
+        let y: Vec<f64> = rows
+            .iter()
+            .map(|v| v[1] - 2.0 * v[4] + rng::uniform(&mut r))
+            .collect();
+        let x = Matrix::from_rows(rows.clone(), 6);
+        let all = super::super::data::all_rows(n);
+        let features: Vec<usize> = (0..6).collect();
+        for method in [Method::Exact, Method::Hist { max_bin: 4 }] {
+            let index = match method {
+                Method::Exact => SplitIndex::Exact(ExactIndex::build(&x, &features, 2)),
+                Method::Hist { max_bin } => {
+                    SplitIndex::Hist(HistIndex::build(&x, &all, &features, max_bin, 2))
+                }
+            };
+            let data = TrainData {
+                x: &x,
+                y: &y,
+                rows: &all,
+                features: &features,
+                index: &index,
+            };
+            let p = BoostParams {
+                n_estimators: 20,
+                max_depth: 4,
+                learning_rate: 0.3,
+                colsample_bytree: 0.5,
+                method,
+                ..params()
+            };
+            let b = boost(&data, &p, &Budget::unlimited(), 2);
+            for t in &b.trees {
+                let mut count = vec![0.0; t.nodes.len()];
+                for row in &rows {
+                    let mut i = 0;
+                    loop {
+                        count[i] += 1.0;
+                        let nd = &t.nodes[i];
+                        if nd.is_leaf() {
+                            break;
+                        }
+                        i = if row[nd.feature as usize] < nd.threshold {
+                            nd.left
+                        } else {
+                            nd.right
+                        } as usize;
+                    }
+                }
+                for (c, nd) in count.iter().zip(&t.nodes) {
+                    assert_eq!(*c, nd.cover, "{method:?}");
+                }
+            }
+        }
     }
 
     #[test]

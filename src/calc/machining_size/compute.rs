@@ -104,13 +104,9 @@ struct Fitted {
 fn build_index(x: &Matrix, rows: &[u32], input: &TrainInput, threads: usize) -> SplitIndex {
     match input.params.method {
         Method::Exact => SplitIndex::Exact(ExactIndex::build(x, &input.features, threads)),
-        Method::Hist { max_bin } => SplitIndex::Hist(HistIndex::build(
-            x,
-            rows,
-            &input.features,
-            max_bin,
-            threads,
-        )),
+        Method::Hist { max_bin } => {
+            SplitIndex::Hist(HistIndex::build(x, rows, &input.features, max_bin, threads))
+        }
     }
 }
 
@@ -205,7 +201,12 @@ pub fn predict_matrix(model: &Model, x: &Matrix, rows: &[u32], threads: usize) -
     .concat()
 }
 
-fn metrics_on(model: &Model, input: &TrainInput, rows: &[u32], threads: usize) -> (Metrics, Vec<f64>) {
+fn metrics_on(
+    model: &Model,
+    input: &TrainInput,
+    rows: &[u32],
+    threads: usize,
+) -> (Metrics, Vec<f64>) {
     let pred = predict_matrix(model, &input.x, rows, threads);
     let y: Vec<f64> = rows.iter().map(|&r| input.y[r as usize]).collect();
     (data::metrics(&pred, &y), pred)
@@ -236,7 +237,14 @@ pub fn train(input: &TrainInput, budget: &Budget) -> Result<TrainOutput, Machini
     let importance = input.outputs.importance.then(|| importance(&model));
     let want_shap = input.outputs.shap_summary;
     let shap_summary = if want_shap && !budget.expired() {
-        shap_summary(&model, &input.x, &train_rows, input.split_seed, budget, threads)
+        shap_summary(
+            &model,
+            &input.x,
+            &train_rows,
+            input.split_seed,
+            budget,
+            threads,
+        )
     } else {
         None
     };
@@ -272,8 +280,7 @@ fn cross_validate(
             return Err(budget.check(0).unwrap_or(StopReason::Deadline));
         }
         let rows = data::complement(n, fold);
-        let fitted =
-            fit(input, &rows, shared, budget, 1).map_err(|_| StopReason::Deadline)?;
+        let fitted = fit(input, &rows, shared, budget, 1).map_err(|_| StopReason::Deadline)?;
         let stop = fitted.boosted.stop;
         let built = fitted.boosted.trees.len() as u64;
         if !matches!(stop, StopReason::Completed | StopReason::Converged) {
@@ -287,9 +294,13 @@ fn cross_validate(
         .map(|r| r.as_ref().map_or(0, |(_, b)| *b))
         .sum();
     let stopped = results.iter().find_map(|r| r.as_ref().err().copied());
-    let folds = stopped
-        .is_none()
-        .then(|| results.into_iter().filter_map(Result::ok).map(|(m, _)| m).collect());
+    let folds = stopped.is_none().then(|| {
+        results
+            .into_iter()
+            .filter_map(Result::ok)
+            .map(|(m, _)| m)
+            .collect()
+    });
     (Cv { folds, stopped }, built)
 }
 
@@ -469,7 +480,11 @@ pub fn predict(input: &PredictInput, budget: &Budget) -> Result<PredictOutput, M
     };
     let chunks: Vec<&[Vec<f64>]> = input.rows.chunks(ROW_CHUNK * 8).collect();
     let predictions: Vec<f64> = par_map_while(threads, &chunks, |_, c| {
-        (!budget.expired()).then(|| c.iter().map(|x| model.predict_prepared(x)).collect::<Vec<f64>>())
+        (!budget.expired()).then(|| {
+            c.iter()
+                .map(|x| model.predict_prepared(x))
+                .collect::<Vec<f64>>()
+        })
     })
     .into_iter()
     .collect::<Option<Vec<Vec<f64>>>>()
@@ -479,8 +494,8 @@ pub fn predict(input: &PredictInput, budget: &Budget) -> Result<PredictOutput, M
     let shap = match input.shap {
         ShapKind::None => None,
         ShapKind::PathDependent => {
-            let (values, worst) =
-                shap_rows(model, &input.rows, budget, threads).ok_or_else(|| deadline("SHAP", 0))?;
+            let (values, worst) = shap_rows(model, &input.rows, budget, threads)
+                .ok_or_else(|| deadline("SHAP", 0))?;
             traversals += n as u64 * trees;
             Some(ShapValues {
                 expected_value: model.expected_value(),
@@ -592,13 +607,19 @@ pub fn analyze(input: &AnalyzeInput, budget: &Budget) -> Result<AnalyzeOutput, M
     let varying: Vec<usize> = (0..d).filter(|f| !constant.contains(f)).collect();
     let pca = match input.pca {
         Some((k, scores)) if !varying.is_empty() => Some(
-            pca::pca(x, &varying, k.unwrap_or(varying.len()), scores, budget, threads).ok_or(
-                MachiningSizeError::Deadline {
-                    stage: "PCA",
-                    done: 0,
-                    total: varying.len() as u64,
-                },
-            )?,
+            pca::pca(
+                x,
+                &varying,
+                k.unwrap_or(varying.len()),
+                scores,
+                budget,
+                threads,
+            )
+            .ok_or(MachiningSizeError::Deadline {
+                stage: "PCA",
+                done: 0,
+                total: varying.len() as u64,
+            })?,
         ),
         _ => None,
     };

@@ -110,7 +110,9 @@ impl Matrix {
 /// `0..n` as row ids.
 #[must_use]
 pub fn all_rows(n: usize) -> Vec<u32> {
-    (0..n).map(|i| u32::try_from(i).unwrap_or(u32::MAX)).collect()
+    (0..n)
+        .map(|i| u32::try_from(i).unwrap_or(u32::MAX))
+        .collect()
 }
 
 /// Train/test split of `n` rows by a seeded permutation: the first ⌊(1 − test_fraction)·n⌋ rows of

@@ -7,8 +7,8 @@
 use serde_json::{Map, Value};
 
 use super::model::{
-    MAX_ABS_VALUE, MAX_TOTAL_NODES, Model, ModelSource, RawNames, RawTree, Routing,
-    StructureIssue, Tree, build_tree,
+    MAX_ABS_VALUE, MAX_TOTAL_NODES, Model, ModelSource, RawNames, RawTree, Routing, StructureIssue,
+    Tree, build_tree,
 };
 
 /// The `format` string of our model documents.
@@ -107,7 +107,10 @@ fn flags(v: &Value, at: &str) -> Res<Vec<bool>> {
             _ => match integer(x, &format!("{at}/{i}"))? {
                 0 => Ok(false),
                 1 => Ok(true),
-                k => Err(issue(format!("{at}/{i}"), format!("must be 0 or 1, got {k}"))),
+                k => Err(issue(
+                    format!("{at}/{i}"),
+                    format!("must be 0 or 1, got {k}"),
+                )),
             },
         })
         .collect()
@@ -327,7 +330,10 @@ pub fn read_xgboost(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
     let learner = object(field(root, "learner", at)?, &at_l)?;
     let at_obj = format!("{at_l}/objective");
     let objective = object(field(learner, "objective", &at_l)?, &at_obj)?;
-    let name = string(field(objective, "name", &at_obj)?, &format!("{at_obj}/name"))?;
+    let name = string(
+        field(objective, "name", &at_obj)?,
+        &format!("{at_obj}/name"),
+    )?;
     if name != OBJECTIVE {
         return Err(issue(
             format!("{at_obj}/name"),
@@ -337,7 +343,10 @@ pub fn read_xgboost(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
     let at_p = format!("{at_l}/learner_model_param");
     let lmp = object(field(learner, "learner_model_param", &at_l)?, &at_p)?;
     let base_score = parse_base_score(
-        string(field(lmp, "base_score", &at_p)?, &format!("{at_p}/base_score"))?,
+        string(
+            field(lmp, "base_score", &at_p)?,
+            &format!("{at_p}/base_score"),
+        )?,
         &format!("{at_p}/base_score"),
     )?;
     for (key, allowed) in [("num_target", 1), ("num_class", 0)] {
@@ -359,10 +368,7 @@ pub fn read_xgboost(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
         .ok_or_else(|| {
             issue(
                 format!("{at_p}/num_feature"),
-                format!(
-                    "must be in [1, {}], got {n_features}",
-                    limits.max_features
-                ),
+                format!("must be in [1, {}], got {n_features}", limits.max_features),
             )
         })?;
     let feature_names = match learner.get("feature_names") {
@@ -521,10 +527,8 @@ mod tests {
         let e = read_xgboost(&v, "/m", LIMITS).unwrap_err();
         assert_eq!(e.pointer, "/m/learner/objective/name");
         let mut v = xgb_t1();
-        v["learner"]["gradient_booster"]["model"]["trees"][0]["left_children"] =
-            json!([1, 0, -1]);
-        v["learner"]["gradient_booster"]["model"]["trees"][0]["right_children"] =
-            json!([2, 2, -1]);
+        v["learner"]["gradient_booster"]["model"]["trees"][0]["left_children"] = json!([1, 0, -1]);
+        v["learner"]["gradient_booster"]["model"]["trees"][0]["right_children"] = json!([2, 2, -1]);
         let e = read_xgboost(&v, "/m", LIMITS).unwrap_err();
         assert!(e.detail.contains("reached twice"), "{e:?}");
         assert!(e.pointer.ends_with("/left_children/1"), "{e:?}");
@@ -537,7 +541,10 @@ mod tests {
 
     #[test]
     fn base_score_forms() {
-        assert_eq!(parse_base_score("[1.9962889E1]", "/b").unwrap(), 19.962_889_f32 as f64);
+        assert_eq!(
+            parse_base_score("[1.9962889E1]", "/b").unwrap(),
+            19.962_889_f32 as f64
+        );
         assert_eq!(parse_base_score("5E-1", "/b").unwrap(), 0.5);
         assert!(parse_base_score("[1,2]", "/b").is_err());
         assert!(parse_base_score("nan", "/b").is_err());

@@ -34,7 +34,10 @@ fn scaled_mean(s: &[f64]) -> (f64, f64) {
     if m == 0.0 {
         return (0.0, 1.0);
     }
-    (s.iter().map(|&v| v / m).sum::<f64>() / s.len().max(1) as f64, m)
+    (
+        s.iter().map(|&v| v / m).sum::<f64>() / s.len().max(1) as f64,
+        m,
+    )
 }
 
 /// Grades of `series[1..]` against the reference `series[0]` (all of one length, ≥ 1).
@@ -75,7 +78,9 @@ pub fn grades(series: &[&[f64]], rho: f64, normalise: Normalise) -> Result<Vec<f
     let (dmin, dmax) = deltas
         .iter()
         .flatten()
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| (lo.min(d), hi.max(d)));
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
+            (lo.min(d), hi.max(d))
+        });
     if !(dmax > 0.0) {
         return Ok(vec![1.0; deltas.len()]);
     }
@@ -107,7 +112,12 @@ mod tests {
     fn hand_computed_grades() {
         // Normalise none, ρ = 0.5: Δ1 = [0, 1], Δ2 = [2, 0]; Δmin 0, Δmax 2.
         // ζ1 = [1, 1/2], ζ2 = [1/3, 1]: grades 0.75 and 2/3.
-        let g = grades(&[&[1.0, 1.0], &[1.0, 2.0], &[3.0, 1.0]], 0.5, Normalise::None).unwrap();
+        let g = grades(
+            &[&[1.0, 1.0], &[1.0, 2.0], &[3.0, 1.0]],
+            0.5,
+            Normalise::None,
+        )
+        .unwrap();
         assert!((g[0] - 0.75).abs() < 1e-15);
         assert!((g[1] - 2.0 / 3.0).abs() < 1e-15);
     }

@@ -15,12 +15,12 @@ use super::gra::Normalise;
 use super::model::Model;
 use super::smogn::SmognParams;
 use super::wire::{
-    AnalyzeRequest, GraNormalise, K_FOLD, MAX_BACKGROUND, MAX_BIN, MAX_DEPTH, MAX_FEATURES,
-    MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS, MAX_INTERVENTIONAL_PAIRS, MAX_PREDICT_ROWS,
-    MAX_ROWS, MAX_SCORE_CELLS, MAX_SHAP_CELLS, MAX_TREES, MIN_ROWS, N_ESTIMATORS, PCA_COMPONENTS,
-    PredictRequest, REGULARISATION, SMOGN_K, SMOGN_PERTURBATION, SMOGN_THRESHOLD, ShapKind,
-    TARGET, TEST_FRACTION, TrainOutputKind, TrainRequest, TreeMethod, FRACTION, GRA_RHO,
-    LEARNING_RATE,
+    AnalyzeRequest, FRACTION, GRA_RHO, GraNormalise, K_FOLD, LEARNING_RATE, MAX_BACKGROUND,
+    MAX_BIN, MAX_DEPTH, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
+    MAX_INTERVENTIONAL_PAIRS, MAX_PREDICT_ROWS, MAX_ROWS, MAX_SCORE_CELLS, MAX_SHAP_CELLS,
+    MAX_TREES, MIN_ROWS, N_ESTIMATORS, PCA_COMPONENTS, PredictRequest, REGULARISATION, SMOGN_K,
+    SMOGN_PERTURBATION, SMOGN_THRESHOLD, ShapKind, TARGET, TEST_FRACTION, TrainOutputKind,
+    TrainRequest, TreeMethod,
 };
 
 /// A validated `/train` request.
@@ -101,10 +101,7 @@ fn check_names(v: &mut Validator, names: &[String]) {
         v.push_code(
             TOO_LARGE,
             "/feature_names",
-            format!(
-                "must name 1..{MAX_FEATURES} features, got {}",
-                names.len()
-            ),
+            format!("must name 1..{MAX_FEATURES} features, got {}", names.len()),
         );
     }
     let mut seen = HashSet::new();
@@ -145,14 +142,17 @@ fn check_rows(v: &mut Validator, at: &str, rows: &[Vec<f64>], d: usize, lo: usiz
         };
         v.push(
             format!("{at}/{i}"),
-            format!("must have {d} values (one per feature), got {}{tail}", r.len()),
+            format!(
+                "must have {d} values (one per feature), got {}{tail}",
+                r.len()
+            ),
         );
     }
-    if let Some((i, j)) = rows.iter().enumerate().find_map(|(i, r)| {
-        r.iter()
-            .position(|x| !x.is_finite())
-            .map(|j| (i, j))
-    }) {
+    if let Some((i, j)) = rows
+        .iter()
+        .enumerate()
+        .find_map(|(i, r)| r.iter().position(|x| !x.is_finite()).map(|j| (i, j)))
+    {
         v.push(
             format!("{at}/{i}/{j}"),
             format!("must be a finite number, got {}", rows[i][j]),
@@ -193,12 +193,7 @@ fn smogn_params(
         );
     }
     for (i, p) in relevance.iter().enumerate() {
-        v.range(
-            &format!("{at}/relevance/{i}/0"),
-            "y",
-            p[0],
-            Range::FINITE,
-        );
+        v.range(&format!("{at}/relevance/{i}/0"), "y", p[0], Range::FINITE);
         v.range(
             &format!("{at}/relevance/{i}/1"),
             "φ",
@@ -216,7 +211,12 @@ fn smogn_params(
             );
         }
     }
-    v.range(&format!("{at}/threshold"), "threshold", threshold, SMOGN_THRESHOLD);
+    v.range(
+        &format!("{at}/threshold"),
+        "threshold",
+        threshold,
+        SMOGN_THRESHOLD,
+    );
     v.uint(&format!("{at}/k"), "k", u64::from(k), SMOGN_K);
     v.range(
         &format!("{at}/perturbation"),
@@ -262,11 +262,36 @@ impl TryFrom<TrainRequest> for TrainInput {
         time_limit(&mut v, req.time_limit_ms);
         check_data(&mut v, &req.feature_names, &req.rows, &req.target);
         let p = &req.params;
-        v.uint("/params/n_estimators", "n_estimators", u64::from(p.n_estimators), N_ESTIMATORS);
-        v.uint("/params/max_depth", "max_depth", u64::from(p.max_depth), MAX_DEPTH);
-        v.range("/params/learning_rate", "learning_rate", p.learning_rate, LEARNING_RATE);
-        v.range("/params/reg_lambda", "reg_lambda", p.reg_lambda, REGULARISATION);
-        v.range("/params/reg_alpha", "reg_alpha", p.reg_alpha, REGULARISATION);
+        v.uint(
+            "/params/n_estimators",
+            "n_estimators",
+            u64::from(p.n_estimators),
+            N_ESTIMATORS,
+        );
+        v.uint(
+            "/params/max_depth",
+            "max_depth",
+            u64::from(p.max_depth),
+            MAX_DEPTH,
+        );
+        v.range(
+            "/params/learning_rate",
+            "learning_rate",
+            p.learning_rate,
+            LEARNING_RATE,
+        );
+        v.range(
+            "/params/reg_lambda",
+            "reg_lambda",
+            p.reg_lambda,
+            REGULARISATION,
+        );
+        v.range(
+            "/params/reg_alpha",
+            "reg_alpha",
+            p.reg_alpha,
+            REGULARISATION,
+        );
         v.range("/params/gamma", "gamma", p.gamma, REGULARISATION);
         v.range(
             "/params/min_child_weight",
@@ -293,7 +318,12 @@ impl TryFrom<TrainRequest> for TrainInput {
             );
         }
         let val = &req.validation;
-        v.range("/validation/test_fraction", "test_fraction", val.test_fraction, TEST_FRACTION);
+        v.range(
+            "/validation/test_fraction",
+            "test_fraction",
+            val.test_fraction,
+            TEST_FRACTION,
+        );
         if let Some(k) = val.k_fold {
             v.uint("/validation/k_fold", "k_fold", u64::from(k), K_FOLD);
         }
@@ -338,7 +368,10 @@ impl TryFrom<TrainRequest> for TrainInput {
         let x = Matrix::from_rows(req.rows, d);
         let y = req.target;
         if y.iter().all(|&t| !(t > y[0] || t < y[0])) {
-            v.push("/target", "all targets are equal: there is nothing to learn (spec §2.5)");
+            v.push(
+                "/target",
+                "all targets are equal: there is nothing to learn (spec §2.5)",
+            );
         }
         let dropped = if req.preprocessing.drop_constant {
             constant_columns(&x)
@@ -553,7 +586,12 @@ impl TryFrom<AnalyzeRequest> for AnalyzeInput {
         });
         let pca = req.pca.as_ref().map(|p| {
             if let Some(k) = p.components {
-                v.uint("/pca/components", "components", u64::from(k), PCA_COMPONENTS);
+                v.uint(
+                    "/pca/components",
+                    "components",
+                    u64::from(k),
+                    PCA_COMPONENTS,
+                );
             }
             if p.scores {
                 let k = p.components.map_or(req.feature_names.len(), |k| k as usize);

@@ -14,8 +14,9 @@ use super::smogn::Smogn;
 use super::wire::{
     AnalyzeResponse, ConstantColumn, CvMetrics, FeatureImportance, FeatureShap, GbdtModel,
     GraGrade, GraNormalise, GraOut, LevelShap, MetricsOut, ModelSummary, OffGrid, PcaOut,
-    PredictResponse, PreprocessingOut, ShapOut, ShapSummary as ShapSummaryWire, SmognBinOut, SmognData, SmognOut, SplitMetrics,
-    TestPredictions, TrainParams, TrainResponse, TreeDoc, TreeMethod,
+    PredictResponse, PreprocessingOut, ShapOut, ShapSummary as ShapSummaryWire, SmognBinOut,
+    SmognData, SmognOut, SplitMetrics, TestPredictions, TrainParams, TrainResponse, TreeDoc,
+    TreeMethod,
 };
 
 /// Local accuracy is flagged when the residual exceeds this share of the output scale (f64
@@ -69,7 +70,11 @@ fn tree_doc(t: &Tree) -> TreeDoc {
     let child = |c: u32, leaf: bool| if leaf { -1 } else { i64::from(c) };
     TreeDoc {
         left: t.nodes.iter().map(|n| child(n.left, n.is_leaf())).collect(),
-        right: t.nodes.iter().map(|n| child(n.right, n.is_leaf())).collect(),
+        right: t
+            .nodes
+            .iter()
+            .map(|n| child(n.right, n.is_leaf()))
+            .collect(),
         feature: t
             .nodes
             .iter()
@@ -272,10 +277,9 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
                 ),
             ));
         }
-        if let Some(w) = local_accuracy_warning(
-            s.local_accuracy,
-            super::compute::output_scale(model),
-        ) {
+        if let Some(w) =
+            local_accuracy_warning(s.local_accuracy, super::compute::output_scale(model))
+        {
             warnings.push(w);
         }
         shap_summary_out(s, &input.names)
@@ -314,11 +318,7 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
     });
     let test_predictions = input.outputs.test_predictions.then(|| TestPredictions {
         rows: out.test_rows.clone(),
-        target: out
-            .test_rows
-            .iter()
-            .map(|&r| input.y[r as usize])
-            .collect(),
+        target: out.test_rows.iter().map(|&r| input.y[r as usize]).collect(),
         prediction: out.test.as_ref().map(|t| t.1.clone()).unwrap_or_default(),
     });
     TrainResponse {
@@ -330,7 +330,11 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
             cv,
         },
         preprocessing: PreprocessingOut {
-            dropped_constant: input.dropped.iter().map(|&f| input.names[f].clone()).collect(),
+            dropped_constant: input
+                .dropped
+                .iter()
+                .map(|&f| input.names[f].clone())
+                .collect(),
             n_train: u32_of(out.train_rows.len()),
             n_test: u32_of(out.test_rows.len()),
             smogn,
@@ -350,7 +354,11 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
 
 /// The `/predict` response.
 #[must_use]
-pub fn respond_predict(input: &PredictInput, out: &PredictOutput, budget: &Budget) -> PredictResponse {
+pub fn respond_predict(
+    input: &PredictInput,
+    out: &PredictOutput,
+    budget: &Budget,
+) -> PredictResponse {
     let model = &input.model;
     let d = model.n_features;
     let mut warnings = Vec::new();
@@ -411,7 +419,11 @@ pub fn respond_predict(input: &PredictInput, out: &PredictOutput, budget: &Budge
 
 /// The `/analyze` response.
 #[must_use]
-pub fn respond_analyze(input: &AnalyzeInput, out: &AnalyzeOutput, budget: &Budget) -> AnalyzeResponse {
+pub fn respond_analyze(
+    input: &AnalyzeInput,
+    out: &AnalyzeOutput,
+    budget: &Budget,
+) -> AnalyzeResponse {
     let names = &input.names;
     let mut warnings = Vec::new();
     if out.varying.is_empty() && (input.pca.is_some() || input.gra.is_some()) {
@@ -464,48 +476,56 @@ pub fn respond_analyze(input: &AnalyzeInput, out: &AnalyzeOutput, budget: &Budge
             scores: p.scores.clone(),
         }
     });
-    let gra = out.gra.as_ref().zip(input.gra).map(|(grades, (rho, norm))| {
-        let ranks = ranks(grades);
-        GraOut {
-            rho,
-            normalise: match norm {
-                super::gra::Normalise::Mean => GraNormalise::Mean,
-                super::gra::Normalise::None => GraNormalise::None,
-            },
-            grades: out
-                .varying
-                .iter()
-                .zip(grades)
-                .zip(ranks)
-                .map(|((&f, &grade), rank)| GraGrade {
-                    feature: names[f].clone(),
-                    grade,
-                    rank,
-                })
-                .collect(),
-        }
-    });
-    let smogn = out.smogn.as_ref().zip(input.smogn.as_ref()).map(|(s, (_, include))| {
-        let data = include.then(|| SmognData {
-            rows: s
-                .kept
-                .iter()
-                .map(|&r| input.x.row(r as usize))
-                .chain(s.new_rows.iter().cloned())
-                .collect(),
-            target: s
-                .kept
-                .iter()
-                .map(|&r| input.y[r as usize])
-                .chain(s.new_targets.iter().copied())
-                .collect(),
+    let gra = out
+        .gra
+        .as_ref()
+        .zip(input.gra)
+        .map(|(grades, (rho, norm))| {
+            let ranks = ranks(grades);
+            GraOut {
+                rho,
+                normalise: match norm {
+                    super::gra::Normalise::Mean => GraNormalise::Mean,
+                    super::gra::Normalise::None => GraNormalise::None,
+                },
+                grades: out
+                    .varying
+                    .iter()
+                    .zip(grades)
+                    .zip(ranks)
+                    .map(|((&f, &grade), rank)| GraGrade {
+                        feature: names[f].clone(),
+                        grade,
+                        rank,
+                    })
+                    .collect(),
+            }
         });
-        let o = smogn_out(s, input.x.n_rows(), names, data);
-        if let Some(w) = off_grid_warning(&o, "/smogn") {
-            warnings.push(w);
-        }
-        o
-    });
+    let smogn = out
+        .smogn
+        .as_ref()
+        .zip(input.smogn.as_ref())
+        .map(|(s, (_, include))| {
+            let data = include.then(|| SmognData {
+                rows: s
+                    .kept
+                    .iter()
+                    .map(|&r| input.x.row(r as usize))
+                    .chain(s.new_rows.iter().cloned())
+                    .collect(),
+                target: s
+                    .kept
+                    .iter()
+                    .map(|&r| input.y[r as usize])
+                    .chain(s.new_targets.iter().copied())
+                    .collect(),
+            });
+            let o = smogn_out(s, input.x.n_rows(), names, data);
+            if let Some(w) = off_grid_warning(&o, "/smogn") {
+                warnings.push(w);
+            }
+            o
+        });
     AnalyzeResponse {
         constant_columns: out
             .constant

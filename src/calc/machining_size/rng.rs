@@ -27,7 +27,9 @@ pub fn stream(seed: u64, purpose: u64) -> ChaCha8Rng {
 /// A uniformly random permutation of `0..n`.
 #[must_use]
 pub fn permutation(rng: &mut ChaCha8Rng, n: usize) -> Vec<u32> {
-    let mut p: Vec<u32> = (0..n).map(|i| u32::try_from(i).unwrap_or(u32::MAX)).collect();
+    let mut p: Vec<u32> = (0..n)
+        .map(|i| u32::try_from(i).unwrap_or(u32::MAX))
+        .collect();
     p.shuffle(rng);
     p
 }

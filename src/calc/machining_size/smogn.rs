@@ -78,7 +78,9 @@ pub const DISCRETE_LEVELS: usize = 20;
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum SmognError {
     /// The relevance is degenerate over the data: every sample rare, or none.
-    #[error("the relevance makes {rare} of {n} samples rare: SMOGN needs both rare and normal samples")]
+    #[error(
+        "the relevance makes {rare} of {n} samples rare: SMOGN needs both rare and normal samples"
+    )]
     Degenerate {
         /// Rare samples.
         rare: usize,
@@ -97,7 +99,9 @@ pub enum SmognError {
 ///
 /// # Errors
 /// The control points are not strictly increasing in y (the validator rejects that first).
-pub fn relevance_fn(points: &[(f64, f64)]) -> Result<impl Fn(f64) -> f64, crate::numerics::pchip::PchipError> {
+pub fn relevance_fn(
+    points: &[(f64, f64)],
+) -> Result<impl Fn(f64) -> f64, crate::numerics::pchip::PchipError> {
     let (ys, ps): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
     let p = Pchip::new(&ys, &ps)?;
     Ok(move |y: f64| p.eval(y).clamp(0.0, 1.0))
@@ -126,7 +130,10 @@ pub fn smogn(
         .collect();
     let rare_count = rare.iter().filter(|&&r| r).count();
     if rare_count == 0 || rare_count == n {
-        return Err(SmognError::Degenerate { rare: rare_count, n });
+        return Err(SmognError::Degenerate {
+            rare: rare_count,
+            n,
+        });
     }
     let mut runs: Vec<(usize, usize)> = Vec::new();
     let mut start = 0;
@@ -174,8 +181,10 @@ pub fn smogn(
             if size >= 2 && target > size {
                 let sd_x = (0..x.n_cols())
                     .map(|f| {
-                        let v: Vec<f64> =
-                            members.iter().map(|&i| x.get(rows[i] as usize, f)).collect();
+                        let v: Vec<f64> = members
+                            .iter()
+                            .map(|&i| x.get(rows[i] as usize, f))
+                            .collect();
                         super::data::scaled_sd(&v)
                     })
                     .collect();
@@ -353,7 +362,15 @@ mod tests {
         let rows: Vec<Vec<f64>> = (0..40)
             .map(|i| vec![f64::from(i % 4), f64::from(i) * 0.1])
             .collect();
-        let y: Vec<f64> = (0..40).map(|i| if i < 34 { f64::from(i) * 0.01 } else { 1.0 + f64::from(i) * 0.01 }).collect();
+        let y: Vec<f64> = (0..40)
+            .map(|i| {
+                if i < 34 {
+                    f64::from(i) * 0.01
+                } else {
+                    1.0 + f64::from(i) * 0.01
+                }
+            })
+            .collect();
         (Matrix::from_rows(rows, 2), y)
     }
 

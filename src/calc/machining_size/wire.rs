@@ -93,6 +93,7 @@ crate::schema_bounds! {
     },
     ValidationIn { test_fraction: TEST_FRACTION, k_fold: K_FOLD },
     SmognIn { threshold: SMOGN_THRESHOLD, k: SMOGN_K, perturbation: SMOGN_PERTURBATION },
+    SmognPreviewIn { threshold: SMOGN_THRESHOLD, k: SMOGN_K, perturbation: SMOGN_PERTURBATION },
     AnalyzeRequest { target @items: TARGET },
     GraIn { rho: GRA_RHO },
     PcaIn { components: PCA_COMPONENTS },
@@ -191,6 +192,7 @@ pub struct TrainParams {
     #[schema(nullable = false)]
     pub base_score: Option<f64>,
     /// Split search: `exact` (default) or `hist`.
+    #[schema(inline)]
     pub tree_method: TreeMethod,
     /// Bins per feature for `hist`, 2..1024. Default 256.
     pub max_bin: u32,
@@ -231,14 +233,20 @@ pub enum TreeMethod {
 /// Preprocessing of the training data (spec §3 step 1).
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 #[schema(as = machining_size::PreprocessingIn)]
-#[serde(deny_unknown_fields, default)]
+#[serde(deny_unknown_fields)]
 pub struct PreprocessingIn {
     /// Remove zero-variance columns before training (paper §3.2). Default true. The model keeps
     /// the original column indices.
+    #[serde(default = "yes")]
     pub drop_constant: bool,
     /// SMOGN resampling of the TRAINING split only (never the test rows). Default none.
+    #[serde(default)]
     #[schema(nullable = false)]
     pub smogn: Option<SmognIn>,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for PreprocessingIn {
@@ -827,6 +835,7 @@ pub struct GraIn {
     pub rho: f64,
     /// `mean` (default: each series divided by its mean; a series with mean 0 is rejected) or
     /// `none`.
+    #[schema(inline)]
     pub normalise: GraNormalise,
 }
 
