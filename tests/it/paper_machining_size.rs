@@ -45,6 +45,9 @@ fn shap_of(m: &Model, x: f64) -> f64 {
     phi[0]
 }
 
+/// A row of the spec's §7.1 table: case, parameters, predictions, φ_1 per row, φ_0.
+type TinyCase = (&'static str, BoostParams, [f64; 4], [f64; 4], f64);
+
 /// Spec §7.1 table: (case, params, predictions, φ_1 per row, φ_0). Printed to 10 decimals:
 /// tolerance 5e-11.
 #[test]
@@ -58,7 +61,7 @@ fn spec_7_1_tiny_hand_checkable_cases() {
         gamma: 3.0,
         ..t1()
     };
-    let cases: [(&str, BoostParams, [f64; 4], [f64; 4], f64); 4] = [
+    let cases: [TinyCase; 4] = [
         (
             "T1",
             t1(),

@@ -836,7 +836,7 @@ mod tests {
     fn t1_hand_checked_split() {
         let b = train(&params());
         let root = b.trees[0].nodes[0];
-        assert_eq!(root.threshold, 3.5);
+        assert_eq!((root.threshold).to_bits(), f64::to_bits(3.5));
         assert!((root.loss_change - 27.0).abs() < 1e-12);
         let pred: Vec<f64> = [1.0, 2.0, 3.0, 4.0]
             .iter()
@@ -883,7 +883,7 @@ mod tests {
             method: Method::Hist { max_bin: 256 },
             ..params()
         });
-        assert_eq!(b.trees[0].nodes[0].threshold, 4.0);
+        assert_eq!((b.trees[0].nodes[0].threshold).to_bits(), f64::to_bits(4.0));
         assert!((predict(&b, 3.0) - 2.5).abs() < 1e-12);
     }
 
@@ -931,7 +931,7 @@ mod tests {
             };
             let b = boost(&data, &p, &Budget::unlimited(), 2);
             for t in &b.trees {
-                let mut count = vec![0.0; t.nodes.len()];
+                let mut count = vec![0.0f64; t.nodes.len()];
                 for row in &rows {
                     let mut i = 0;
                     loop {
@@ -948,7 +948,7 @@ mod tests {
                     }
                 }
                 for (c, nd) in count.iter().zip(&t.nodes) {
-                    assert_eq!(*c, nd.cover, "{method:?}");
+                    assert_eq!(c.to_bits(), nd.cover.to_bits(), "{method:?}");
                 }
             }
         }

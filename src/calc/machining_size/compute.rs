@@ -393,7 +393,7 @@ fn shap_summary(
             let mut lv: Vec<(f64, usize, f64)> = Vec::new();
             for (x, v) in prepared.iter().zip(&values) {
                 let key = x[f];
-                if let Some(e) = lv.iter_mut().find(|(k, _, _)| !(*k < key || *k > key)) {
+                if let Some(e) = lv.iter_mut().find(|(k, _, _)| (*k - key) == 0.0) {
                     e.1 += 1;
                     e.2 += v[f];
                 } else if lv.len() < LEVELS_MAX {

@@ -81,7 +81,7 @@ pub fn grades(series: &[&[f64]], rho: f64, normalise: Normalise) -> Result<Vec<f
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
             (lo.min(d), hi.max(d))
         });
-    if !(dmax > 0.0) {
+    if dmax <= 0.0 {
         return Ok(vec![1.0; deltas.len()]);
     }
     Ok(deltas

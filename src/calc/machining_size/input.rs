@@ -200,7 +200,7 @@ fn smogn_params(
             p[1],
             Range::closed(0.0, 1.0),
         );
-        if i > 0 && !(p[0] > relevance[i - 1][0]) {
+        if i > 0 && p[0] <= relevance[i - 1][0] {
             v.push(
                 format!("{at}/relevance/{i}/0"),
                 format!(
@@ -367,7 +367,7 @@ impl TryFrom<TrainRequest> for TrainInput {
         let d = req.feature_names.len();
         let x = Matrix::from_rows(req.rows, d);
         let y = req.target;
-        if y.iter().all(|&t| !(t > y[0] || t < y[0])) {
+        if y.iter().all(|&t| (t - y[0]) == 0.0) {
             v.push(
                 "/target",
                 "all targets are equal: there is nothing to learn (spec §2.5)",
@@ -492,16 +492,16 @@ impl TryFrom<PredictRequest> for PredictInput {
                     "/feature_names",
                     format!("the model has {d} features, got {} names", names.len()),
                 );
-            } else if !model.feature_names.is_empty() {
-                if let Some(i) = (0..d).find(|&i| names[i] != model.feature_names[i]) {
-                    v.push(
-                        format!("/feature_names/{i}"),
-                        format!(
-                            "must be the model's feature \"{}\", got \"{}\"",
-                            model.feature_names[i], names[i]
-                        ),
-                    );
-                }
+            } else if !model.feature_names.is_empty()
+                && let Some(i) = (0..d).find(|&i| names[i] != model.feature_names[i])
+            {
+                v.push(
+                    format!("/feature_names/{i}"),
+                    format!(
+                        "must be the model's feature \"{}\", got \"{}\"",
+                        model.feature_names[i], names[i]
+                    ),
+                );
             }
         }
         let n = req.rows.len();

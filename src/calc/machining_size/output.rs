@@ -256,7 +256,7 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
             }
         })
     });
-    if out.test_rows.len() < SMALL_TEST_SET && out.test_rows.len() > 0 && out.cv.is_none() {
+    if out.test_rows.len() < SMALL_TEST_SET && !out.test_rows.is_empty() && out.cv.is_none() {
         warnings.push(Warning::at(
             "SMALL_TEST_SET",
             "/validation/test_fraction",

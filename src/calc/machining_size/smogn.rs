@@ -335,7 +335,7 @@ fn off_grid(x: &Matrix, rows: &[u32], new_rows: &[Vec<f64>]) -> Vec<(usize, usiz
         let c = x.col(f);
         let mut levels: Vec<f64> = rows.iter().map(|&r| c[r as usize]).collect();
         levels.sort_unstable_by(f64::total_cmp);
-        levels.dedup_by(|a, b| !(*a > *b));
+        levels.dedup_by(|a, b| *a <= *b);
         if levels.len() > DISCRETE_LEVELS {
             continue;
         }
@@ -344,7 +344,7 @@ fn off_grid(x: &Matrix, rows: &[u32], new_rows: &[Vec<f64>]) -> Vec<(usize, usiz
             .filter(|row| {
                 let v = row[f];
                 let i = levels.partition_point(|&l| l < v);
-                !levels.get(i).is_some_and(|&l| !(l > v))
+                levels.get(i).is_none_or(|&l| l > v)
             })
             .count();
         if count > 0 {
