@@ -18,6 +18,7 @@ mod http_component_importance;
 mod http_continuum_workspace;
 mod http_error_contract;
 mod http_irefc;
+mod http_machining_size;
 mod http_mutated_examples;
 mod http_service;
 mod openapi;

@@ -260,6 +260,12 @@ pub fn read_native(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
             },
         };
         check_nodes(&mut total, raw.left.len(), &at_t)?;
+        if let Some(i) = raw.value.iter().position(|v| v.abs() > MAX_ABS_VALUE) {
+            return Err(issue(
+                format!("{at_t}/value/{i}"),
+                format!("must have magnitude ≤ 1e100, got {}", raw.value[i]),
+            ));
+        }
         let names = RawNames {
             left: "left",
             right: "right",

@@ -417,6 +417,21 @@ pub fn build_tree(
                 ));
             }
         }
+        // In range: checked above.
+        let (lu, ru) = (l as usize, r as usize);
+        for (field, c) in [(names.left, lu), (names.right, ru)] {
+            if seen[c] {
+                return Err(issue(
+                    field,
+                    i,
+                    format!(
+                        "node {c} is reached twice (a cycle or a shared child): a tree needs \
+                         each node to have exactly one parent"
+                    ),
+                ));
+            }
+            seen[c] = true;
+        }
         if depth + 1 > MAX_TREE_DEPTH {
             return Err(issue(
                 names.left,
@@ -442,21 +457,6 @@ pub fn build_tree(
         }
         if !value.is_finite() {
             node.value = 0.0;
-        }
-        // In range: checked above.
-        let (lu, ru) = (l as usize, r as usize);
-        for (field, c) in [(names.left, lu), (names.right, ru)] {
-            if seen[c] {
-                return Err(issue(
-                    field,
-                    i,
-                    format!(
-                        "node {c} is reached twice (a cycle or a shared child): a tree needs \
-                         each node to have exactly one parent"
-                    ),
-                ));
-            }
-            seen[c] = true;
         }
         let next = queue.len();
         node.left = u32::try_from(next).unwrap_or(LEAF);
