@@ -122,11 +122,13 @@ impl BoostParams {
 }
 
 /// Pre-sorted columns for the exact method: for each candidate feature, every row of the matrix
-/// in ascending order of its value (4 bytes per cell).
+/// in ascending order of its value, and the values in that order (12 bytes per cell): the split
+/// search reads both sequentially.
 #[derive(Debug, Clone)]
 pub struct ExactIndex {
     n_rows: usize,
     order: Vec<u32>,
+    vals: Vec<f64>,
 }
 
 impl ExactIndex {
@@ -138,18 +140,32 @@ impl ExactIndex {
             let col = x.col(f);
             let mut idx = super::data::all_rows(n);
             idx.sort_unstable_by(|&a, &b| {
-                col[a as usize].total_cmp(&col[b as usize]).then(a.cmp(&b))
+                col[a as usize]
+                    .total_cmp(&col[b as usize])
+                    .then(a.cmp(&b))
             });
-            idx
+            let vals: Vec<f64> = idx.iter().map(|&r| col[r as usize]).collect();
+            (idx, vals)
         });
+        let mut order = Vec::with_capacity(n * features.len());
+        let mut vals = Vec::with_capacity(n * features.len());
+        for (o, v) in parts {
+            order.extend(o);
+            vals.extend(v);
+        }
         Self {
             n_rows: n,
-            order: parts.concat(),
+            order,
+            vals,
         }
     }
 
     fn order(&self, k: usize) -> &[u32] {
         &self.order[k * self.n_rows..(k + 1) * self.n_rows]
+    }
+
+    fn vals(&self, k: usize) -> &[f64] {
+        &self.vals[k * self.n_rows..(k + 1) * self.n_rows]
     }
 }
 
@@ -278,9 +294,14 @@ pub fn boost(data: &TrainData<'_>, p: &BoostParams, budget: &Budget, threads: us
     let mut ws = Workspace {
         yc: data.y.iter().map(|&y| y - base).collect(),
         margin: vec![0.0; n],
-        g: vec![0.0; n],
-        pos: vec![NONE; n],
+        row: vec![RowState { g: 0.0, pos: NONE }; n],
         node_of: vec![0; n],
+        inv: (0..=m)
+            .map(|c| {
+                let h = c as f64 + p.reg_lambda;
+                if h > 0.0 { 1.0 / h } else { 0.0 }
+            })
+            .collect(),
     };
     let mut rng = rng::stream(p.seed, rng::STREAM_SAMPLING);
     let d = data.features.len();
@@ -308,7 +329,7 @@ pub fn boost(data: &TrainData<'_>, p: &BoostParams, budget: &Budget, threads: us
         });
         for &r in data.rows {
             let r = r as usize;
-            ws.g[r] = ws.margin[r] - ws.yc[r];
+            ws.row[r].g = ws.margin[r] - ws.yc[r];
         }
         let tree = grow(data, p, &mut ws, &cols, sampled.as_deref(), threads);
         let no_op = tree.nodes.len() == 1 && tree.nodes[0].value == 0.0;
@@ -331,12 +352,24 @@ struct Workspace {
     yc: Vec<f64>,
     /// Σ tree outputs so far (margin without base).
     margin: Vec<f64>,
-    /// Gradients g = margin − yc (hessians are 1).
-    g: Vec<f64>,
-    /// Slot of the row's node in the current level (or [`NONE`], with [`UNSAMPLED`]).
-    pos: Vec<u32>,
+    /// Gradient and level slot of every row, side by side: the split search reads both for each
+    /// entry of a sorted column, so one cache line serves both.
+    row: Vec<RowState>,
     /// The row's node in the tree under construction.
     node_of: Vec<u32>,
+    /// 1/(c + λ) for every row count c: hessians are 1, so H is a count and the split search
+    /// multiplies instead of dividing twice per boundary (scores agree with the division to
+    /// 1 ulp; the tie tolerance absorbs that).
+    inv: Vec<f64>,
+}
+
+/// Gradient (hessian 1) and level slot of one row.
+#[derive(Debug, Clone, Copy)]
+struct RowState {
+    /// g = margin − yc.
+    g: f64,
+    /// Slot of the row's node in the current level (or [`NONE`], with [`UNSAMPLED`]).
+    pos: u32,
 }
 
 /// A node under construction.
@@ -370,6 +403,12 @@ struct Cand {
     /// Σ g and count of the left child.
     gl: f64,
     nl: u32,
+}
+
+/// score(G, H) of a child with H = `count` ≥ min_child_weight rows: T_α(G)²·(1/(H + λ)).
+fn fast_score(g: f64, count: u32, inv: &[f64], alpha: f64) -> f64 {
+    let t = soft_threshold(g, alpha);
+    t * t * inv[count as usize]
 }
 
 /// Whether a candidate with loss change `gain` replaces `best` (strictly better beyond the tie
@@ -408,11 +447,11 @@ fn grow(
         let r = r as usize;
         ws.node_of[r] = 0;
         if sampled.is_none_or(|s| s[r]) {
-            ws.pos[r] = 0;
-            g0 += ws.g[r];
+            ws.row[r].pos = 0;
+            g0 += ws.row[r].g;
             n0 += 1;
         } else {
-            ws.pos[r] = UNSAMPLED;
+            ws.row[r].pos = UNSAMPLED;
         }
     }
     let mut nodes = vec![BNode {
@@ -519,9 +558,8 @@ fn search_level(
     threads: usize,
 ) -> Vec<Option<Best>> {
     let scan = |_: usize, &k: &usize| -> Vec<Option<Cand>> {
-        let f = data.features[k];
         match data.index {
-            SplitIndex::Exact(ix) => scan_exact(ix.order(k), data.x.col(f), ws, st, p),
+            SplitIndex::Exact(ix) => scan_exact(ix.order(k), ix.vals(k), ws, st, p),
             SplitIndex::Hist(ix) => scan_hist(ix.bins(k), &ix.cuts[k], data.rows, ws, st, p),
         }
     };
@@ -559,7 +597,7 @@ fn search_level(
 /// each node's sampled rows, ascending.
 fn scan_exact(
     order: &[u32],
-    col: &[f64],
+    vals: &[f64],
     ws: &Workspace,
     st: &Level,
     p: &BoostParams,
@@ -582,20 +620,20 @@ fn scan_exact(
         nslots
     ];
     let limit = u32::try_from(nslots).unwrap_or(NONE);
-    for &r in order {
-        let r = r as usize;
-        let s = ws.pos[r];
+    for (&r, &x) in order.iter().zip(vals) {
+        let RowState { g, pos: s } = ws.row[r as usize];
         if s >= limit {
             continue;
         }
         let s = s as usize;
-        let x = col[r];
         let a = &mut acc[s];
         if a.nl > 0 && x > a.last {
             let nr = st.n[s] - a.nl;
             let (hl, hr) = (f64::from(a.nl), f64::from(nr));
             if hl >= p.min_child_weight && hr >= p.min_child_weight {
-                let gain = p.score(a.gl, hl) + p.score(st.g[s] - a.gl, hr) - st.parent_score[s];
+                let gain = fast_score(a.gl, a.nl, &ws.inv, p.reg_alpha)
+                    + fast_score(st.g[s] - a.gl, nr, &ws.inv, p.reg_alpha)
+                    - st.parent_score[s];
                 if better(gain, a.best.as_ref()) {
                     a.best = Some(Cand {
                         gain,
@@ -606,7 +644,7 @@ fn scan_exact(
                 }
             }
         }
-        a.gl += ws.g[r];
+        a.gl += g;
         a.nl += 1;
         a.last = x;
     }
@@ -629,12 +667,12 @@ fn scan_hist(
     let limit = u32::try_from(nslots).unwrap_or(NONE);
     for &r in rows {
         let r = r as usize;
-        let s = ws.pos[r];
+        let RowState { g, pos: s } = ws.row[r];
         if s >= limit {
             continue;
         }
         let h = &mut hist[s as usize * nb + usize::from(bins[r])];
-        h.0 += ws.g[r];
+        h.0 += g;
         h.1 += 1;
     }
     let mut out = vec![None; nslots];
@@ -649,7 +687,9 @@ fn scan_hist(
             }
             let (hl, hr) = (f64::from(nl), f64::from(nr));
             if hl >= p.min_child_weight && hr >= p.min_child_weight {
-                let gain = p.score(gl, hl) + p.score(st.g[s] - gl, hr) - st.parent_score[s];
+                let gain = fast_score(gl, nl, &ws.inv, p.reg_alpha)
+                    + fast_score(st.g[s] - gl, nr, &ws.inv, p.reg_alpha)
+                    - st.parent_score[s];
                 if better(gain, best.as_ref()) {
                     *best = Some(Cand {
                         gain,
@@ -675,14 +715,14 @@ fn route(
     let limit = u32::try_from(level.len()).unwrap_or(NONE);
     for &r in data.rows {
         let r = r as usize;
-        let p = ws.pos[r];
+        let p = ws.row[r].pos;
         let s = p & !UNSAMPLED;
         if s >= limit {
             continue;
         }
         let b = &nodes[level[s as usize] as usize];
         let Some(split) = b.split else {
-            ws.pos[r] = NONE | (p & UNSAMPLED);
+            ws.row[r].pos = NONE | (p & UNSAMPLED);
             continue;
         };
         let (left, (ls, rs)) = (
@@ -690,7 +730,7 @@ fn route(
             child_slot[s as usize],
         );
         ws.node_of[r] = if left { b.left } else { b.right };
-        ws.pos[r] = (if left { ls } else { rs }) | (p & UNSAMPLED);
+        ws.row[r].pos = (if left { ls } else { rs }) | (p & UNSAMPLED);
     }
 }
 
