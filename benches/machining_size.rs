@@ -143,7 +143,8 @@ fn big_set() -> Set {
     let mut y = Vec::with_capacity(n);
     for _ in 0..n {
         let x: Vec<f64> = (0..d).map(|_| rng::uniform(&mut r)).collect();
-        let v = (std::f64::consts::TAU * x[0]).sin() + 2.0 * x[1] * x[2]
+        let v = (std::f64::consts::TAU * x[0]).sin()
+            + 2.0 * x[1] * x[2]
             + if x[3] > 0.5 { 1.0 } else { 0.0 }
             + 0.5 * x[4]
             - x[5] * x[5]
@@ -195,7 +196,12 @@ fn fit(x: &Matrix, y: &[f64], rows: &[u32], p: &BoostParams, threads: usize) -> 
         features: &features,
         index: &index,
     };
-    boost(&data, p, &Budget::unlimited().with_threads(threads), threads)
+    boost(
+        &data,
+        p,
+        &Budget::unlimited().with_threads(threads),
+        threads,
+    )
 }
 
 fn model_of(b: Boosted, d: usize) -> Model {
@@ -234,10 +240,15 @@ fn sweep_training(paper: &Set, big: &Set, reference: Option<&Value>) {
     println!("|---|---|---|---|---|---|---|---|");
     let x = paper.matrix();
     let rows = all_rows(paper.n);
-    for (colsample, label) in [(1.0, "Table 2, colsample 1.0"), (0.8, "Table 2 (colsample 0.8)")] {
+    for (colsample, label) in [
+        (1.0, "Table 2, colsample 1.0"),
+        (0.8, "Table 2 (colsample 0.8)"),
+    ] {
         for threads in [1usize, 2] {
             let p = table2(400, colsample);
-            let (t, b) = time_for(Duration::from_secs(3), 30, || fit(&x, &paper.y, &rows, &p, threads));
+            let (t, b) = time_for(Duration::from_secs(3), 30, || {
+                fit(&x, &paper.y, &rows, &p, threads)
+            });
             let req = paper_request(paper, colsample);
             let (tr, _) = time_runs(5, || {
                 run_train(req.clone(), &Budget::unlimited().with_threads(threads)).unwrap()
@@ -258,13 +269,23 @@ fn sweep_training(paper: &Set, big: &Set, reference: Option<&Value>) {
     }
     let xb = big.matrix();
     let rows = all_rows(big.n);
-    for (method, label) in [(Method::Exact, "exact"), (Method::Hist { max_bin: 256 }, "hist 256")] {
+    for (method, label) in [
+        (Method::Exact, "exact"),
+        (Method::Hist { max_bin: 256 }, "hist 256"),
+    ] {
         let p = BoostParams {
             method,
             ..table2(400, 1.0)
         };
         let (t, _) = time_runs(1, || fit(&xb, &big.y, &rows, &p, 2));
-        let key = format!("/big/{}", if method == Method::Exact { "exact" } else { "hist" });
+        let key = format!(
+            "/big/{}",
+            if method == Method::Exact {
+                "exact"
+            } else {
+                "hist"
+            }
+        );
         let xt = refnum(reference, &format!("{key}/train_ms"));
         println!(
             "| 100 000 × 20 | Table 2, colsample 1.0, {label}, 400 trees | 2 | {} | — | {} | — | {} |",
@@ -306,7 +327,13 @@ fn sweep_threads(paper: &Set, big: &Set) {
         y: paper.y.clone(),
         fold: Vec::new(),
     };
-    for s in [paper_sub, sub(2000, 10), sub(5000, 12), sub(10_000, 20), sub(100_000, 20)] {
+    for s in [
+        paper_sub,
+        sub(2000, 10),
+        sub(5000, 12),
+        sub(10_000, 20),
+        sub(100_000, 20),
+    ] {
         let x = s.matrix();
         let rows = all_rows(s.n);
         let p = BoostParams {
@@ -372,7 +399,11 @@ fn sweep_grid(paper: &Set, reference: Option<&Value>) {
             times.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
             let worst = times.iter().map(|t| t.worst_ms()).fold(0.0, f64::max);
             let xr = refnum(reference, &format!("/grid/{trees}_{depth}/rmse"));
-            let mark = if trees == 400 && depth == 6 { " **(default)**" } else { "" };
+            let mark = if trees == 400 && depth == 6 {
+                " **(default)**"
+            } else {
+                ""
+            };
             println!(
                 "| {trees}{mark} | {depth} | {:.2} / {worst:.2} | {effective} | {mean:.6} | {} | {} |",
                 times[2].median_ms(),
@@ -428,7 +459,11 @@ fn sweep_shap(paper: &Set, reference: Option<&Value>) {
             black_box(acc)
         });
         let per = |t: &Timing, rows: usize| {
-            format!("{:.1} / {:.1}", t.median_us() / rows as f64, t.worst_us() / rows as f64)
+            format!(
+                "{:.1} / {:.1}",
+                t.median_us() / rows as f64,
+                t.worst_us() / rows as f64
+            )
         };
         let ours = t.median_us() / prepared.len() as f64;
         let shap_pd = refnum(reference, &format!("{key}/path_dependent_us"));
@@ -438,10 +473,22 @@ fn sweep_shap(paper: &Set, reference: Option<&Value>) {
             per(&t, prepared.len()),
             opt(if key.is_empty() { None } else { shap_pd }, 1),
             opt(if key.is_empty() { None } else { xgb_pd }, 1),
-            opt(if key.is_empty() { None } else { shap_pd.map(|s| s / ours) }, 2)
+            opt(
+                if key.is_empty() {
+                    None
+                } else {
+                    shap_pd.map(|s| s / ours)
+                },
+                2
+            )
         );
         for nb in [10usize, 100, 1000] {
-            let bg: Vec<Vec<f64>> = prepared.iter().step_by(paper.n / nb.min(paper.n)).take(nb).cloned().collect();
+            let bg: Vec<Vec<f64>> = prepared
+                .iter()
+                .step_by(paper.n / nb.min(paper.n))
+                .take(nb)
+                .cloned()
+                .collect();
             let nrows = if nb >= 1000 { 5 } else { 40 };
             let wt = InterventionalWeights::new(m.max_depth());
             let (t, _) = time_runs(3, || {
@@ -528,9 +575,12 @@ fn bench_core(c: &mut Criterion) {
     let x = paper.matrix();
     let rows = all_rows(paper.n);
     let p = table2(400, 0.8);
-    c.bench_function("machining_size/train paper-sized 400 trees (2 threads)", |b| {
-        b.iter(|| fit(&x, &paper.y, &rows, &p, 2));
-    });
+    c.bench_function(
+        "machining_size/train paper-sized 400 trees (2 threads)",
+        |b| {
+            b.iter(|| fit(&x, &paper.y, &rows, &p, 2));
+        },
+    );
     let m = model_of(fit(&x, &paper.y, &rows, &table2(400, 1.0), 2), paper.d);
     let row = x.row(3);
     let mut buf = PathBuffer::for_depth(m.max_depth());

@@ -64,6 +64,69 @@ pub struct ServiceConfig {
     )]
     pub max_time_budget_ms: u64,
 
+    /// Time a client has to send a complete request head, and the longest an idle keep-alive
+    /// connection is kept open [ms].
+    #[arg(
+        long = "header-timeout-ms",
+        env = "MECHCALC_HEADER_TIMEOUT_MS",
+        default_value_t = 10_000
+    )]
+    pub header_timeout_ms: u64,
+
+    /// Time a client has to send the whole request body [ms] (408 after it).
+    #[arg(
+        long = "body-timeout-ms",
+        env = "MECHCALC_BODY_TIMEOUT_MS",
+        default_value_t = 30_000
+    )]
+    pub body_timeout_ms: u64,
+
+    /// Longest a single write of a response may stall on a client that does not read [ms]; the
+    /// connection is closed after it.
+    #[arg(
+        long = "write-timeout-ms",
+        env = "MECHCALC_WRITE_TIMEOUT_MS",
+        default_value_t = 30_000
+    )]
+    pub write_timeout_ms: u64,
+
+    /// Open connections at most (0 = from the process's file-descriptor limit); beyond it a new
+    /// connection gets an immediate 503 and is closed.
+    #[arg(
+        long = "max-connections",
+        env = "MECHCALC_MAX_CONNECTIONS",
+        default_value_t = 0
+    )]
+    pub max_connections: usize,
+
+    /// After SIGTERM/SIGINT, time in-flight requests get to finish [ms]; then running jobs are
+    /// cancelled and the process exits.
+    #[arg(
+        long = "shutdown-grace-ms",
+        env = "MECHCALC_SHUTDOWN_GRACE_MS",
+        default_value_t = 20_000
+    )]
+    pub shutdown_grace_ms: u64,
+
+    /// Largest response body [bytes]; a request whose answer would be larger is refused with a
+    /// 422 naming the option to change (before computing where the size is known in advance).
+    #[arg(
+        long = "max-response-bytes",
+        env = "MECHCALC_MAX_RESPONSE_BYTES",
+        default_value_t = 64 * 1024 * 1024
+    )]
+    pub max_response_bytes: usize,
+
+    /// Browser origins allowed to call the API (comma-separated, `*` for any); CORS is off when
+    /// empty.
+    #[arg(
+        long = "cors-origins",
+        env = "MECHCALC_CORS_ORIGINS",
+        value_delimiter = ',',
+        default_value = ""
+    )]
+    pub cors_origins: Vec<String>,
+
     /// Log format: `text` or `json`.
     #[arg(
         long = "log-format",
@@ -83,6 +146,13 @@ impl Default for ServiceConfig {
             queue_depth: 16,
             max_body_bytes: 16 * 1024 * 1024,
             max_time_budget_ms: 600_000,
+            header_timeout_ms: 10_000,
+            body_timeout_ms: 30_000,
+            write_timeout_ms: 30_000,
+            max_connections: 0,
+            shutdown_grace_ms: 20_000,
+            max_response_bytes: 64 * 1024 * 1024,
+            cors_origins: Vec::new(),
             log_format: "text".to_owned(),
         }
     }
@@ -119,6 +189,20 @@ impl ServiceConfig {
             self.threads_per_job.min(all)
         } else {
             all
+        }
+    }
+
+    /// Effective connection limit: the configured one, or what the file-descriptor limit allows
+    /// (leaving room for the listener, logs and the process itself).
+    #[must_use]
+    pub fn effective_max_connections(&self, nofile: u64) -> usize {
+        let from_fds = usize::try_from(nofile.saturating_sub(64))
+            .unwrap_or(usize::MAX)
+            .max(16);
+        if self.max_connections > 0 {
+            self.max_connections.min(from_fds)
+        } else {
+            from_fds.min(65_536)
         }
     }
 

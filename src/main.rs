@@ -1,5 +1,7 @@
 //! The mechcalc binary: configuration, logging, bind, serve, graceful shutdown.
 
+use std::time::Duration;
+
 use clap::Parser;
 use mechcalc::config::ServiceConfig;
 use mechcalc::{AppState, app};
@@ -17,11 +19,36 @@ struct Cli {
     /// Print the OpenAPI document (YAML) and exit.
     #[arg(long)]
     print_openapi: bool,
+    #[command(subcommand)]
+    command: Option<Command>,
 }
 
-#[tokio::main]
-async fn main() -> std::process::ExitCode {
+#[derive(Debug, clap::Subcommand)]
+enum Command {
+    /// Run one calculation (or an NDJSON batch) without a server: JSON request in (a file or
+    /// standard input), JSON (or `--svg`) out; problem details on stderr and exit code 2 for a
+    /// refused request.
+    Run(mechcalc::cli::RunArgs),
+}
+
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
+    if let Some(Command::Run(args)) = &cli.command {
+        return mechcalc::cli::run(args, cli.config);
+    }
+    match tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(rt) => rt.block_on(serve(cli)),
+        Err(e) => {
+            eprintln!("cannot start the runtime: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+async fn serve(cli: Cli) -> std::process::ExitCode {
     if cli.print_openapi {
         return match mechcalc::http::openapi().to_yaml() {
             Ok(y) => {
@@ -58,6 +85,15 @@ async fn main() -> std::process::ExitCode {
         tracing::error!(error = %e, "cannot start the compute pool");
         return std::process::ExitCode::FAILURE;
     }
+    // Idle and slow connections each hold a descriptor: take the hard limit, size the
+    // connection limit from it.
+    let nofile = rlimit::increase_nofile_limit(u64::MAX).unwrap_or(1024);
+    let limits = mechcalc::http::serve::ConnLimits {
+        header_timeout: Duration::from_millis(config.header_timeout_ms.max(1)),
+        write_timeout: Duration::from_millis(config.write_timeout_ms.max(1)),
+        max_connections: config.effective_max_connections(nofile),
+        shutdown_grace: Duration::from_millis(config.shutdown_grace_ms),
+    };
     let listener = match tokio::net::TcpListener::bind(config.bind).await {
         Ok(l) => l,
         Err(e) => {
@@ -72,17 +108,18 @@ async fn main() -> std::process::ExitCode {
         threads_per_job = config.effective_threads_per_job(),
         queue_depth = config.queue_depth,
         max_body_bytes = config.max_body_bytes,
+        max_response_bytes = config.max_response_bytes,
         max_time_budget_ms = config.max_time_budget_ms,
+        max_connections = limits.max_connections,
+        header_timeout_ms = config.header_timeout_ms,
+        body_timeout_ms = config.body_timeout_ms,
+        write_timeout_ms = config.write_timeout_ms,
+        shutdown_grace_ms = config.shutdown_grace_ms,
         "mechcalc listening"
     );
-    let app = app(AppState::new(config));
-    if let Err(e) = axum::serve(listener, app)
-        .with_graceful_shutdown(shutdown_signal())
-        .await
-    {
-        tracing::error!(error = %e, "server error");
-        return std::process::ExitCode::FAILURE;
-    }
+    let state = AppState::new(config);
+    let pool = state.pool.clone();
+    mechcalc::http::serve::serve(listener, app(state), limits, pool, shutdown_signal()).await;
     tracing::info!("mechcalc stopped");
     std::process::ExitCode::SUCCESS
 }
@@ -109,5 +146,5 @@ async fn shutdown_signal() {
         () = ctrl_c => {},
         () = term => {},
     }
-    tracing::info!("shutdown signal received; finishing in-flight requests");
+    tracing::info!("shutdown signal received");
 }

@@ -167,12 +167,27 @@ fn num(x: f64) -> String {
 pub struct SchemaBound {
     /// The schema name of the wire type (`ToSchema::name`), e.g. `cognates.Links`.
     pub schema: Cow<'static, str>,
-    /// The property as it appears on the wire.
+    /// The property as it appears on the wire, or a JSON pointer into the schema starting with
+    /// `/` (for fields of enum variants, which are rendered inline).
     pub property: &'static str,
     /// The bound applies to each item of an array property, not to the property itself.
     pub items: bool,
     /// The bound.
     pub range: Range,
+}
+
+impl SchemaBound {
+    /// A bound at a JSON pointer inside the schema of `T` (fields of enum variants and items of
+    /// untagged alternatives, which the document renders inline).
+    #[must_use]
+    pub fn at<T: utoipa::ToSchema>(pointer: &'static str, range: Range) -> Self {
+        Self {
+            schema: T::name(),
+            property: pointer,
+            items: false,
+            range,
+        }
+    }
 }
 
 /// Declares the documented bounds of a module's wire types, one line per field; expands to
@@ -197,8 +212,7 @@ macro_rules! schema_bounds {
                 {
                     // Fails to compile when the field does not exist.
                     let _ = |x: &$ty| { let _ = &x.$field; };
-                    let property: &'static str = stringify!($field);
-                    $( let property: &'static str = $wire; )?
+                    let property: &'static str = [$($wire,)? stringify!($field)][0];
                     let items = false $( || stringify!($items) == "items" )?;
                     v.push($crate::calc::bounds::SchemaBound {
                         schema: <$ty as ::utoipa::ToSchema>::name(),

@@ -28,6 +28,18 @@ pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validato
 pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         crate::numerics::budget::schema_bounds(),
+        bus_fuel_economy::wire::schema_bounds(),
+        cam_law::wire::schema_bounds(),
+        cam_law_fit::wire::schema_bounds(),
+        cognates::wire::schema_bounds(),
+        cognates::wire::variant_bounds(),
+        component_importance::wire::schema_bounds(),
+        component_importance::wire::variant_bounds(),
+        continuum_workspace::wire::schema_bounds(),
+        continuum_workspace::wire::nested_bounds(),
+        irefc::wire::schema_bounds(),
+        irefc::stress::wire::schema_bounds(),
+        irefc::efficiency::wire::schema_bounds(),
         machining_size::schema_bounds(),
     ]
     .concat()

@@ -6,19 +6,38 @@ use serde::Serialize;
 use serde::ser::{self, Impossible};
 
 /// The JSON pointer of the first non-finite float in `value`, if any.
+///
+/// The common case (every number finite) is one pass that allocates nothing; only when a
+/// non-finite number is found is the value walked again, recording the path to it.
 pub fn first_non_finite<T: Serialize + ?Sized>(value: &T) -> Option<String> {
+    if all_finite(value) {
+        return None;
+    }
     let mut walker = Walker {
         path: Vec::new(),
+        record: true,
         found: None,
     };
     // The walker's only error is "found one"; any other serialization error is ignored here
     // (serde_json reports it when the body is written).
     let _ = value.serialize(&mut walker);
-    walker.found
+    walker.found.or_else(|| Some(String::new()))
+}
+
+/// Whether every float in `value` is finite (no allocation).
+pub fn all_finite<T: Serialize + ?Sized>(value: &T) -> bool {
+    let mut walker = Walker {
+        path: Vec::new(),
+        record: false,
+        found: None,
+    };
+    value.serialize(&mut walker).is_ok()
 }
 
 struct Walker {
     path: Vec<String>,
+    /// Record the path (the slow pass that names the offending number).
+    record: bool,
     found: Option<String>,
 }
 
@@ -42,12 +61,22 @@ impl Walker {
         if v.is_finite() {
             Ok(())
         } else {
-            self.found = Some(self.path.iter().map(|p| format!("/{p}")).collect());
+            if self.record {
+                self.found = Some(self.path.iter().map(|p| format!("/{p}")).collect());
+            }
             Err(Found)
         }
     }
-    fn nested<T: Serialize + ?Sized>(&mut self, key: String, value: &T) -> Result<(), Found> {
-        self.path.push(key);
+    /// Walk `value` under the path segment `key` (built only when the path is recorded).
+    fn nested<T: Serialize + ?Sized>(
+        &mut self,
+        key: impl FnOnce() -> String,
+        value: &T,
+    ) -> Result<(), Found> {
+        if !self.record {
+            return value.serialize(&mut *self);
+        }
+        self.path.push(key());
         let r = value.serialize(&mut *self);
         self.path.pop();
         r
@@ -122,7 +151,7 @@ impl<'a> ser::Serializer for &'a mut Walker {
         variant: &'static str,
         value: &T,
     ) -> Result<(), Found> {
-        self.nested(variant.to_owned(), value)
+        self.nested(|| variant.to_owned(), value)
     }
     fn serialize_seq(self, _len: Option<usize>) -> Result<Seq<'a>, Found> {
         Ok(Seq { w: self, index: 0 })
@@ -170,9 +199,9 @@ impl<'a> ser::Serializer for &'a mut Walker {
 
 impl Seq<'_> {
     fn element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Found> {
-        let key = self.index.to_string();
+        let index = self.index;
         self.index += 1;
-        self.w.nested(key, value)
+        self.w.nested(|| index.to_string(), value)
     }
 }
 
@@ -351,12 +380,14 @@ impl ser::SerializeMap for Map<'_> {
     type Ok = ();
     type Error = Found;
     fn serialize_key<T: Serialize + ?Sized>(&mut self, key: &T) -> Result<(), Found> {
-        self.key = key.serialize(KeyText).unwrap_or_else(|_| String::from("?"));
+        if self.w.record {
+            self.key = key.serialize(KeyText).unwrap_or_else(|_| String::from("?"));
+        }
         Ok(())
     }
     fn serialize_value<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Found> {
         let key = std::mem::take(&mut self.key);
-        self.w.nested(key, value)
+        self.w.nested(|| key, value)
     }
     fn end(self) -> Result<(), Found> {
         Ok(())
@@ -370,7 +401,7 @@ impl ser::SerializeStruct for Map<'_> {
         key: &'static str,
         value: &T,
     ) -> Result<(), Found> {
-        self.w.nested(key.to_owned(), value)
+        self.w.nested(|| key.to_owned(), value)
     }
     fn end(self) -> Result<(), Found> {
         Ok(())
@@ -384,7 +415,7 @@ impl ser::SerializeStructVariant for Map<'_> {
         key: &'static str,
         value: &T,
     ) -> Result<(), Found> {
-        self.w.nested(key.to_owned(), value)
+        self.w.nested(|| key.to_owned(), value)
     }
     fn end(self) -> Result<(), Found> {
         Ok(())

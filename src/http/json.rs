@@ -1,6 +1,8 @@
 //! The JSON request extractor: content-type check (415), size limit (413), syntax (400) and
 //! data errors (422) with a JSON pointer taken from serde's path.
 
+use std::time::Duration;
+
 use axum::body::Bytes;
 use axum::extract::{FromRequest, Request};
 use axum::http::{StatusCode, header};
@@ -105,7 +107,20 @@ fn strip_position(message: &str) -> String {
     }
 }
 
-impl<T: DeserializeOwned> FromRequest<AppState> for ApiJson<T> {
+/// Bodies up to this size are decoded inline (microseconds); larger ones on the blocking pool.
+const INLINE_DECODE_BYTES: usize = 64 * 1024;
+
+/// Large bodies decoded at once, at most.
+fn decode_slots() -> &'static tokio::sync::Semaphore {
+    static SLOTS: std::sync::OnceLock<tokio::sync::Semaphore> = std::sync::OnceLock::new();
+    SLOTS.get_or_init(|| {
+        tokio::sync::Semaphore::new(
+            std::thread::available_parallelism().map_or(2, std::num::NonZeroUsize::get),
+        )
+    })
+}
+
+impl<T: DeserializeOwned + utoipa::ToSchema + Send + 'static> FromRequest<AppState> for ApiJson<T> {
     type Rejection = ApiError;
 
     async fn from_request(req: Request, state: &AppState) -> Result<Self, Self::Rejection> {
@@ -118,14 +133,39 @@ impl<T: DeserializeOwned> FromRequest<AppState> for ApiJson<T> {
             other => return Err(ApiError::unsupported_media_type(other)),
         }
         let limit = state.config.max_body_bytes;
-        let bytes = Bytes::from_request(req, state).await.map_err(|rejection| {
-            if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE {
-                ApiError::body_too_large(limit)
-            } else {
-                ApiError::malformed_json(format!("could not read the request body: {rejection}"))
-            }
-        })?;
-        decode(&bytes).map(ApiJson)
+        let timeout_ms = state.config.body_timeout_ms;
+        let read = Bytes::from_request(req, state);
+        let bytes = tokio::time::timeout(Duration::from_millis(timeout_ms.max(1)), read)
+            .await
+            .map_err(|_| ApiError::request_timeout(timeout_ms))?
+            .map_err(|rejection| {
+                if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE {
+                    ApiError::body_too_large(limit)
+                } else {
+                    ApiError::malformed_json(format!(
+                        "could not read the request body: {rejection}"
+                    ))
+                }
+            })?;
+        let schema = T::name();
+        let inline = bytes.len() <= INLINE_DECODE_BYTES;
+        let decode_and_check = move || {
+            let v = decode(&bytes)?;
+            super::shape::check(&schema, &bytes)?;
+            Ok(ApiJson(v))
+        };
+        if inline {
+            return decode_and_check();
+        }
+        // A large body takes milliseconds to decode: do it off the threads that serve
+        // connections, at most `DECODE_SLOTS` at once.
+        let _permit = decode_slots()
+            .acquire()
+            .await
+            .map_err(|_| ApiError::internal())?;
+        tokio::task::spawn_blocking(decode_and_check)
+            .await
+            .map_err(|_| ApiError::internal())?
     }
 }
 

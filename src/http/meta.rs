@@ -23,7 +23,6 @@ pub struct Health {
     #[schema(example = "0.1.0")]
     pub version: &'static str,
     /// Compute slots free right now.
-    #[schema(minimum = 0)]
     pub compute_slots_free: usize,
 }
 
@@ -133,6 +132,69 @@ fn json_bytes(body: &'static [u8]) -> Response {
     r.headers_mut().insert(
         header::CONTENT_TYPE,
         HeaderValue::from_static("application/json"),
+    );
+    r
+}
+
+/// An `api/` example request, embedded in the binary.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct ExampleRequest {
+    /// File name under `api/`.
+    pub file: &'static str,
+    /// The endpoint it is sent to.
+    pub endpoint: &'static str,
+    /// The request body.
+    #[schema(value_type = Object)]
+    pub request: serde_json::Value,
+}
+
+mod embedded {
+    include!(concat!(env!("OUT_DIR"), "/examples.rs"));
+}
+
+/// Every `api/` example request (ready to send; the page at `/` loads them).
+#[utoipa::path(
+    get,
+    path = "/v1/examples",
+    tag = "service",
+    operation_id = "list_examples",
+    responses((status = 200, description = "Every example request with its endpoint", body = [ExampleRequest]))
+)]
+pub async fn examples() -> Response {
+    static BODY: OnceLock<Vec<u8>> = OnceLock::new();
+    json_bytes(BODY.get_or_init(|| {
+        let list: Vec<ExampleRequest> = embedded::EXAMPLES
+            .iter()
+            .map(|(file, endpoint, body)| ExampleRequest {
+                file,
+                endpoint,
+                request: serde_json::from_str(body).unwrap_or_default(),
+            })
+            .collect();
+        serde_json::to_vec(&list).unwrap_or_default()
+    }))
+}
+
+const INDEX_HTML: &str = include_str!("../../assets/index.html");
+
+/// The browser page: endpoints, examples in an editable box, the JSON answer and its picture.
+pub async fn page() -> Html<&'static str> {
+    Html(INDEX_HTML)
+}
+
+/// Prometheus metrics of this process (text exposition format), built from the `metrics`
+/// facade: requests by route and status, latency histograms, job times by lane, compute-slot
+/// and queue occupancy, cancelled jobs, budget stops, rejections.
+pub async fn metrics(State(state): State<AppState>) -> Response {
+    let pool = &state.pool;
+    metrics::gauge!("mechcalc_compute_slots").set(pool.slots() as f64);
+    metrics::gauge!("mechcalc_compute_slots_free").set(pool.available_slots() as f64);
+    metrics::gauge!("mechcalc_queue_depth_waiting").set(pool.waiting() as f64);
+    let body = super::telemetry::render();
+    let mut r = body.into_response();
+    r.headers_mut().insert(
+        header::CONTENT_TYPE,
+        HeaderValue::from_static("text/plain; version=0.0.4; charset=utf-8"),
     );
     r
 }

@@ -13,27 +13,32 @@ pub mod component_importance;
 pub mod continuum_workspace;
 pub mod irefc;
 pub mod json;
+pub mod layers;
 pub mod machining_size;
 pub mod meta;
 pub mod openapi;
+pub mod picture;
 pub mod pool;
 pub mod problem;
+pub mod serve;
+pub mod shape;
 pub mod state;
+pub mod stream;
+pub mod telemetry;
 
 pub mod finite;
 
-use std::time::{Duration, Instant};
-
 use axum::Router;
 use axum::body::Body;
-use axum::extract::{DefaultBodyLimit, Request};
-use axum::http::{HeaderValue, Method, Uri, header};
-use axum::middleware::{self, Next};
+use axum::extract::DefaultBodyLimit;
+use axum::http::{HeaderName, HeaderValue, Method, Uri, header};
+use axum::middleware;
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
 use serde::Serialize;
 use tower_http::catch_panic::CatchPanicLayer;
-use tracing::Instrument;
+use tower_http::request_id::{PropagateRequestIdLayer, SetRequestIdLayer};
+use tower_http::set_header::SetResponseHeaderLayer;
 use utoipa::OpenApi;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
@@ -56,6 +61,20 @@ pub enum ProblemResponses {
         content_type = "application/problem+json"
     )]
     MalformedJson(Problem),
+    /// The endpoint has no picture (`Accept: image/svg+xml`).
+    #[response(
+        status = 406,
+        description = "No representation in the accepted media type (`/problems/not-acceptable`)",
+        content_type = "application/problem+json"
+    )]
+    NotAcceptable(Problem),
+    /// The body did not arrive within the body timeout.
+    #[response(
+        status = 408,
+        description = "Request body timeout (`/problems/request-timeout`)",
+        content_type = "application/problem+json"
+    )]
+    RequestTimeout(Problem),
     /// The body exceeds the configured size limit.
     #[response(
         status = 413,
@@ -118,6 +137,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
     openapi::Registry::new(OpenApiRouter::with_openapi(ApiDoc::openapi()))
         .route(routes!(meta::healthz))
         .route(routes!(meta::index))
+        .route(routes!(meta::examples))
         .route(routes!(cam_law::evaluate))
         .route(routes!(cam_law_fit::fit))
         .route(routes!(cognates::construct))
@@ -150,8 +170,11 @@ pub fn openapi() -> utoipa::openapi::OpenApi {
 pub fn app(state: AppState) -> Router {
     let (router, _api) = api_router().0.split_for_parts();
     let body_limit = state.config.max_body_bytes;
-    router
+    let cors = layers::cors(&state.config.cors_origins);
+    let mut app = router
+        .route("/", get(meta::page))
         .route("/openapi.json", get(meta::openapi_json))
+        .route("/metrics", get(meta::metrics))
         .route("/docs", get(meta::docs))
         .route("/docs/", get(meta::docs))
         .route("/docs/swagger-ui-bundle.js", get(meta::swagger_js))
@@ -161,7 +184,20 @@ pub fn app(state: AppState) -> Router {
         .with_state(state)
         .layer(DefaultBodyLimit::max(body_limit))
         .layer(CatchPanicLayer::custom(panic_response))
-        .layer(middleware::from_fn(log_request))
+        .layer(middleware::from_fn(picture::picture))
+        .layer(middleware::from_fn(stream::event_stream))
+        .layer(middleware::from_fn(layers::log_request));
+    for (name, value) in layers::hardening_headers() {
+        app = app.layer(SetResponseHeaderLayer::if_not_present(name, value));
+    }
+    if let Some(cors) = cors {
+        app = app.layer(cors);
+    }
+    app.layer(PropagateRequestIdLayer::new(layers::REQUEST_ID))
+        .layer(SetRequestIdLayer::new(
+            layers::REQUEST_ID,
+            layers::MakeId::default(),
+        ))
 }
 
 async fn not_found(uri: Uri) -> ApiError {
@@ -177,48 +213,89 @@ fn panic_response(payload: Box<dyn std::any::Any + Send + 'static>) -> Response<
     ApiError::internal().into_response()
 }
 
-/// One structured log line per request: method, path, status, latency. Bodies are never logged.
-async fn log_request(req: Request, next: Next) -> Response {
-    let method = req.method().clone();
-    let path = req.uri().path().to_owned();
-    let span = tracing::info_span!("request", %method, %path);
-    let start = Instant::now();
-    let resp = next.run(req).instrument(span).await;
-    let latency_ms = start.elapsed().as_secs_f64() * 1e3;
-    tracing::info!(%method, %path, status = resp.status().as_u16(), latency_ms, "request");
-    resp
-}
-
 /// Serialize a calculation's response as JSON, refusing to send a non-finite number (a bug:
 /// logged, answered with 500).
 pub fn respond<T: Serialize>(value: &T) -> Result<Response, ApiError> {
-    if let Some(pointer) = finite::first_non_finite(value) {
+    encode(value).map(json_response)
+}
+
+/// The JSON body of a response: checked for non-finite numbers (one allocation-free pass), then
+/// written once into a buffer. Runs inside the compute job, so large answers are encoded on the
+/// bounded compute pool, not on the threads that accept connections.
+pub fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
+    if !finite::all_finite(value) {
+        let pointer = finite::first_non_finite(value).unwrap_or_default();
         tracing::error!(%pointer, "calculation produced a non-finite number");
         return Err(ApiError::internal());
     }
-    let body = serde_json::to_vec(value).map_err(|e| {
+    serde_json::to_vec(value).map_err(|e| {
         tracing::error!(error = %e, "response serialization failed");
         ApiError::internal()
-    })?;
+    })
+}
+
+/// An `application/json` response from an encoded body.
+fn json_response(body: Vec<u8>) -> Response {
     let mut r = body.into_response();
     r.headers_mut().insert(
         header::CONTENT_TYPE,
         HeaderValue::from_static("application/json"),
     );
-    Ok(r)
+    r
 }
 
 /// Run a module's calculation on the compute pool with a budget of `limit` (capped by the server
-/// maximum), map its failure to problem+json and respond.
+/// maximum), encode its answer there too, map its failure to problem+json and respond.
+///
+/// `demand` is the request's time limit (`Option<Duration>`) or a [`pool::Demand`] that also
+/// carries the module's cost estimate. An answer larger than `--max-response-bytes` is refused
+/// with a 422 (`/problems/too-large`); modules that can tell the size before computing refuse
+/// earlier, naming the option to change.
 pub async fn run_calc<T, F>(
     state: &AppState,
-    limit: Option<Duration>,
+    demand: impl Into<pool::Demand>,
     job: F,
 ) -> Result<Response, ApiError>
 where
     T: Serialize + Send + 'static,
     F: FnOnce(&Budget) -> Result<T, CalcFailure> + Send + 'static,
 {
-    let out = state.pool.run(limit, job).await??;
-    respond(&out)
+    let max_bytes = state.config.max_response_bytes;
+    let arrived = std::time::Instant::now();
+    let (body, compute, encoding, started) = state
+        .pool
+        .run(demand, move |budget| {
+            let started = std::time::Instant::now();
+            let out = job(budget).map_err(ApiError::from)?;
+            let computed = std::time::Instant::now();
+            let body = encode(&out)?;
+            drop(out);
+            if body.len() > max_bytes {
+                return Err(ApiError::from(CalcFailure::general(
+                    crate::calc::ProblemClass::TooLarge,
+                    "RESPONSE_TOO_LARGE",
+                    format!(
+                        "the answer is {} bytes, over the service's limit of {max_bytes} \
+                         bytes; request fewer points or fewer optional outputs",
+                        body.len()
+                    ),
+                )));
+            }
+            Ok((body, computed - started, computed.elapsed(), started))
+        })
+        .await??;
+    let mut r = json_response(body);
+    // Server-Timing (W3C): where the time of this answer went, for clients and benchmarks.
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let queue = started.saturating_duration_since(arrived);
+    if let Ok(v) = HeaderValue::from_str(&format!(
+        "queue;dur={:.3}, compute;dur={:.3}, encode;dur={:.3}",
+        ms(queue),
+        ms(compute),
+        ms(encoding)
+    )) {
+        r.headers_mut()
+            .insert(HeaderName::from_static("server-timing"), v);
+    }
+    Ok(r)
 }

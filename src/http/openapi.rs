@@ -101,6 +101,28 @@ fn build() -> (Value, Vec<String>) {
         problems.extend(apply_bounds(schemas, &crate::calc::schema_bounds()));
         close_tagged_enums(schemas);
     }
+    let request_roots: Vec<String> = doc
+        .get("paths")
+        .and_then(Value::as_object)
+        .map(|paths| {
+            paths
+                .values()
+                .filter_map(|item| {
+                    item.pointer("/post/requestBody/content/application~1json/schema/$ref")
+                        .and_then(Value::as_str)
+                        .and_then(|r| r.strip_prefix("#/components/schemas/"))
+                        .map(str::to_owned)
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    if let Some(schemas) = doc
+        .pointer_mut("/components/schemas")
+        .and_then(Value::as_object_mut)
+    {
+        allow_null_for_optional_request_fields(schemas, &request_roots);
+    }
+    document_alternative_media_types(&mut doc);
     (doc, problems)
 }
 
@@ -143,10 +165,17 @@ fn type_is(schema: &Value, ty: &str) -> bool {
 fn apply_bounds(schemas: &mut Map<String, Value>, bounds: &[SchemaBound]) -> Vec<String> {
     let mut missing = Vec::new();
     for b in bounds {
+        // A property name, or a JSON pointer into the schema (fields of enum variants, which
+        // utoipa renders inline: `/oneOf/0/properties/d`).
         let target = schemas
             .get_mut(b.schema.as_ref())
-            .and_then(|s| s.get_mut("properties"))
-            .and_then(|p| p.get_mut(b.property))
+            .and_then(|s| {
+                if b.property.starts_with('/') {
+                    s.pointer_mut(b.property)
+                } else {
+                    s.get_mut("properties").and_then(|p| p.get_mut(b.property))
+                }
+            })
             .and_then(|p| if b.items { p.get_mut("items") } else { Some(p) })
             .and_then(Value::as_object_mut);
         match target {
@@ -320,4 +349,141 @@ fn reference_counts(schemas: &Map<String, Value>) -> BTreeMap<String, usize> {
         walk(s, &mut out);
     }
     out
+}
+
+/// Request decoding reads an explicit `null` for an optional field as "absent" (and some fields
+/// use `null` to mean "none", e.g. a limit that is off), so the documented request schemas say
+/// so: every optional property of a schema reachable from a request body also admits `null`.
+/// (Responses omit absent fields; their schemas are not changed.)
+fn allow_null_for_optional_request_fields(schemas: &mut Map<String, Value>, roots: &[String]) {
+    let mut seen: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
+    let mut todo: Vec<String> = roots.to_vec();
+    while let Some(name) = todo.pop() {
+        if !seen.insert(name.clone()) {
+            continue;
+        }
+        if let Some(s) = schemas.get(&name) {
+            collect_refs(s, &mut todo);
+        }
+    }
+    for name in seen {
+        let Some(schema) = schemas.get_mut(&name) else {
+            continue;
+        };
+        let required: Vec<String> = schema
+            .get("required")
+            .and_then(Value::as_array)
+            .map(|r| {
+                r.iter()
+                    .filter_map(|x| x.as_str().map(str::to_owned))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let Some(props) = schema.get_mut("properties").and_then(Value::as_object_mut) else {
+            continue;
+        };
+        for (prop, body) in props.iter_mut() {
+            if !required.contains(prop) {
+                admit_null(body);
+            }
+        }
+    }
+}
+
+fn collect_refs(v: &Value, out: &mut Vec<String>) {
+    match v {
+        Value::Object(m) => {
+            if let Some(n) = m
+                .get("$ref")
+                .and_then(Value::as_str)
+                .and_then(|r| r.strip_prefix("#/components/schemas/"))
+            {
+                out.push(n.to_owned());
+            }
+            m.values().for_each(|x| collect_refs(x, out));
+        }
+        Value::Array(a) => a.iter().for_each(|x| collect_refs(x, out)),
+        _ => {}
+    }
+}
+
+/// Make a property schema admit `null` as well, keeping its description at the top.
+fn admit_null(body: &mut Value) {
+    let Some(obj) = body.as_object_mut() else {
+        return;
+    };
+    match obj.get_mut("type") {
+        Some(Value::String(t)) => {
+            let t = t.clone();
+            if t != "null" {
+                obj.insert("type".to_owned(), json!([t, "null"]));
+            }
+            if let Some(Value::Array(e)) = obj.get_mut("enum")
+                && !e.contains(&Value::Null)
+            {
+                e.push(Value::Null);
+            }
+            return;
+        }
+        Some(Value::Array(a)) => {
+            if !a.iter().any(|x| x == "null") {
+                a.push(json!("null"));
+            }
+            if let Some(Value::Array(e)) = obj.get_mut("enum")
+                && !e.contains(&Value::Null)
+            {
+                e.push(Value::Null);
+            }
+            return;
+        }
+        _ => {}
+    }
+    if let Some(Value::Array(alts)) = obj.get_mut("oneOf") {
+        if !alts.iter().any(|a| a.get("type") == Some(&json!("null"))) {
+            alts.push(json!({"type": "null"}));
+        }
+        return;
+    }
+    if let Some(r) = obj.remove("$ref") {
+        obj.insert(
+            "oneOf".to_owned(),
+            json!([{ "$ref": r }, { "type": "null" }]),
+        );
+    } else if let Some(parts) = obj.remove("allOf") {
+        obj.insert(
+            "oneOf".to_owned(),
+            json!([{ "allOf": parts }, { "type": "null" }]),
+        );
+    }
+}
+
+/// Every calculation can also answer as an event stream (progress, then the JSON answer) and,
+/// where it has a picture, as SVG; the 200 response of each POST operation says so.
+fn document_alternative_media_types(doc: &mut Value) {
+    let Some(paths) = doc.get_mut("paths").and_then(Value::as_object_mut) else {
+        return;
+    };
+    for (route, item) in paths.iter_mut() {
+        let Some(content) = item
+            .pointer_mut("/post/responses/200/content")
+            .and_then(Value::as_object_mut)
+        else {
+            continue;
+        };
+        content.insert(
+            "text/event-stream".to_owned(),
+            json!({"schema": {"type": "string", "description":
+                "With `Accept: text/event-stream`: Server-Sent Events `progress` ({fraction, best?, \
+                 elapsed_ms}) while the calculation runs, then one `result` event whose data is the \
+                 JSON answer above (or one `problem` event with the problem details)."}}),
+        );
+        if crate::plot::has_picture(route) {
+            content.insert(
+                "image/svg+xml".to_owned(),
+                json!({"schema": {"type": "string", "description":
+                    "With `Accept: image/svg+xml`: the answer's picture (SVG; axes carry quantity \
+                     and unit)."}}),
+            );
+        }
+    }
 }

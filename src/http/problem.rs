@@ -189,6 +189,58 @@ impl ApiError {
         e
     }
 
+    /// 406: the endpoint has no representation in the media type the client accepts.
+    pub fn not_acceptable(route: &str) -> Self {
+        Self::new(
+            StatusCode::NOT_ACCEPTABLE,
+            "not-acceptable",
+            "Not acceptable",
+            "NOT_ACCEPTABLE",
+            format!("{route} answers application/json (and text/event-stream); it has no picture"),
+        )
+    }
+
+    /// 408: the request body did not arrive within the body timeout.
+    pub fn request_timeout(timeout_ms: u64) -> Self {
+        Self::new(
+            StatusCode::REQUEST_TIMEOUT,
+            "request-timeout",
+            "Request body timeout",
+            "REQUEST_TIMEOUT",
+            format!("the request body did not arrive within {timeout_ms} ms"),
+        )
+    }
+
+    /// 503: the service is stopping and takes no new work.
+    pub fn shutting_down() -> Self {
+        let mut e = Self::new(
+            StatusCode::SERVICE_UNAVAILABLE,
+            "overloaded",
+            "Service stopping",
+            "SHUTTING_DOWN",
+            "the service is shutting down; retry against another replica",
+        );
+        e.0.retry_after_s = Some(1);
+        e
+    }
+
+    /// 503 when the queue cannot start the job before its time budget runs out: refused at once
+    /// instead of after waiting for nothing.
+    pub fn cannot_start_in_time(retry_after_s: u64, wait_ms: u64, budget_ms: u64) -> Self {
+        let mut e = Self::new(
+            StatusCode::SERVICE_UNAVAILABLE,
+            "overloaded",
+            "Compute pool saturated",
+            "OVERLOADED",
+            format!(
+                "the expected wait for a compute slot ({wait_ms} ms) exceeds the request's time \
+                 budget ({budget_ms} ms); retry in {retry_after_s} s or send a larger time_limit_ms"
+            ),
+        );
+        e.0.retry_after_s = Some(retry_after_s);
+        e
+    }
+
     /// 500: a bug. The detail sent to the client is generic; the cause is logged, never echoed.
     pub fn internal() -> Self {
         Self::new(

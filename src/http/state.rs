@@ -19,6 +19,7 @@ impl AppState {
     /// Build the state from a configuration.
     #[must_use]
     pub fn new(config: ServiceConfig) -> Self {
+        super::telemetry::install();
         let pool = ComputePool::new(
             config.effective_compute_slots(),
             config.queue_depth,

@@ -15,19 +15,67 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 /// A wall-clock deadline plus an optional cap on objective/model evaluations, the number of threads
-/// the job may use, and a cancellation flag the service raises when the client has gone.
-#[derive(Debug, Clone)]
+/// the job may use, a cancellation flag the service raises when the client has gone, and an
+/// optional progress sink (streaming clients see how far a long job is).
+#[derive(Clone)]
 pub struct Budget {
     start: Instant,
     deadline: Instant,
     max_evaluations: Option<u64>,
     threads: usize,
     cancel: Option<Arc<AtomicBool>>,
+    progress: Option<Arc<ProgressSink>>,
 }
 
-/// The threads a job may use when nobody says otherwise: the machine's cores.
+impl std::fmt::Debug for Budget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Budget")
+            .field("remaining", &self.remaining())
+            .field("max_evaluations", &self.max_evaluations)
+            .field("threads", &self.threads)
+            .field("cancelled", &self.cancelled())
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
+}
+
+/// How far a long job is, for streaming clients.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+pub struct Progress {
+    /// Fraction of the work done, in [0, 1] (an estimate for open-ended solvers).
+    pub fraction: f64,
+    /// Best objective so far, when the job is an optimisation.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub best: Option<f64>,
+    /// Wall-clock time since the request arrived [ms].
+    pub elapsed_ms: f64,
+}
+
+/// Where progress goes: a callback, called at most every [`PROGRESS_INTERVAL`].
+pub struct ProgressSink {
+    send: Box<dyn Fn(Progress) + Send + Sync>,
+    last_ns: std::sync::atomic::AtomicU64,
+}
+
+/// Smallest interval between two progress reports of one job.
+pub const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
+
+impl ProgressSink {
+    /// A sink that calls `send` with each report.
+    pub fn new(send: impl Fn(Progress) + Send + Sync + 'static) -> Self {
+        Self {
+            send: Box::new(send),
+            last_ns: std::sync::atomic::AtomicU64::new(0),
+        }
+    }
+}
+
+/// The threads a job may use when nobody says otherwise: the machine's cores (read once: the
+/// query reads cgroup files and costs tens of microseconds).
 fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES
+        .get_or_init(|| std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get))
 }
 
 impl Budget {
@@ -49,7 +97,46 @@ impl Budget {
             max_evaluations: None,
             threads: default_threads(),
             cancel: None,
+            progress: None,
         }
+    }
+
+    /// The same budget, reporting progress to `sink`.
+    #[must_use]
+    pub fn with_progress(mut self, sink: Arc<ProgressSink>) -> Self {
+        self.progress = Some(sink);
+        self
+    }
+
+    /// Report progress (`fraction` of the work done, best objective so far). Cheap when nobody
+    /// listens; at most one report per [`PROGRESS_INTERVAL`] reaches the listener, except the
+    /// first.
+    pub fn progress(&self, fraction: f64, best: Option<f64>) {
+        let Some(sink) = &self.progress else {
+            return;
+        };
+        let now = u64::try_from(self.start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        let last = sink.last_ns.load(Ordering::Relaxed);
+        let interval = u64::try_from(PROGRESS_INTERVAL.as_nanos()).unwrap_or(u64::MAX);
+        if last != 0 && now.saturating_sub(last) < interval {
+            return;
+        }
+        if sink
+            .last_ns
+            .compare_exchange(last, now.max(1), Ordering::Relaxed, Ordering::Relaxed)
+            .is_err()
+        {
+            return;
+        }
+        (sink.send)(Progress {
+            fraction: if fraction.is_finite() {
+                fraction.clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+            best: best.filter(|b| b.is_finite()),
+            elapsed_ms: self.elapsed_ms(),
+        });
     }
 
     /// A budget that, for practical purposes, never runs out (one day). For tests and benchmarks.
@@ -178,10 +265,8 @@ pub struct SolverReport {
     /// How the solver stopped.
     pub stop_reason: StopReason,
     /// Iterations (generations, Newton steps, sweep nodes) performed.
-    #[schema(minimum = 0)]
     pub iterations: u64,
     /// Model/objective evaluations performed.
-    #[schema(minimum = 0)]
     pub evaluations: u64,
     /// Wall-clock time spent in the solver [ms].
     pub elapsed_ms: f64,

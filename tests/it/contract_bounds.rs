@@ -15,17 +15,28 @@ use serde_json::{Value, json};
 
 /// Fields whose rejection depends on other fields (`endpoint`, pointer): the rule is in the
 /// field's description in the document.
+#[rustfmt::skip]
 const CROSS_FIELD: &[(&str, &str, &str)] = &[
-    (
-        "/v1/machining-size/train",
-        "/params/colsample_bytree",
-        "⌊colsample_bytree·d⌋ ≥ 1, d = features left after dropping constant columns",
-    ),
-    (
-        "/v1/machining-size/train",
-        "/params/min_child_weight",
-        "the training split needs ≥ 2·max(1, min_child_weight) rows",
-    ),
+    ("/v1/cam-law/evaluate", "/constraints/t_b", "t_b > t_a, with t_b − t_a resolvable at the offset"),
+    ("/v1/cam-law/evaluate", "/abscissa/values/0", "abscissae increase and lie in [t_a, t_b]"),
+    ("/v1/cam-law/evaluate", "/abscissa/grid/start", "the grid lies in [t_a, t_b]"),
+    ("/v1/cam-law/evaluate", "/abscissa/grid/end", "end > start, and the grid lies in [t_a, t_b]"),
+    ("/v1/component-importance", "/overrides/0/time_h", "one of times_h"),
+    ("/v1/component-importance", "/options/o_out", "q_in + o_out = 1"),
+    ("/v1/fit-cam-law", "/constraints/t_b", "t_b > t_a"),
+    ("/v1/fit-cam-law", "/abscissa/grid/end", "end > start"),
+    ("/v1/irefc-stress", "/sweep/Z2/to", "to ≥ from"),
+    ("/v1/irefc-stress", "/sweep/chi/to", "to ≥ from"),
+    ("/v1/continuum-workspace", "/inputs_m/0", "within the actuator's stroke"),
+    ("/v1/continuum-workspace", "/design/rods/0/actuator", "an index of design.actuators"),
+    ("/v1/bus-fuel-economy", "/motors/0/lq_h", "lq_h ≥ ld_h"),
+    ("/v1/bus-fuel-economy", "/motors/0/n_max_rpm", "above the cycles' top motor speed"),
+    ("/v1/bus-fuel-economy/motor-map", "/motor/lq_h", "lq_h ≥ ld_h"),
+    ("/v1/continuum-workspace", "/design/rods/0/diameter_m", "slenderness length_m / diameter_m ≥ 5"),
+    ("/v1/continuum-workspace", "/load/moment_nm", "within 1e4 F_ref L_ref of the design's own scale"),
+    ("/v1/continuum-workspace", "/load/force_n/0", "within 1e4 F_ref of the design's own scale"),
+    ("/v1/machining-size/train", "/params/colsample_bytree", "⌊colsample_bytree·d⌋ ≥ 1, d = features left after dropping constant columns"),
+    ("/v1/machining-size/train", "/params/min_child_weight", "the training split needs ≥ 2·max(1, min_child_weight) rows"),
 ];
 
 /// A number in an example request with its documented bound, if any.
@@ -90,7 +101,12 @@ fn walk(doc: &Value, schema: &Value, instance: &Value, pointer: &str, out: &mut 
         }
     }
     match instance {
-        Value::Number(_) if is_type(s, "number") || is_type(s, "integer") => {
+        // A number restricted to listed values (`enum`) is documented by that list.
+        Value::Number(_)
+            if (is_type(s, "number") || is_type(s, "integer"))
+                && s.get("enum").is_none()
+                && s.get("const").is_none() =>
+        {
             let bound = |k: &str, ek: &str| {
                 s.get(k)
                     .and_then(Value::as_f64)

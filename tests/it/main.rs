@@ -8,6 +8,7 @@ mod support;
 use support::http as common;
 
 mod api_examples;
+mod cli;
 mod contract;
 mod contract_bounds;
 mod http_bus_fuel_economy;
@@ -30,3 +31,4 @@ mod paper_component_importance;
 mod paper_continuum_workspace;
 mod paper_irefc;
 mod paper_machining_size;
+mod pictures;

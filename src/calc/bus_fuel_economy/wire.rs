@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::calc::Range;
 use crate::numerics::SolverReport;
 
 // ---------------------------------------------------------------------------------------------
@@ -45,46 +46,46 @@ pub struct BusFuelEconomyRequest {
 #[serde(deny_unknown_fields, default)]
 pub struct VehicleSpec {
     /// Curb mass [kg].
-    #[schema(minimum = 0.0, maximum = 100000.0, example = 12500.0)]
+    #[schema(example = 12500.0)]
     pub curb_mass_kg: f64,
     /// Number of passengers [-] (0..500).
-    #[schema(minimum = 0, maximum = 500, example = 40)]
+    #[schema(example = 40)]
     pub passengers: u32,
     /// Mass per passenger [kg].
-    #[schema(minimum = 0.0, maximum = 200.0, example = 65.0)]
+    #[schema(example = 65.0)]
     pub mass_per_passenger_kg: f64,
     /// Frontal area A_F [m²].
-    #[schema(minimum = 0.0, maximum = 30.0, example = 6.72)]
+    #[schema(example = 6.72)]
     pub frontal_area_m2: f64,
     /// Aerodynamic drag coefficient C_d [-].
-    #[schema(minimum = 0.0, maximum = 3.0, example = 0.7)]
+    #[schema(example = 0.7)]
     pub drag_coeff: f64,
     /// Rolling resistance coefficient f_R [-].
-    #[schema(minimum = 0.0, maximum = 0.1, example = 0.007)]
+    #[schema(example = 0.007)]
     pub rolling_coeff: f64,
     /// Air density ρ_air [kg/m³].
-    #[schema(minimum = 0.0, maximum = 2.0, example = 1.28)]
+    #[schema(example = 1.28)]
     pub air_density: f64,
     /// Gravitational acceleration g [m/s²].
-    #[schema(minimum = 9.0, maximum = 10.5, example = 9.81)]
+    #[schema(example = 9.81)]
     pub gravity: f64,
     /// Wheel radius r [m].
-    #[schema(minimum = 0.1, maximum = 2.0, example = 0.48)]
+    #[schema(example = 0.48)]
     pub wheel_radius_m: f64,
     /// Single fixed reduction ratio i_g [-] (service minimum 0.01).
-    #[schema(minimum = 0.01, maximum = 50.0, example = 9.5)]
+    #[schema(example = 9.5)]
     pub gear_ratio: f64,
     /// Gear efficiency η_T [-], applied in both power directions (service minimum 0.01).
-    #[schema(minimum = 0.01, maximum = 1.0, example = 0.95)]
+    #[schema(example = 0.95)]
     pub gear_efficiency: f64,
     /// Rotational inertia factor δ [-]: effective mass m(1+δ).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.0)]
+    #[schema(example = 0.0)]
     pub rotational_inertia_factor: f64,
     /// Constant road slope tanθ [-] (a custom cycle's own `grade` array replaces it).
-    #[schema(minimum = -0.3, maximum = 0.3, example = 0.0)]
+    #[schema(example = 0.0)]
     pub grade: f64,
     /// Constant auxiliary DC load [W].
-    #[schema(minimum = 0.0, maximum = 100000.0, example = 0.0)]
+    #[schema(example = 0.0)]
     pub aux_power_w: f64,
 }
 
@@ -115,7 +116,7 @@ impl Default for VehicleSpec {
 #[serde(deny_unknown_fields, default)]
 pub struct InverterSpec {
     /// Inverter efficiency η_Inv [-], applied in both power directions (service minimum 0.01).
-    #[schema(minimum = 0.01, maximum = 1.0, example = 0.95)]
+    #[schema(example = 0.95)]
     pub efficiency: f64,
 }
 
@@ -147,35 +148,35 @@ pub struct BatterySpec {
     #[serde(default)]
     pub model: BatteryModel,
     /// constant: battery efficiency η_Bat [-] (default 1.0, service minimum 0.01).
-    #[schema(minimum = 0.01, maximum = 1.0, example = 1.0)]
+    #[schema(example = 1.0)]
     pub efficiency: Option<f64>,
     /// ecm_2rc: nominal voltage [V] (default 360), used for the charge capacity Q.
-    #[schema(minimum = 0.0, maximum = 5000.0, example = 360.0)]
+    #[schema(example = 360.0)]
     pub nominal_voltage: Option<f64>,
     /// ecm_2rc: energy capacity [kWh] (default 256).
-    #[schema(minimum = 0.0, maximum = 10000.0, example = 256.0)]
+    #[schema(example = 256.0)]
     pub capacity_kwh: Option<f64>,
     /// ecm_2rc: initial state of charge (0, 1] [-].
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.9)]
+    #[schema(example = 0.9)]
     pub soc_initial: Option<f64>,
     /// ecm_2rc: SOC points of the open-circuit-voltage table, strictly increasing in [0, 1].
     pub ocv_soc: Option<Vec<f64>>,
     /// ecm_2rc: open-circuit voltage at `ocv_soc` [V] (> 0).
     pub ocv_v: Option<Vec<f64>>,
     /// ecm_2rc: series resistance R0 [Ω] (> 0).
-    #[schema(minimum = 0.0, maximum = 100.0, example = 0.03)]
+    #[schema(example = 0.03)]
     pub r0_ohm: Option<f64>,
     /// ecm_2rc: first RC branch resistance R1 [Ω] (≥ 0).
-    #[schema(minimum = 0.0, maximum = 100.0, example = 0.01)]
+    #[schema(example = 0.01)]
     pub r1_ohm: Option<f64>,
     /// ecm_2rc: first RC branch capacitance C1 [F] (> 0).
-    #[schema(minimum = 0.0, example = 3000.0)]
+    #[schema(example = 3000.0)]
     pub c1_f: Option<f64>,
     /// ecm_2rc: second RC branch resistance R2 [Ω] (≥ 0).
-    #[schema(minimum = 0.0, maximum = 100.0, example = 0.01)]
+    #[schema(example = 0.01)]
     pub r2_ohm: Option<f64>,
     /// ecm_2rc: second RC branch capacitance C2 [F] (> 0).
-    #[schema(minimum = 0.0, example = 30000.0)]
+    #[schema(example = 30000.0)]
     pub c2_f: Option<f64>,
 }
 
@@ -255,16 +256,16 @@ pub struct ConstantMotor {
     /// Motor name (unique in the request, 1..64 characters).
     pub id: String,
     /// Motor efficiency η_M [-], both directions (service minimum 0.01).
-    #[schema(minimum = 0.01, maximum = 1.0, example = 0.93)]
+    #[schema(example = 0.93)]
     pub efficiency: f64,
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
-    #[schema(minimum = 0.0, example = 800.0)]
+    #[schema(example = 800.0)]
     pub t_peak_nm: Option<f64>,
     /// Peak power [W] (default 130 000; ignored when `envelope` is given).
-    #[schema(minimum = 0.0, example = 130000.0)]
+    #[schema(example = 130000.0)]
     pub p_peak_w: Option<f64>,
     /// Maximum speed [rpm] (default 5200); a cycle needing more is rejected.
-    #[schema(minimum = 0.0, maximum = 100000.0, example = 5200.0)]
+    #[schema(example = 5200.0)]
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope (replaces `t_peak_nm` / `p_peak_w`).
     #[schema(nullable = false)]
@@ -327,10 +328,10 @@ pub struct LossMapMotor {
 #[serde(deny_unknown_fields)]
 pub struct BackEmf {
     /// Peak phase back-EMF [V].
-    #[schema(minimum = 0.0, example = 83.3)]
+    #[schema(example = 83.3)]
     pub v_peak_phase: f64,
     /// Speed of the measurement [rpm].
-    #[schema(minimum = 0.0, example = 1000.0)]
+    #[schema(example = 1000.0)]
     pub at_rpm: f64,
 }
 
@@ -371,19 +372,19 @@ pub struct AcFactorTable {
 #[serde(deny_unknown_fields)]
 pub struct DowellSpec {
     /// Conductor height h in the slot-depth direction [m].
-    #[schema(minimum = 0.0, maximum = 0.1, example = 0.0035)]
+    #[schema(example = 0.0035)]
     pub conductor_height_m: f64,
     /// Number of conductor layers m in the slot [-] (1..100).
-    #[schema(minimum = 1, maximum = 100, example = 6)]
+    #[schema(example = 6)]
     pub layers: u32,
     /// Layer porosity factor (0, 1] [-].
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.9)]
+    #[schema(example = 0.9)]
     pub porosity: f64,
     /// Active (slot) length of the winding per side L_stack [m].
-    #[schema(minimum = 0.0, maximum = 10.0, example = 0.083)]
+    #[schema(example = 0.083)]
     pub stack_length_m: f64,
     /// End-winding length per side L_end [m] (≥ 0).
-    #[schema(minimum = 0.0, maximum = 10.0, example = 0.05)]
+    #[schema(example = 0.05)]
     pub end_length_m: f64,
 }
 
@@ -393,10 +394,10 @@ pub struct DowellSpec {
 #[serde(deny_unknown_fields, default)]
 pub struct IronSpec {
     /// Hysteresis coefficient k_h [W/(Wb²·rad/s)] (≥ 0).
-    #[schema(minimum = 0.0, example = 3.0)]
+    #[schema(example = 3.0)]
     pub k_h: f64,
     /// Eddy-current coefficient k_e [W/(Wb²·(rad/s)²)] (≥ 0).
-    #[schema(minimum = 0.0, example = 0.03)]
+    #[schema(example = 0.03)]
     pub k_e: f64,
 }
 
@@ -406,10 +407,10 @@ pub struct IronSpec {
 #[serde(deny_unknown_fields, default)]
 pub struct MechSpec {
     /// Friction torque [N·m] (≥ 0).
-    #[schema(minimum = 0.0, example = 0.0)]
+    #[schema(example = 0.0)]
     pub c_fric_nm: f64,
     /// Windage coefficient [W·s³/rad³] (≥ 0).
-    #[schema(minimum = 0.0, example = 0.0)]
+    #[schema(example = 0.0)]
     pub c_wind: f64,
 }
 
@@ -421,43 +422,43 @@ pub struct IpmsmMotor {
     /// Motor name (unique in the request, 1..64 characters).
     pub id: String,
     /// Pole pairs p (1..32).
-    #[schema(minimum = 1, maximum = 32, example = 4)]
+    #[schema(example = 4)]
     pub pole_pairs: u32,
     /// Peak phase PM flux linkage ψ_m [Wb] (give this or `back_emf`).
-    #[schema(minimum = 0.0, maximum = 100.0, example = 0.198864)]
+    #[schema(example = 0.198864)]
     pub psi_m_wb: Option<f64>,
     /// Back-EMF from which ψ_m is derived (give this or `psi_m_wb`).
     #[schema(nullable = false)]
     pub back_emf: Option<BackEmf>,
     /// d-axis inductance L_d [H] (> 0).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.00035)]
+    #[schema(example = 0.00035)]
     pub ld_h: f64,
     /// q-axis inductance L_q [H] (≥ L_d).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.00055)]
+    #[schema(example = 0.00055)]
     pub lq_h: f64,
     /// Phase resistance at 20 °C R_20 [Ω] (> 0).
-    #[schema(minimum = 0.0, maximum = 100.0, example = 0.006)]
+    #[schema(example = 0.006)]
     pub r_phase_20c_ohm: f64,
     /// Winding temperature T_w [°C] (default 100).
-    #[schema(minimum = -40.0, maximum = 250.0, example = 100.0)]
+    #[schema(example = 100.0)]
     pub winding_temp_c: Option<f64>,
     /// Current limit [A rms] (I_pk = √2·i_max_arms).
-    #[schema(minimum = 0.0, maximum = 100000.0, example = 500.0)]
+    #[schema(example = 500.0)]
     pub i_max_arms: f64,
     /// DC-link voltage V_dc [V].
-    #[schema(minimum = 0.0, maximum = 100000.0, example = 360.0)]
+    #[schema(example = 360.0)]
     pub v_dc: f64,
     /// Voltage utilisation (0, 1.155] [-] (default 1.0 → V_max = V_dc/√3).
-    #[schema(minimum = 0.0, maximum = 1.155, example = 1.0)]
+    #[schema(example = 1.0)]
     pub voltage_utilization: Option<f64>,
     /// Maximum speed [rpm]; a cycle needing more is rejected.
-    #[schema(minimum = 0.0, maximum = 100000.0, example = 5200.0)]
+    #[schema(example = 5200.0)]
     pub n_max_rpm: f64,
     /// Torque cap [N·m] (default none).
-    #[schema(minimum = 0.0, example = 800.0)]
+    #[schema(example = 800.0)]
     pub t_cap_nm: Option<f64>,
     /// Power cap [W] (default none).
-    #[schema(minimum = 0.0, example = 130000.0)]
+    #[schema(example = 130000.0)]
     pub p_cap_w: Option<f64>,
     /// AC resistance factor model (default `none`).
     #[schema(nullable = false)]
@@ -470,7 +471,7 @@ pub struct IpmsmMotor {
     pub mech: Option<MechSpec>,
     /// Stack-length scale s (paper §3.2; needs the `dowell` AC model for the slot/end split).
     /// Not validated against data.
-    #[schema(minimum = 0.0, maximum = 10.0, example = 1.0)]
+    #[schema(example = 1.0)]
     pub stack_scale: Option<f64>,
 }
 
@@ -532,10 +533,10 @@ pub enum OutputKind {
 #[serde(deny_unknown_fields)]
 pub struct GridSpec {
     /// Speed step [rpm].
-    #[schema(minimum = 1.0, maximum = 10000.0, example = 250.0)]
+    #[schema(example = 250.0)]
     pub speed_step_rpm: f64,
     /// Torque step [N·m].
-    #[schema(minimum = 0.1, maximum = 10000.0, example = 50.0)]
+    #[schema(example = 50.0)]
     pub torque_step_nm: f64,
 }
 
@@ -554,10 +555,10 @@ impl Default for GridSpec {
 #[serde(deny_unknown_fields)]
 pub struct HistogramSpec {
     /// Speed bin width [rpm].
-    #[schema(minimum = 1.0, maximum = 100000.0, example = 500.0)]
+    #[schema(example = 500.0)]
     pub speed_bin_rpm: f64,
     /// Torque bin width [N·m].
-    #[schema(minimum = 0.1, maximum = 100000.0, example = 100.0)]
+    #[schema(example = 100.0)]
     pub torque_bin_nm: f64,
 }
 
@@ -583,7 +584,7 @@ pub struct OptionsSpec {
     pub power_convention: PowerConvention,
     /// Split each cycle interval into k equal pieces (1..32; accuracy knob; default 1).
     #[serde(default = "default_substeps")]
-    #[schema(minimum = 1, maximum = 32, example = 1)]
+    #[schema(example = 1)]
     pub substeps: u32,
     /// Allow regenerative braking (default true).
     #[serde(default = "default_true")]
@@ -936,4 +937,90 @@ pub struct LossComponentMaps {
     pub i_q_a: Vec<Vec<Option<f64>>>,
     /// Operating mode: `mtpa`, `fw` or `envelope`.
     pub mode: Vec<Vec<Option<String>>>,
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+crate::schema_bounds! {
+    VehicleSpec {
+        curb_mass_kg: Range::FINITE.gt(0.0).max(100000.0),
+        passengers: Range::INTEGER.min(0.0).max(500.0),
+        mass_per_passenger_kg: Range::FINITE.min(0.0).max(200.0),
+        frontal_area_m2: Range::FINITE.gt(0.0).max(30.0),
+        drag_coeff: Range::FINITE.gt(0.0).max(3.0),
+        rolling_coeff: Range::FINITE.min(0.0).max(0.1),
+        air_density: Range::FINITE.gt(0.0).max(2.0),
+        gravity: Range::FINITE.gt(9.0).max(10.5),
+        wheel_radius_m: Range::FINITE.gt(0.1).max(2.0),
+        gear_ratio: Range::FINITE.min(0.01).max(50.0),
+        gear_efficiency: Range::FINITE.min(0.01).max(1.0),
+        rotational_inertia_factor: Range::FINITE.min(0.0).max(1.0),
+        grade: Range::FINITE.min(-0.3).max(0.3),
+        aux_power_w: Range::FINITE.min(0.0).max(100000.0),
+    },
+    InverterSpec {
+        efficiency: Range::FINITE.min(0.01).max(1.0),
+    },
+    BatterySpec {
+        efficiency: Range::FINITE.min(0.01).max(1.0),
+        nominal_voltage: Range::FINITE.gt(0.0).max(5000.0),
+        capacity_kwh: Range::FINITE.gt(0.0).max(10000.0),
+        soc_initial: Range::FINITE.min(0.0).max(1.0),
+        r0_ohm: Range::FINITE.min(0.0).max(100.0),
+        r1_ohm: Range::FINITE.min(0.0).max(100.0),
+        c1_f: Range::FINITE.min(0.0),
+        r2_ohm: Range::FINITE.min(0.0).max(100.0),
+        c2_f: Range::FINITE.min(0.0),
+    },
+    ConstantMotor {
+        efficiency: Range::FINITE.min(0.01).max(1.0),
+        t_peak_nm: Range::FINITE.gt(0.0).max(1e6),
+        p_peak_w: Range::FINITE.gt(0.0).max(1e9),
+        n_max_rpm: Range::FINITE.gt(0.0).max(100000.0),
+    },
+    BackEmf {
+        v_peak_phase: Range::FINITE.gt(0.0),
+        at_rpm: Range::FINITE.gt(0.0),
+    },
+    DowellSpec {
+        conductor_height_m: Range::FINITE.gt(0.0).max(0.1),
+        layers: Range::INTEGER.min(1.0).max(100.0),
+        porosity: Range::FINITE.gt(0.0).max(1.0),
+        stack_length_m: Range::FINITE.gt(0.0).max(10.0),
+        end_length_m: Range::FINITE.min(0.0).max(10.0),
+    },
+    IronSpec {
+        k_h: Range::FINITE.min(0.0),
+        k_e: Range::FINITE.min(0.0),
+    },
+    MechSpec {
+        c_fric_nm: Range::FINITE.min(0.0),
+        c_wind: Range::FINITE.min(0.0),
+    },
+    IpmsmMotor {
+        pole_pairs: Range::INTEGER.min(1.0).max(32.0),
+        psi_m_wb: Range::FINITE.gt(0.0).max(100.0),
+        ld_h: Range::FINITE.gt(0.0).max(1.0),
+        lq_h: Range::FINITE.gt(0.0).max(1.0),
+        r_phase_20c_ohm: Range::FINITE.gt(0.0).max(100.0),
+        winding_temp_c: Range::FINITE.min(-40.0).max(250.0),
+        i_max_arms: Range::FINITE.gt(0.0).max(100000.0),
+        v_dc: Range::FINITE.gt(0.0).max(100000.0),
+        voltage_utilization: Range::FINITE.gt(0.0).max(1.155),
+        n_max_rpm: Range::FINITE.gt(0.0).max(100000.0),
+        t_cap_nm: Range::FINITE.gt(0.0).max(1e6),
+        p_cap_w: Range::FINITE.gt(0.0).max(1e9),
+        stack_scale: Range::FINITE.gt(0.0).max(10.0),
+    },
+    GridSpec {
+        speed_step_rpm: Range::FINITE.min(1.0).max(10000.0),
+        torque_step_nm: Range::FINITE.min(0.1).max(10000.0),
+    },
+    HistogramSpec {
+        speed_bin_rpm: Range::FINITE.min(1.0).max(100000.0),
+        torque_bin_nm: Range::FINITE.min(0.1).max(100000.0),
+    },
+    OptionsSpec {
+        substeps: Range::INTEGER.min(1.0).max(32.0),
+    },
 }

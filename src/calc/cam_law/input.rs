@@ -3,10 +3,12 @@
 
 use super::catalogue::NamedLaw;
 use super::law::{
-    BoundaryConditions, LawError, MAX_MAGNITUDE, MIN_RELATIVE_INTERVAL, Quantity,
-    normalize_coefficients,
+    BoundaryConditions, LawError, MIN_RELATIVE_INTERVAL, Quantity, normalize_coefficients,
 };
-use super::wire::{AbscissaIn, EvaluateRequest, MAX_POINTS, Units, Warning};
+use super::wire::{
+    AbscissaIn, BOUNDARY_VALUE, COEFFICIENT, EvaluateRequest, GRID_COUNT, MAX_POINTS, Units,
+    Warning,
+};
 use crate::calc::{CalcFailure, Validator};
 
 /// Coefficients must sum to 1 within this unless `normalize` is set (spec §2).
@@ -126,15 +128,10 @@ fn check_abscissa(v: &mut Validator, a: Option<AbscissaIn>) -> Option<Abscissa> 
         (None, Some(g)) => {
             let ok_start = v.finite("/abscissa/grid/start", g.start);
             let ok_end = v.finite("/abscissa/grid/end", g.end);
-            let count = usize::try_from(g.count)
-                .ok()
-                .filter(|c| (2..=MAX_POINTS).contains(c));
-            if count.is_none() {
-                v.push(
-                    "/abscissa/grid/count",
-                    format!("must be in [2, {MAX_POINTS}], got {}", g.count),
-                );
-            }
+            let count = v
+                .uint("/abscissa/grid/count", "count", g.count, GRID_COUNT)
+                .then(|| usize::try_from(g.count).ok())
+                .flatten();
             if ok_start && ok_end && g.end <= g.start {
                 v.push(
                     "/abscissa/grid/end",
@@ -164,12 +161,7 @@ fn check_coefficients(v: &mut Validator, c: &[f64], normalize: bool) -> Option<(
     let mut ok = true;
     for (i, &x) in arr.iter().enumerate() {
         let p = format!("/coefficients/{i}");
-        if !v.finite(&p, x) {
-            ok = false;
-        } else if x < 0.0 {
-            v.push(p, format!("coefficient c{i} must be >= 0, got {x}"));
-            ok = false;
-        }
+        ok &= v.range(&p, &format!("coefficient c{i}"), x, COEFFICIENT);
     }
     if !ok {
         return None;
@@ -264,15 +256,7 @@ impl TryFrom<EvaluateRequest> for EvaluateInput {
         let mut bc_ok = true;
         for (name, value) in bc.named_values() {
             let p = format!("/constraints/{name}");
-            if !v.finite(&p, value) {
-                bc_ok = false;
-            } else if value.abs() > MAX_MAGNITUDE {
-                v.push(
-                    p,
-                    format!("|{name}| must be <= {MAX_MAGNITUDE:e}, got {value}"),
-                );
-                bc_ok = false;
-            }
+            bc_ok &= v.range(&p, name, value, BOUNDARY_VALUE);
         }
         if bc_ok {
             let defaulted = |given: Option<f64>, what: &str| {

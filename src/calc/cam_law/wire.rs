@@ -9,6 +9,7 @@ use utoipa::ToSchema;
 
 use super::catalogue::{NamedLaw, PeakFactors};
 use super::law::{Jump, Knot, Quantity};
+use crate::calc::Range;
 
 /// Largest number of abscissae per evaluate request (spec §8b).
 pub const MAX_POINTS: usize = 200_000;
@@ -63,28 +64,28 @@ pub struct EvaluateRequest {
 #[serde(deny_unknown_fields)]
 pub struct ConstraintsIn {
     /// Segment start `t_a` [x]. Default: first abscissa (0 without an abscissa).
-    #[schema(example = 0.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.0)]
     pub t_a: Option<f64>,
     /// Segment end `t_b` [x], `> t_a`. Default: last abscissa (1 without an abscissa).
-    #[schema(example = 1.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.0)]
     pub t_b: Option<f64>,
     /// Displacement at the start `s_a` [U]. Default 0.
-    #[schema(example = 0.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.0)]
     pub s_a: Option<f64>,
     /// Displacement at the end `s_b` [U]. Default 1 (unit rise).
-    #[schema(example = 1.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.0)]
     pub s_b: Option<f64>,
     /// Velocity at the start `v_a` [U/x]. Default 0.
-    #[schema(example = 0.2, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.2)]
     pub v_a: Option<f64>,
     /// Velocity at the end `v_b` [U/x]. Default 0.
-    #[schema(example = 0.5, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.5)]
     pub v_b: Option<f64>,
     /// Acceleration at the start `a_a` [U/x²]. Default 0.
-    #[schema(example = 1.4, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.4)]
     pub a_a: Option<f64>,
     /// Acceleration at the end `a_b` [U/x²]. Default 0.
-    #[schema(example = 1.2, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.2)]
     pub a_b: Option<f64>,
 }
 
@@ -116,7 +117,7 @@ pub struct GridIn {
     #[schema(example = 1.0)]
     pub end: f64,
     /// Number of points, 2..200 000.
-    #[schema(minimum = 2, maximum = 200000, example = 300)]
+    #[schema(example = 300)]
     pub count: u64,
 }
 
@@ -257,4 +258,35 @@ pub struct EvaluateResponse {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub units: Option<Units>,
+}
+
+/// A boundary value (`t_a`, `t_b`, `s_a`, `s_b`, end rates): finite and at most
+/// [`MAX_MAGNITUDE`](super::law::MAX_MAGNITUDE) in magnitude (spec §6 item 9).
+pub const BOUNDARY_VALUE: Range = Range::FINITE
+    .min(-super::law::MAX_MAGNITUDE)
+    .max(super::law::MAX_MAGNITUDE);
+/// A duration coefficient `ĉ_i`: finite and non-negative.
+pub const COEFFICIENT: Range = Range::FINITE.min(0.0);
+/// Points of a uniform abscissa grid.
+pub const GRID_COUNT: Range = Range::int(2, MAX_POINTS as i64);
+
+// The documented bounds of this module's wire types: the validator (input.rs) checks the same
+// constants, and tests/it/contract_bounds.rs probes both.
+crate::schema_bounds! {
+    EvaluateRequest {
+        coefficients @items: COEFFICIENT,
+    },
+    ConstraintsIn {
+        t_a: BOUNDARY_VALUE,
+        t_b: BOUNDARY_VALUE,
+        s_a: BOUNDARY_VALUE,
+        s_b: BOUNDARY_VALUE,
+        v_a: BOUNDARY_VALUE,
+        v_b: BOUNDARY_VALUE,
+        a_a: BOUNDARY_VALUE,
+        a_b: BOUNDARY_VALUE,
+    },
+    GridIn {
+        count: GRID_COUNT,
+    },
 }

@@ -1,9 +1,7 @@
 //! Validation of a fit request into a [`FitInput`] (spec §2 "Reject with 422", §3.3 data
 //! preparation). Every offending field is collected with its JSON pointer before failing once.
 
-use crate::calc::cam_law::law::{
-    BoundaryConditions, K1, LawError, MAX_MAGNITUDE, Quantity, SevenSegmentLaw,
-};
+use crate::calc::cam_law::law::{BoundaryConditions, K1, LawError, Quantity, SevenSegmentLaw};
 use crate::calc::cam_law::wire::{Units, Warning};
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
@@ -125,16 +123,7 @@ const CHANNELS: [FitQuantity; 3] = [
 ];
 
 fn check_magnitudes(v: &mut Validator, pointer: &str, values: &[f64]) {
-    if let Some((i, x)) = values
-        .iter()
-        .enumerate()
-        .find(|(_, x)| x.abs() > MAX_MAGNITUDE)
-    {
-        v.push(
-            format!("{pointer}/{i}"),
-            format!("|value| must be <= {MAX_MAGNITUDE:e} (rescale the unit), got {x:e}"),
-        );
-    }
+    v.all_in(pointer, "value", values, super::wire::DATA_VALUE);
 }
 
 fn uint_in(v: &mut Validator, pointer: &str, value: u64, lo: u64, hi: u64) -> bool {
@@ -313,15 +302,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     for (name, value) in named {
         if let Some(x) = value {
             let p = format!("/constraints/{name}");
-            if !v.finite(&p, x) {
-                bc_ok = false;
-            } else if x.abs() > MAX_MAGNITUDE {
-                v.push(
-                    p,
-                    format!("|{name}| must be <= {MAX_MAGNITUDE:e} (rescale the unit), got {x:e}"),
-                );
-                bc_ok = false;
-            }
+            bc_ok &= v.range(&p, name, x, super::wire::DATA_VALUE);
         }
     }
     let first = xs.as_ref().and_then(|x| x.first().copied());

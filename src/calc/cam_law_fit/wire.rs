@@ -7,6 +7,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::calc::Range;
 use crate::calc::cam_law::catalogue::NamedLaw;
 use crate::calc::cam_law::law::{Jump, Knot, Peaks};
 use crate::calc::cam_law::wire::{Curves, Units, Warning};
@@ -110,7 +111,7 @@ pub struct FitGrid {
     #[schema(example = 1.0)]
     pub end: f64,
     /// Number of samples N, 8..200 000.
-    #[schema(minimum = 8, maximum = 200000, example = 300)]
+    #[schema(example = 300)]
     pub count: u64,
 }
 
@@ -149,30 +150,30 @@ pub enum FitQuantity {
 #[serde(deny_unknown_fields)]
 pub struct FitConstraints {
     /// Segment start `t_a` [x]. Default: first abscissa.
-    #[schema(example = 0.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.0)]
     pub t_a: Option<f64>,
     /// Segment end `t_b` [x], `> t_a`. Default: last abscissa.
-    #[schema(example = 1.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.0)]
     pub t_b: Option<f64>,
     /// Displacement at the start `s_a` [U]. Default: first displacement sample; required
     /// without a displacement channel.
-    #[schema(example = 0.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.0)]
     pub s_a: Option<f64>,
     /// Displacement at the end `s_b` [U]. Default: last displacement sample; required without
     /// a displacement channel.
-    #[schema(example = 1.0, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.0)]
     pub s_b: Option<f64>,
     /// Velocity at the start `v_a` [U/x]. Default 0.
-    #[schema(example = 0.2, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.2)]
     pub v_a: Option<f64>,
     /// Velocity at the end `v_b` [U/x]. Default 0.
-    #[schema(example = 0.5, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 0.5)]
     pub v_b: Option<f64>,
     /// Acceleration at the start `a_a` [U/x²]. Default 0.
-    #[schema(example = 1.4, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.4)]
     pub a_a: Option<f64>,
     /// Acceleration at the end `a_b` [U/x²]. Default 0.
-    #[schema(example = 1.2, minimum = -1e12, maximum = 1e12)]
+    #[schema(example = 1.2)]
     pub a_b: Option<f64>,
 }
 
@@ -200,7 +201,7 @@ pub struct ObjectiveIn {
     /// DTW band radius `w` [samples], `0 ≤ w ≤ N`; default 1 (reproduces the paper). Ignored
     /// for `euclidean`.
     #[serde(default)]
-    #[schema(minimum = 0, maximum = 200000, example = 1)]
+    #[schema(example = 1)]
     pub dtw_window: Option<i64>,
 }
 
@@ -237,12 +238,12 @@ pub struct OptimizerIn {
     pub seed: Option<u64>,
     /// Hard cap on objective evaluations, 1..10⁷ (default 50 000).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 10000000, example = 50000)]
+    #[schema(example = 50000)]
     pub max_evaluations: Option<u64>,
     /// Wall-clock cap [ms], 1..600 000 (default 10 000); the best-so-far is returned with
     /// `stop_reason: "deadline"` when it ends.
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 600000, example = 10000)]
+    #[schema(example = 10000)]
     pub time_limit_ms: Option<u64>,
     /// GA settings (paper Table 2 defaults).
     #[serde(default)]
@@ -250,7 +251,7 @@ pub struct OptimizerIn {
     pub ga: Option<GaIn>,
     /// IPOP-CMA-ES restarts of `auto` when the metric is DTW, 0..9 (default 3).
     #[serde(default)]
-    #[schema(minimum = 0, maximum = 9, example = 3)]
+    #[schema(example = 3)]
     pub dtw_global_restarts: Option<u32>,
     /// Run the least-squares + zero-snap polish after `ga`, `de`, `cmaes` (and the snap after
     /// `lsq`); Euclidean only. Default true; false reproduces the paper's GA alone.
@@ -258,7 +259,7 @@ pub struct OptimizerIn {
     pub polish: Option<bool>,
     /// Zero-snap threshold on normalized coefficients, 0..0.05 (default 2e-3).
     #[serde(default)]
-    #[schema(minimum = 0.0, maximum = 0.05, example = 0.002)]
+    #[schema(example = 0.002)]
     pub snap_tol: Option<f64>,
 }
 
@@ -268,35 +269,35 @@ pub struct OptimizerIn {
 #[serde(deny_unknown_fields)]
 pub struct GaIn {
     /// Individuals per generation, 4..10 000 (paper 100).
-    #[schema(minimum = 4, maximum = 10000, example = 100)]
+    #[schema(example = 100)]
     pub population: Option<u64>,
     /// Maximum generations, 1..100 000 (paper 500).
-    #[schema(minimum = 1, maximum = 100000, example = 500)]
+    #[schema(example = 500)]
     pub generations: Option<u64>,
     /// Crossover probability per pair, 0..1 (paper 0.85).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.85)]
+    #[schema(example = 0.85)]
     pub p_crossover: Option<f64>,
     /// Inversion probability per child, 0..1 (paper 0.1).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.1)]
+    #[schema(example = 0.1)]
     pub p_inversion: Option<f64>,
     /// Probability per gene of mutation around the range, 0..1 (paper 0.1).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.1)]
+    #[schema(example = 0.1)]
     pub p_range_mutation: Option<f64>,
     /// Initial mutation range (absolute, genes in [0,1]), 0..1 (paper 0.10).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.1)]
+    #[schema(example = 0.1)]
     pub range0: Option<f64>,
     /// Range factor applied every `range_every` generations, 0..1 (spec 0.25: "reduced by 75 %").
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.25)]
+    #[schema(example = 0.25)]
     pub range_factor: Option<f64>,
     /// Generations between range reductions, 1..100 000 (paper 50).
-    #[schema(minimum = 1, maximum = 100000, example = 50)]
+    #[schema(example = 50)]
     pub range_every: Option<u64>,
     /// Classic mutation probability per gene, 0..1 (spec 0.01).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.01)]
+    #[schema(example = 0.01)]
     pub p_mutation: Option<f64>,
     /// Stop after this many generations without relative improvement > 1e-12, 1..100 000
     /// (spec 100).
-    #[schema(minimum = 1, maximum = 100000, example = 100)]
+    #[schema(example = 100)]
     pub stall_generations: Option<u64>,
 }
 
@@ -326,7 +327,7 @@ pub struct OutputsIn {
 #[serde(deny_unknown_fields)]
 pub struct CurvesIn {
     /// Number of uniformly spaced points over `[t_a, t_b]`, 0..100 000 (0 = none; 1 gives `t_a`).
-    #[schema(minimum = 0, maximum = 100000, example = 0)]
+    #[schema(example = 0)]
     #[serde(default)]
     pub count: u64,
     /// Quantities to return (default all: s, v, a, j).
@@ -455,4 +456,55 @@ pub struct OptimizerReport {
     pub starts_used: u32,
     /// Segments set to exactly zero by the zero-snap step (indices 0..6).
     pub snapped_segments: Vec<usize>,
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+/// A sampled value (data channel, boundary value): finite and within the law's magnitude cap
+/// (rescale the unit beyond it); the same bound as the evaluator's boundary values.
+pub const DATA_VALUE: Range = crate::calc::cam_law::wire::BOUNDARY_VALUE;
+
+crate::schema_bounds! {
+    Channels {
+        displacement @items: DATA_VALUE,
+        velocity @items: DATA_VALUE,
+        acceleration @items: DATA_VALUE,
+    },
+    FitGrid {
+        count: Range::INTEGER.min(8.0).max(200000.0),
+    },
+    FitConstraints {
+        t_a: DATA_VALUE,
+        t_b: DATA_VALUE,
+        s_a: DATA_VALUE,
+        s_b: DATA_VALUE,
+        v_a: DATA_VALUE,
+        v_b: DATA_VALUE,
+        a_a: DATA_VALUE,
+        a_b: DATA_VALUE,
+    },
+    ObjectiveIn {
+        dtw_window: Range::INTEGER.min(0.0).max(200000.0),
+    },
+    OptimizerIn {
+        max_evaluations: Range::INTEGER.min(1.0).max(10000000.0),
+        time_limit_ms: Range::INTEGER.min(1.0).max(600000.0),
+        dtw_global_restarts: Range::INTEGER.min(0.0).max(9.0),
+        snap_tol: Range::FINITE.min(0.0).max(0.05),
+    },
+    GaIn {
+        population: Range::INTEGER.min(4.0).max(10000.0),
+        generations: Range::INTEGER.min(1.0).max(100000.0),
+        p_crossover: Range::FINITE.min(0.0).max(1.0),
+        p_inversion: Range::FINITE.min(0.0).max(1.0),
+        p_range_mutation: Range::FINITE.min(0.0).max(1.0),
+        range0: Range::FINITE.min(0.0).max(1.0),
+        range_factor: Range::FINITE.min(0.0).max(1.0),
+        range_every: Range::INTEGER.min(1.0).max(100000.0),
+        p_mutation: Range::FINITE.min(0.0).max(1.0),
+        stall_generations: Range::INTEGER.min(1.0).max(100000.0),
+    },
+    CurvesIn {
+        count: Range::INTEGER.min(0.0).max(100000.0),
+    },
 }

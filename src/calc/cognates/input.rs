@@ -16,9 +16,9 @@ use super::wire::{
     AngleReference, CognatesRequest, CouplerPoint, CurveMode, Spacing, VerifyKind, WireSign,
 };
 
-/// Largest magnitude accepted for any coordinate or length: keeps `|B − A|` and every product of
-/// two lengths finite (1e100² = 1e200 < f64::MAX), far beyond any physical unit choice.
-pub const MAX_MAGNITUDE: f64 = 1e100;
+pub use super::wire::MAX_MAGNITUDE;
+use super::wire::{COORDINATE, GRASHOF_RTOL, LENGTH, NON_NEGATIVE_LENGTH, POINTS_PER_CIRCUIT};
+use crate::calc::Range;
 /// A ground length at or below this fraction of L is "coincident pivots" (spec §3: 1e-12).
 pub const COINCIDENT_REL: f64 = 1e-12;
 /// A link length below this fraction of L is numerically zero next to L (same bound as the pivots):
@@ -30,10 +30,8 @@ pub const TRIANGLE_SLACK_REL: f64 = 1e-12;
 pub const AT_JOINT_TOL: f64 = 1e-9;
 /// P within this fraction of max(b, d, e) of the line DE is collinear (spec §7 warning).
 pub const COLLINEAR_REL: f64 = 1e-12;
-/// Smallest and largest `points_per_circuit` (spec §3).
+/// Smallest and largest `points_per_circuit` (spec §3; the bound is [`POINTS_PER_CIRCUIT`]).
 pub const POINTS_PER_CIRCUIT_RANGE: (u64, u64) = (16, 100_000);
-/// Largest `grashof_rtol` (spec §3).
-pub const MAX_GRASHOF_RTOL: f64 = 1e-3;
 
 /// Snapshot request in the normalised frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -123,67 +121,41 @@ impl Issues {
         self.list.is_empty()
     }
 
-    /// A positive, finite, bounded length.
-    fn length(&mut self, pointer: &str, name: &str, x: f64) -> bool {
-        if !x.is_finite() || x <= 0.0 {
-            self.push(
-                "NON_POSITIVE_LENGTH",
-                pointer,
-                format!("{name} must be a finite length > 0, got {x}"),
-            );
-            false
-        } else if x > MAX_MAGNITUDE {
+    /// A value of `range` (a length or coordinate bound of wire.rs); out of range below or
+    /// non-finite is the spec's `NON_POSITIVE_LENGTH`, above the magnitude cap `INVALID_INPUT`.
+    fn bounded(&mut self, pointer: &str, name: &str, x: f64, range: Range, what: &str) -> bool {
+        if range.contains(x) {
+            true
+        } else if x.is_finite() && (x > range.hi || (x < range.lo && range.lo < 0.0)) {
             self.push(
                 "INVALID_INPUT",
                 pointer,
-                format!("{name} must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"),
+                format!("{name} must be {range}, got {x:e}"),
             );
             false
         } else {
-            true
+            self.push(
+                "NON_POSITIVE_LENGTH",
+                pointer,
+                format!("{name} must be a finite {what}, got {x}"),
+            );
+            false
         }
+    }
+
+    /// A positive, finite, bounded length.
+    fn length(&mut self, pointer: &str, name: &str, x: f64) -> bool {
+        self.bounded(pointer, name, x, LENGTH, "length > 0")
     }
 
     /// A non-negative, finite, bounded length.
     fn non_negative(&mut self, pointer: &str, name: &str, x: f64) -> bool {
-        if !x.is_finite() || x < 0.0 {
-            self.push(
-                "NON_POSITIVE_LENGTH",
-                pointer,
-                format!("{name} must be a finite length ≥ 0, got {x}"),
-            );
-            false
-        } else if x > MAX_MAGNITUDE {
-            self.push(
-                "INVALID_INPUT",
-                pointer,
-                format!("{name} must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"),
-            );
-            false
-        } else {
-            true
-        }
+        self.bounded(pointer, name, x, NON_NEGATIVE_LENGTH, "length ≥ 0")
     }
 
     /// A finite, bounded coordinate or signed length.
     fn coord(&mut self, pointer: &str, name: &str, x: f64) -> bool {
-        if !x.is_finite() {
-            self.push(
-                "NON_POSITIVE_LENGTH",
-                pointer,
-                format!("{name} must be a finite number, got {x}"),
-            );
-            false
-        } else if x.abs() > MAX_MAGNITUDE {
-            self.push(
-                "INVALID_INPUT",
-                pointer,
-                format!("|{name}| must be ≤ {MAX_MAGNITUDE:e}, got {x:e}"),
-            );
-            false
-        } else {
-            true
-        }
+        self.bounded(pointer, name, x, COORDINATE, "number")
     }
 
     fn point(&mut self, pointer: &str, name: &str, p: [f64; 2]) -> bool {
@@ -268,22 +240,24 @@ struct CouplerData {
 fn validate_options(req: &CognatesRequest, issues: &mut Issues) -> Options {
     let o = &req.options;
     let (lo, hi) = POINTS_PER_CIRCUIT_RANGE;
-    if !(lo..=hi).contains(&o.points_per_circuit) {
+    // Counts up to 2^53 convert exactly; larger ones are far outside the range either way.
+    let n = o.points_per_circuit as f64;
+    if !POINTS_PER_CIRCUIT.contains(n) {
         issues.push(
             "INVALID_INPUT",
             "/options/points_per_circuit",
             format!(
-                "points_per_circuit must be in [{lo}, {hi}], got {}",
+                "points_per_circuit must be {POINTS_PER_CIRCUIT}, got {}",
                 o.points_per_circuit
             ),
         );
     }
-    if !(o.grashof_rtol.is_finite() && (0.0..=MAX_GRASHOF_RTOL).contains(&o.grashof_rtol)) {
+    if !GRASHOF_RTOL.contains(o.grashof_rtol) {
         issues.push(
             "INVALID_INPUT",
             "/options/grashof_rtol",
             format!(
-                "grashof_rtol must be in [0, {MAX_GRASHOF_RTOL}], got {}",
+                "grashof_rtol must be {GRASHOF_RTOL}, got {}",
                 o.grashof_rtol
             ),
         );

@@ -2,6 +2,7 @@
 //! contract). Lengths are in the caller's unit (any consistent unit; the paper uses cm) and are
 //! returned in the same unit; angles are in degrees.
 
+use crate::calc::Range;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 use utoipa::openapi::RefOr;
@@ -74,15 +75,15 @@ pub struct CognatesRequest {
     pub ground: Option<GroundSpec>,
     /// Crank (input link) length `a` [length], > 0 (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(nullable = false, exclusive_minimum = 0.0, example = 1.13)]
+    #[schema(nullable = false, example = 1.13)]
     pub crank: Option<f64>,
     /// Coupler length `b` = |E − D| [length], > 0 (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(nullable = false, exclusive_minimum = 0.0, example = 1.23)]
+    #[schema(nullable = false, example = 1.23)]
     pub coupler: Option<f64>,
     /// Rocker (output link) length `c` [length], > 0 (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(nullable = false, exclusive_minimum = 0.0, example = 1.04)]
+    #[schema(nullable = false, example = 1.04)]
     pub rocker: Option<f64>,
     /// Coupler point P, exactly one of three forms (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -125,7 +126,7 @@ pub struct GroundSpec {
     pub b: Option<Point>,
     /// Ground length `l` = |B − A| [length], > 0 (instead of `B`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(nullable = false, exclusive_minimum = 0.0)]
+    #[schema(nullable = false)]
     pub length: Option<f64>,
     /// Direction γ of A→B when `length` is used [deg], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -141,10 +142,10 @@ pub enum CouplerPoint {
     /// Paper form: distances to the coupler joints and the side.
     Triangle {
         /// `d` = |P − D| [length], ≥ 0.
-        #[schema(minimum = 0.0, example = 0.92)]
+        #[schema(example = 0.92)]
         d: f64,
         /// `e` = |P − E| [length], ≥ 0.
-        #[schema(minimum = 0.0, example = 1.56)]
+        #[schema(example = 1.56)]
         e: f64,
         /// Coupler side `t2`: 1 when P is left of the directed line D→E. Default 1.
         #[serde(default)]
@@ -160,7 +161,6 @@ pub enum CouplerPoint {
     /// Polar form from D: `k = (p/b)·e^{i·alpha}`.
     Polar {
         /// Distance |P − D| [length], ≥ 0.
-        #[schema(minimum = 0.0)]
         p: f64,
         /// Angle from D→E, CCW positive [deg].
         alpha_deg: f64,
@@ -299,7 +299,7 @@ pub struct CognatesOptions {
     /// Return sampled coupler curves of all three mechanisms.
     pub curves: bool,
     /// Samples per closed circuit per mechanism, N.
-    #[schema(minimum = 16, maximum = 100_000, example = 360)]
+    #[schema(example = 360)]
     pub points_per_circuit: u64,
     /// Sample spacing: `auto` (cosine on limited-range circuits, uniform on full turns) or `uniform`.
     #[schema(inline)]
@@ -315,7 +315,7 @@ pub struct CognatesOptions {
     /// Comparison metrics per mechanism (spec §4.11).
     pub metrics: bool,
     /// Relative tolerance of the Grashof equality test (change point) and of the special shapes.
-    #[schema(minimum = 0.0, maximum = 0.001, example = 1e-9)]
+    #[schema(example = 1e-9)]
     pub grashof_rtol: f64,
 }
 
@@ -927,4 +927,57 @@ pub struct Meta {
     pub points_total: usize,
     /// Compute time [µs].
     pub compute_us: u64,
+}
+
+/// Largest magnitude accepted for any coordinate or length: keeps `|B − A|` and every product of
+/// two lengths finite (1e100² = 1e200 < f64::MAX), far beyond any physical unit choice.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+/// A link length [length]: positive and at most [`MAX_MAGNITUDE`].
+pub const LENGTH: Range = Range::FINITE.gt(0.0).max(MAX_MAGNITUDE);
+/// A distance that may be zero [length].
+pub const NON_NEGATIVE_LENGTH: Range = Range::FINITE.min(0.0).max(MAX_MAGNITUDE);
+/// A coordinate or signed length [length].
+pub const COORDINATE: Range = Range::FINITE.min(-MAX_MAGNITUDE).max(MAX_MAGNITUDE);
+/// Samples per circuit N (spec §3).
+pub const POINTS_PER_CIRCUIT: Range = Range::int(16, 100_000);
+/// Relative tolerance of the Grashof classification (spec §3).
+pub const GRASHOF_RTOL: Range = Range::closed(0.0, 1e-3);
+
+// The documented bounds of this module's wire types: the validator (input.rs) checks the same
+// constants, and tests/it/contract_bounds.rs probes both.
+crate::schema_bounds! {
+    CognatesRequest {
+        crank: LENGTH,
+        coupler: LENGTH,
+        rocker: LENGTH,
+    },
+    GroundSpec {
+        a @items as "A": COORDINATE,
+        b @items as "B": COORDINATE,
+        length: LENGTH,
+    },
+    JointsSpec {
+        a @items as "A": COORDINATE,
+        b @items as "B": COORDINATE,
+        d @items as "D": COORDINATE,
+        e @items as "E": COORDINATE,
+        p @items as "P": COORDINATE,
+    },
+    CognatesOptions {
+        points_per_circuit: POINTS_PER_CIRCUIT,
+        grashof_rtol: GRASHOF_RTOL,
+    },
+}
+
+/// Bounds of the coupler-point forms (fields of enum variants, rendered inline in the document).
+#[must_use]
+pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
+    use crate::calc::SchemaBound;
+    vec![
+        SchemaBound::at::<CouplerPoint>("/oneOf/0/properties/d", NON_NEGATIVE_LENGTH),
+        SchemaBound::at::<CouplerPoint>("/oneOf/0/properties/e", NON_NEGATIVE_LENGTH),
+        SchemaBound::at::<CouplerPoint>("/oneOf/1/properties/u", COORDINATE),
+        SchemaBound::at::<CouplerPoint>("/oneOf/1/properties/v", COORDINATE),
+        SchemaBound::at::<CouplerPoint>("/oneOf/2/properties/p", NON_NEGATIVE_LENGTH),
+    ]
 }

@@ -7,7 +7,8 @@ use std::collections::HashMap;
 use super::graph::Digraph;
 use super::structure::LevelMode;
 use super::wire::{
-    BetweennessMode, ComponentImportanceRequest, ConstantWeights, Outputs, PathMethod, Warning,
+    BetweennessMode, ComponentImportanceRequest, ConstantWeights, Outputs, PathMethod, TIME_H,
+    WEIGHT, Warning,
 };
 use crate::calc::{CalcFailure, Validator};
 
@@ -115,12 +116,7 @@ fn weight_pair(v: &mut Validator, pointer: &str, w: &[f64]) -> Option<[f64; 2]> 
     let mut ok = true;
     for (k, &x) in w.iter().enumerate() {
         let p = format!("{pointer}/{k}");
-        if v.finite(&p, x) && x <= 0.0 {
-            v.push(p, format!("weight must be > 0, got {x}"));
-            ok = false;
-        } else if !x.is_finite() {
-            ok = false;
-        }
+        ok &= v.range(&p, "weight", x, WEIGHT);
     }
     if ok && (w[0] + w[1] - 1.0).abs() > SUM_TOL {
         v.push(
@@ -178,7 +174,7 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
         });
         for (k, &t) in req.times_h.iter().enumerate() {
             // t = 0 makes F = 0 (every index 0) and λ infinite for β < 1 (spec §6 H1).
-            v.greater_than(&format!("/times_h/{k}"), t, 0.0);
+            v.range(&format!("/times_h/{k}"), "", t, TIME_H);
         }
         let find_time = |t: f64| -> Vec<usize> {
             req.times_h

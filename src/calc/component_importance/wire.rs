@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::calc::Range;
 use crate::numerics::SolverReport;
 
 /// Request: one fault graph, one or more operating ages.
@@ -68,16 +69,13 @@ pub struct ComponentSpec {
     pub failure_modes: Option<Vec<FailureMode>>,
     /// S_i = Σ α·impact given directly [–]; replaces `failure_modes`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(minimum = 0.0)]
     pub mode_sum: Option<f64>,
     /// Replaces the computed node efficiency I_i (Eq. 1) [–]; needed to reproduce the paper
     /// (it uses 0.20 for D and G, spec §3.11-2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(minimum = 0.0)]
     pub efficiency_override: Option<f64>,
     /// Replaces the hierarchy number h_i (1 = most upstream) [–].
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(minimum = 1)]
     pub level_override: Option<u32>,
 }
 
@@ -87,10 +85,10 @@ pub struct ComponentSpec {
 #[serde(deny_unknown_fields)]
 pub struct Weibull {
     /// Scale η [h] (same unit as `times_h`); finite, > 0.
-    #[schema(exclusive_minimum = 0.0, example = 7832.7)]
+    #[schema(example = 7832.7)]
     pub eta_h: f64,
     /// Shape β [–]; 0.05 ≤ β ≤ 20.
-    #[schema(minimum = 0.05, maximum = 20.0, example = 0.6414)]
+    #[schema(example = 0.6414)]
     pub beta: f64,
 }
 
@@ -100,10 +98,10 @@ pub struct Weibull {
 #[serde(deny_unknown_fields)]
 pub struct FailureMode {
     /// α: share of this mode among the component's faults [–], in [0, 1].
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.142857)]
+    #[schema(example = 0.142857)]
     pub alpha: f64,
     /// ANP influence degree of the mode [–], ≥ 0.
-    #[schema(minimum = 0.0, example = 0.07288)]
+    #[schema(example = 0.07288)]
     pub impact: f64,
 }
 
@@ -194,18 +192,18 @@ pub enum BetweennessMode {
 pub struct Options {
     /// In-degree coefficient Q [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.25.
     #[serde(default = "default_q_in")]
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.25, default = 0.25)]
+    #[schema(example = 0.25, default = 0.25)]
     pub q_in: f64,
     /// Out-degree coefficient O [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.75.
     #[serde(default = "default_o_out")]
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.75, default = 0.75)]
+    #[schema(example = 0.75, default = 0.75)]
     pub o_out: f64,
     /// Constant weights ω_c (probability, risk); default the paper's [0.520614, 0.479386].
     #[serde(default)]
     pub constant_weights: ConstantWeights,
     /// K: maximal path length (edges) in the propagation sum, 1–8. Default 3.
     #[serde(default = "default_path_cap")]
-    #[schema(minimum = 1, maximum = 8, example = 3, default = 3)]
+    #[schema(example = 3, default = 3)]
     pub path_cap: u32,
     /// Simple paths (`exact`, default) or walks.
     #[serde(default)]
@@ -218,12 +216,7 @@ pub struct Options {
     pub betweenness: BetweennessMode,
     /// Enumeration budget (number of simple paths) on graphs with cycles, 1e3–1e8. Default 2e6.
     #[serde(default = "default_max_simple_paths")]
-    #[schema(
-        minimum = 1000.0,
-        maximum = 100_000_000.0,
-        example = 2_000_000.0,
-        default = 2_000_000.0
-    )]
+    #[schema(example = 2_000_000.0, default = 2_000_000.0)]
     pub max_simple_paths: f64,
 }
 
@@ -480,4 +473,47 @@ pub struct KendallTau {
     pub closeness_out: Option<f64>,
     /// τ_b(reversed PageRank, CI).
     pub pagerank_reversed: Option<f64>,
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+/// An operating time [h]: positive (t = 0 makes every index 0, spec §6 H1).
+pub const TIME_H: Range = Range::FINITE.gt(0.0);
+/// A constant weight of the probability/risk pair: positive (the pair sums to 1).
+pub const WEIGHT: Range = Range::FINITE.gt(0.0);
+
+crate::schema_bounds! {
+    ComponentImportanceRequest {
+        times_h @items: TIME_H,
+    },
+    Options {
+        max_simple_paths: Range::FINITE.min(1000.0).max(100_000_000.0),
+    },
+    ComponentSpec {
+        mode_sum: Range::FINITE.min(0.0),
+        efficiency_override: Range::FINITE.min(0.0),
+        level_override: Range::INTEGER.min(1.0),
+    },
+    Weibull {
+        eta_h: Range::FINITE.gt(0.0),
+        beta: Range::FINITE.min(0.05).max(20.0),
+    },
+    FailureMode {
+        alpha: Range::FINITE.min(0.0).max(1.0),
+        impact: Range::FINITE.min(0.0),
+    },
+    Options {
+        q_in: Range::FINITE.min(0.0).max(1.0),
+        o_out: Range::FINITE.min(0.0).max(1.0),
+        path_cap: Range::INTEGER.min(1.0).max(8.0),
+    },
+}
+
+/// Bounds inside the untagged constant-weights alternatives (rendered inline).
+#[must_use]
+pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
+    vec![crate::calc::SchemaBound::at::<ConstantWeights>(
+        "/oneOf/0/items",
+        WEIGHT,
+    )]
 }

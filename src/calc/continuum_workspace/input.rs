@@ -14,20 +14,15 @@ use super::wire::{
 };
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
-/// Largest accepted coordinate, stroke or length magnitude [m]: the scales the service is
-/// tested at run from 1e-6 m to 1e6 m; beyond, products such as EI or B x n leave the range
-/// where the scaled residual is meaningful.
-const MAX_COORD_M: f64 = 1e6;
-/// Smallest rod length [m] (see `MAX_COORD_M`).
-const MIN_LENGTH_M: f64 = 1e-7;
-/// Smallest rod diameter [m] (EI ~ d^4 must stay a normal float).
-const MIN_DIAMETER_M: f64 = 1e-9;
-/// Accepted Young's modulus range [Pa] (gels to beyond diamond).
-const E_RANGE_PA: [f64; 2] = [1.0, 1e13];
-/// Accepted bending stiffness range [N m^2] when given directly.
-const EI_RANGE: [f64; 2] = [1e-30, 1e20];
-/// Largest allowable stress [Pa].
-const MAX_SIGMA_PA: f64 = 1e15;
+use super::wire::{
+    ASSEMBLY_MODES_TOL, CELL, COND_MAX, CONTINUATION_STEPS, COORDINATE_M, DIAMETER_M, EI_NM2,
+    GRID_SIDE, JUMP_LIMITS_ANGLE_DEG, JUMP_LIMITS_POSITION_FACTOR, LENGTH_M, MAX_REFINE,
+    MAX_SUBSTEPS, MAX_TRIES, N_GRID, QUASI_TRANSLATIONAL_DEG, RK4_STEPS, ROD_SHAPE_POINTS,
+    SIGMA_ALLOW_PA, SOLVER_MAX_ITER, SOLVER_TOL, STABILITY_SEGMENTS, SUBSTEP_MAX_ITER,
+    YOUNGS_MODULUS_PA,
+};
+use crate::calc::Range;
+
 /// Default Young's modulus (steel) [Pa] (spec 3.1).
 const DEFAULT_E: f64 = 2.1e11;
 /// Rods with L/d below this are rejected (spec 3.1).
@@ -40,14 +35,12 @@ const MIN_DIRECTION_NORM: f64 = 1e-12;
 const COINCIDENT_REL: f64 = 1e-9;
 /// Load limit in units of `F_ref = EI_ref/L_ref^2` (spec 3.2); the moment limit uses `F_ref L_ref`.
 const MAX_LOAD_REL: f64 = 1e4;
-/// Largest grid side and node count (spec 4.7).
-const MAX_GRID_SIDE: u32 = 401;
 /// Largest number of grid nodes (spec 4.7).
 const MAX_GRID_NODES: u64 = 40_401;
 /// Largest number of closed-form grid combinations (spec 4.6).
 const MAX_COMBINATIONS: f64 = 1e8;
 /// Service-side ceiling of a request's own time limit [ms].
-pub const MAX_TIME_LIMIT_MS: u64 = 120_000;
+pub const MAX_TIME_LIMIT_MS: u64 = 600_000;
 /// Default stability segments in sweeps (spec 8 targets use M = 20; the sign is what matters).
 const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
 /// Worker threads of the sweep (the service machine has 2 cores; results do not depend on it).
@@ -141,46 +134,27 @@ fn preset_of(p: PresetName) -> Preset {
     }
 }
 
-fn u32_in(v: &mut Validator, ptr: &str, x: Option<u32>, lo: u32, hi: u32, default: u32) -> u32 {
+/// An optional integer in `range` (the default when absent or out of range, which is reported).
+fn u32_in(v: &mut Validator, ptr: &str, x: Option<u32>, range: Range, default: u32) -> u32 {
     match x {
-        Some(x) if x < lo || x > hi => {
-            v.push(ptr, format!("must be in [{lo}, {hi}], got {x}"));
-            default
-        }
+        Some(x) if !v.uint(ptr, "", u64::from(x), range) => default,
         Some(x) => x,
         None => default,
     }
 }
 
-fn f64_in(v: &mut Validator, ptr: &str, x: Option<f64>, lo: f64, hi: f64, default: f64) -> f64 {
+/// An optional number in `range` (the default when absent or out of range, which is reported).
+fn f64_in(v: &mut Validator, ptr: &str, x: Option<f64>, range: Range, default: f64) -> f64 {
     match x {
-        Some(x) => {
-            if v.in_range(ptr, x, lo, hi) {
-                x
-            } else {
-                default
-            }
-        }
+        Some(x) if v.range(ptr, "", x, range) => x,
+        Some(_) => default,
         None => default,
     }
 }
 
-/// Require every element finite and within `+/- MAX_COORD_M`.
+/// Require every element finite and within [`COORDINATE_M`].
 fn coords(v: &mut Validator, ptr: &str, values: &[f64]) -> bool {
-    if !v.all_finite(ptr, values) {
-        return false;
-    }
-    let mut ok = true;
-    for (i, x) in values.iter().enumerate() {
-        if x.abs() > MAX_COORD_M {
-            v.push(
-                format!("{ptr}/{i}"),
-                format!("must be within +/-{MAX_COORD_M:e} m, got {x}"),
-            );
-            ok = false;
-        }
-    }
-    ok
+    v.all_in(ptr, "", values, COORDINATE_M)
 }
 
 fn usize_of(x: u32) -> usize {
@@ -211,7 +185,7 @@ fn design_of(
         let mut design = preset.design();
         design.sigma_allow = d.sigma_allow_pa;
         if let Some(s) = d.sigma_allow_pa {
-            v.in_range("/design/sigma_allow_pa", s, f64::MIN_POSITIVE, MAX_SIGMA_PA);
+            v.range("/design/sigma_allow_pa", "", s, SIGMA_ALLOW_PA);
         }
         return (design, Some(preset));
     }
@@ -284,23 +258,13 @@ fn design_of(
                 let offset = r.offset_m.unwrap_or([0.0, 0.0]);
                 coords(v, &format!("{p}/offset_m"), &offset);
                 v.finite(&format!("{p}/clamp_angle_deg"), r.clamp_angle_deg);
-                let len_ok = v.in_range(
-                    &format!("{p}/length_m"),
-                    r.length_m,
-                    MIN_LENGTH_M,
-                    MAX_COORD_M,
-                );
+                let len_ok = v.range(&format!("{p}/length_m"), "", r.length_m, LENGTH_M);
                 coords(v, &format!("{p}/attach_m"), &r.attach_m);
                 let e = r.youngs_modulus_pa.unwrap_or(DEFAULT_E);
-                let e_ok = v.in_range(
-                    &format!("{p}/youngs_modulus_pa"),
-                    e,
-                    E_RANGE_PA[0],
-                    E_RANGE_PA[1],
-                );
+                let e_ok = v.range(&format!("{p}/youngs_modulus_pa"), "", e, YOUNGS_MODULUS_PA);
                 let mut diameter = None;
                 if let Some(dm) = r.diameter_m
-                    && v.in_range(&format!("{p}/diameter_m"), dm, MIN_DIAMETER_M, MAX_COORD_M)
+                    && v.range(&format!("{p}/diameter_m"), "", dm, DIAMETER_M)
                 {
                     diameter = Some(dm);
                     {
@@ -322,7 +286,7 @@ fn design_of(
                     }
                 }
                 if let Some(ei) = r.ei_nm2 {
-                    v.in_range(&format!("{p}/ei_nm2"), ei, EI_RANGE[0], EI_RANGE[1]);
+                    v.range(&format!("{p}/ei_nm2"), "", ei, EI_NM2);
                 }
                 if r.diameter_m.is_none() && r.ei_nm2.is_none() {
                     v.push(format!("{p}/diameter_m"), "required unless ei_nm2 is given");
@@ -371,7 +335,7 @@ fn design_of(
         }
     }
     if let Some(s) = d.sigma_allow_pa {
-        v.in_range("/design/sigma_allow_pa", s, f64::MIN_POSITIVE, MAX_SIGMA_PA);
+        v.range("/design/sigma_allow_pa", "", s, SIGMA_ALLOW_PA);
     }
     if let Some(h) = &d.home_inputs_m {
         if h.len() != n_act {
@@ -403,9 +367,15 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         let mut warnings = Vec::new();
         let (design, preset) = design_of(req, &mut v, &mut warnings);
         let solver = req.solver.clone().unwrap_or_default();
-        let base_steps = u32_in(&mut v, "/solver/rk4_steps", solver.rk4_steps, 4, 4096, 32);
-        let tol = f64_in(&mut v, "/solver/tol", solver.tol, 1e-14, 1e-4, 1e-10);
-        let max_iter = u32_in(&mut v, "/solver/max_iter", solver.max_iter, 5, 200, 50);
+        let base_steps = u32_in(&mut v, "/solver/rk4_steps", solver.rk4_steps, RK4_STEPS, 32);
+        let tol = f64_in(&mut v, "/solver/tol", solver.tol, SOLVER_TOL, 1e-10);
+        let max_iter = u32_in(
+            &mut v,
+            "/solver/max_iter",
+            solver.max_iter,
+            SOLVER_MAX_ITER,
+            50,
+        );
         let extensible = solver.axial_extensibility.unwrap_or(false);
         if extensible && design.rods.iter().any(|r| r.ea.is_none()) {
             v.push(
@@ -518,8 +488,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                     &mut v,
                     "/start/continuation_steps",
                     Some(k),
-                    1,
-                    10_000,
+                    CONTINUATION_STEPS,
                     30,
                 ))
             });
@@ -530,16 +499,14 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             &mut v,
             "/outputs/stability_segments",
             outputs.stability_segments,
-            10,
-            400,
+            STABILITY_SEGMENTS,
             40,
         );
         let shape_points = u32_in(
             &mut v,
             "/outputs/rod_shape_points",
             outputs.rod_shape_points,
-            0,
-            1000,
+            ROD_SHAPE_POINTS,
             0,
         );
         // Mode search.
@@ -548,32 +515,28 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             &mut v,
             "/assembly_modes/n_grid",
             am.n_grid,
-            1,
-            50,
+            N_GRID,
             u32::try_from(modes::default_n_grid(nr)).unwrap_or(1),
         );
         let mtol = f64_in(
             &mut v,
             "/assembly_modes/tol",
             am.tol,
-            f64::MIN_POSITIVE,
-            10.0,
+            ASSEMBLY_MODES_TOL,
             modes::DEFAULT_TOL,
         );
         let cell = u32_in(
             &mut v,
             "/assembly_modes/cell",
             am.cell,
-            1,
-            100,
+            CELL,
             u32::try_from(modes::DEFAULT_CELL).unwrap_or(2),
         );
         let max_refine = u32_in(
             &mut v,
             "/assembly_modes/max_refine",
             am.max_refine,
-            1,
-            20_000,
+            MAX_REFINE,
             u32::try_from(modes::DEFAULT_MAX_REFINE).unwrap_or(4000),
         );
         let modes = ModeSearch {
@@ -596,17 +559,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             ..modes
         };
         // Time limit.
-        let time_limit = req.time_limit_ms.and_then(|ms| {
-            if (1..=MAX_TIME_LIMIT_MS).contains(&ms) {
-                Some(Duration::from_millis(ms))
-            } else {
-                v.push(
-                    "/time_limit_ms",
-                    format!("must be in [1, {MAX_TIME_LIMIT_MS}] ms, got {ms}"),
-                );
-                None
-            }
-        });
+        let time_limit = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         // Workspace.
         let mut too_large: Option<CalcFailure> = None;
         let sweep = if req.mode == Mode::Workspace {
@@ -619,12 +572,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             let w = req.workspace.clone().unwrap_or_default();
             let grid = w.grid.unwrap_or([31, 31]);
             for (k, &g) in grid.iter().enumerate() {
-                if !(2..=MAX_GRID_SIDE).contains(&g) {
-                    v.push(
-                        format!("/workspace/grid/{k}"),
-                        format!("must be in [2, {MAX_GRID_SIDE}], got {g}"),
-                    );
-                }
+                v.uint(&format!("/workspace/grid/{k}"), "", u64::from(g), GRID_SIDE);
             }
             let nodes = u64::from(grid[0]) * u64::from(grid[1]);
             if nodes > MAX_GRID_NODES {
@@ -655,27 +603,27 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                     );
                 }
             }
-            let neighbours = w.neighbours.unwrap_or(4);
-            if neighbours != 4 && neighbours != 8 {
-                v.push(
-                    "/workspace/neighbours",
-                    format!("must be 4 or 8, got {neighbours}"),
-                );
-            }
-            let max_substeps = u32_in(&mut v, "/workspace/max_substeps", w.max_substeps, 1, 64, 8);
+            // 4 or 8 is enforced when the request is decoded (`Neighbours`).
+            let neighbours = w.neighbours.map_or(4, |n| n.0);
+            let max_substeps = u32_in(
+                &mut v,
+                "/workspace/max_substeps",
+                w.max_substeps,
+                MAX_SUBSTEPS,
+                8,
+            );
             if !max_substeps.is_power_of_two() {
                 v.push(
                     "/workspace/max_substeps",
                     format!("must be a power of two (1, 2, 4, ..., 64), got {max_substeps}"),
                 );
             }
-            let max_tries = u32_in(&mut v, "/workspace/max_tries", w.max_tries, 1, 8, 4);
+            let max_tries = u32_in(&mut v, "/workspace/max_tries", w.max_tries, MAX_TRIES, 4);
             let substep_max_iter = u32_in(
                 &mut v,
                 "/workspace/substep_max_iter",
                 w.substep_max_iter,
-                5,
-                200,
+                SUBSTEP_MAX_ITER,
                 20,
             );
             let jl = w.jump_limits.clone().unwrap_or_default();
@@ -683,19 +631,17 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                 &mut v,
                 "/workspace/jump_limits/angle_deg",
                 jl.angle_deg,
-                1e-6,
-                180.0,
+                JUMP_LIMITS_ANGLE_DEG,
                 5.0,
             );
             let position_factor = f64_in(
                 &mut v,
                 "/workspace/jump_limits/position_factor",
                 jl.position_factor,
-                1e-6,
-                1000.0,
+                JUMP_LIMITS_POSITION_FACTOR,
                 5.0,
             );
-            let cond_max = f64_in(&mut v, "/workspace/cond_max", w.cond_max, 10.0, 1e18, 1e12);
+            let cond_max = f64_in(&mut v, "/workspace/cond_max", w.cond_max, COND_MAX, 1e12);
             let stab = match w.stability_check.unwrap_or(StabilityCheckName::Full) {
                 StabilityCheckName::Full => StabilityCheck::Full,
                 StabilityCheckName::DetSign => StabilityCheck::DetSign,
@@ -705,33 +651,21 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                 &mut v,
                 "/workspace/stability_segments",
                 w.stability_segments,
-                10,
-                400,
+                STABILITY_SEGMENTS,
                 DEFAULT_SWEEP_SEGMENTS,
             );
             let lim = w.limits.clone().unwrap_or_default();
             if let Some(g) = lim.min_actuator_gap_m {
-                v.in_range(
-                    "/workspace/limits/min_actuator_gap_m",
-                    g,
-                    -MAX_COORD_M,
-                    MAX_COORD_M,
-                );
+                v.range("/workspace/limits/min_actuator_gap_m", "", g, COORDINATE_M);
             }
             if let Some(s) = lim.sigma_allow_pa {
-                v.in_range(
-                    "/workspace/limits/sigma_allow_pa",
-                    s,
-                    f64::MIN_POSITIVE,
-                    MAX_SIGMA_PA,
-                );
+                v.range("/workspace/limits/sigma_allow_pa", "", s, SIGMA_ALLOW_PA);
             }
             let qt = f64_in(
                 &mut v,
                 "/workspace/quasi_translational_deg",
                 w.quasi_translational_deg,
-                1e-9,
-                180.0,
+                QUASI_TRANSLATIONAL_DEG,
                 1.0,
             );
             let seed = match &w.seed {

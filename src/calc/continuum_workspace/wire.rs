@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::calc::Range;
 use crate::numerics::SolverReport;
 
 /// What to compute.
@@ -85,7 +86,7 @@ pub struct ContinuumWorkspaceRequest {
     pub assembly_modes: Option<AssemblyModesRequest>,
     /// Wall-clock limit for this request [ms] (extension; capped by the service limit).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 120_000, example = 10_000)]
+    #[schema(example = 10_000)]
     pub time_limit_ms: Option<u64>,
 }
 
@@ -112,7 +113,7 @@ pub struct DesignRequest {
     pub home_inputs_m: Option<Vec<f64>>,
     /// Allowable bending stress [Pa]: FK warnings and default workspace stress limit.
     #[serde(default)]
-    #[schema(minimum = 0.0, example = 1.2e9)]
+    #[schema(example = 1.2e9)]
     pub sigma_allow_pa: Option<f64>,
 }
 
@@ -138,7 +139,7 @@ pub struct ActuatorRequest {
 #[serde(deny_unknown_fields)]
 pub struct RodRequest {
     /// Index `j(i)` of the actuator carrying the clamp.
-    #[schema(minimum = 0, maximum = 3, example = 0)]
+    #[schema(example = 0)]
     pub actuator: usize,
     /// Clamp offset `c_i` on the carriage [m].
     #[serde(default)]
@@ -149,21 +150,21 @@ pub struct RodRequest {
     #[schema(example = -60.0)]
     pub clamp_angle_deg: f64,
     /// Rod length `L_i` [m].
-    #[schema(exclusive_minimum = 0.0, example = 0.5)]
+    #[schema(example = 0.5)]
     pub length_m: f64,
     /// Solid round section diameter `d_i` [m] (L/d >= 20 recommended, >= 5 required).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, example = 0.004)]
+    #[schema(example = 0.004)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub diameter_m: Option<f64>,
     /// Bending stiffness `EI_i` [N m^2] (alternative to the diameter; overrides `E pi d^4/64`).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, example = 2.63894)]
+    #[schema(example = 2.63894)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ei_nm2: Option<f64>,
     /// Young's modulus `E_i` [Pa] (default 2.1e11).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, example = 2.1e11)]
+    #[schema(example = 2.1e11)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub youngs_modulus_pa: Option<f64>,
     /// Platform point `r_i` in the platform frame [m].
@@ -193,15 +194,15 @@ pub struct LoadRequest {
 pub struct SolverRequest {
     /// Base RK4 steps per rod (raised by the load rule of spec 4.1).
     #[serde(default)]
-    #[schema(minimum = 4, maximum = 4096, example = 32)]
+    #[schema(example = 32)]
     pub rk4_steps: Option<u32>,
     /// Newton stop on the scaled residual (inf-norm).
     #[serde(default)]
-    #[schema(minimum = 1e-14, maximum = 1e-4, example = 1e-10)]
+    #[schema(example = 1e-10)]
     pub tol: Option<f64>,
     /// Newton iterations per solve.
     #[serde(default)]
-    #[schema(minimum = 5, maximum = 200, example = 50)]
+    #[schema(example = 50)]
     pub max_iter: Option<u32>,
     /// Add axial compliance `EA = E pi d^2/4` (recommended for N >= 4).
     #[serde(default)]
@@ -244,12 +245,12 @@ pub struct StartRequest {
     pub state: Option<SolverState>,
     /// Assembly-mode index in the margin-sorted list (kind = assembly_mode; default 0).
     #[serde(default)]
-    #[schema(minimum = 0, example = 0)]
+    #[schema(example = 0)]
     pub index: Option<usize>,
     /// Override of the number of equal continuation steps from home (extension; default
     /// `max(10, ceil(max |dlambda| / (0.01 L_ref)))`).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 10_000, example = 30)]
+    #[schema(example = 30)]
     pub continuation_steps: Option<u32>,
 }
 
@@ -264,11 +265,11 @@ pub struct OutputsRequest {
     pub stability: Option<bool>,
     /// Segments per rod `M` of the stability test.
     #[serde(default)]
-    #[schema(minimum = 10, maximum = 400, example = 40)]
+    #[schema(example = 40)]
     pub stability_segments: Option<u32>,
     /// Sample points per rod of the returned shapes (0 = none).
     #[serde(default)]
-    #[schema(minimum = 0, maximum = 1000, example = 0)]
+    #[schema(example = 0)]
     pub rod_shape_points: Option<u32>,
 }
 
@@ -303,7 +304,6 @@ pub struct SeedRequest {
     pub state: Option<SolverState>,
     /// Assembly-mode index (kind = assembly_mode; default 0).
     #[serde(default)]
-    #[schema(minimum = 0)]
     pub index: Option<usize>,
 }
 
@@ -314,11 +314,11 @@ pub struct SeedRequest {
 pub struct JumpLimits {
     /// Largest platform rotation per sub-step [deg].
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 180.0, example = 5.0)]
+    #[schema(example = 5.0)]
     pub angle_deg: Option<f64>,
     /// Largest platform displacement per sub-step as a multiple of the input change.
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 1000.0, example = 5.0)]
+    #[schema(example = 5.0)]
     pub position_factor: Option<f64>,
 }
 
@@ -358,7 +358,6 @@ pub struct WorkspaceLimits {
     pub min_actuator_gap_m: Option<f64>,
     /// Allowable bending stress [Pa]; null = `design.sigma_allow_pa` or none.
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0)]
     pub sigma_allow_pa: Option<f64>,
     /// `ignore` (default) or `reject`.
     #[serde(default)]
@@ -396,24 +395,24 @@ pub struct WorkspaceRequest {
     pub seed: Option<SeedRequest>,
     /// 4 (default) or 8 neighbours.
     #[serde(default)]
-    #[schema(example = 4)]
-    pub neighbours: Option<u32>,
+    #[schema(nullable = false, example = 4)]
+    pub neighbours: Option<Neighbours>,
     /// Tangent predictor (default true).
     #[serde(default)]
     pub predictor: Option<bool>,
     /// Largest number of sub-steps, a power of two 1..64 (default 8).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 64, example = 8)]
+    #[schema(example = 8)]
     pub max_substeps: Option<u32>,
     /// Attempts per node 1..8 (default 4).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 8, example = 4)]
+    #[schema(example = 4)]
     pub max_tries: Option<u32>,
     /// Newton iterations per sub-step solve, capped by `solver.max_iter` (default 20; extension:
     /// a sub-step started from the tangent predictor converges in 2-7 iterations, a solve still
     /// wandering after 20 is abandoned for smaller sub-steps).
     #[serde(default)]
-    #[schema(minimum = 5, maximum = 200, example = 20)]
+    #[schema(example = 20)]
     pub substep_max_iter: Option<u32>,
     /// Jump limits per sub-step.
     #[serde(default)]
@@ -421,7 +420,7 @@ pub struct WorkspaceRequest {
     pub jump_limits: Option<JumpLimits>,
     /// Largest accepted condition number of the scaled Jacobian (default 1e12).
     #[serde(default)]
-    #[schema(minimum = 10.0, maximum = 1e18, example = 1e12)]
+    #[schema(example = 1e12)]
     pub cond_max: Option<f64>,
     /// `full` (default), `det_sign` or `none`.
     #[serde(default)]
@@ -429,7 +428,7 @@ pub struct WorkspaceRequest {
     pub stability_check: Option<StabilityCheckName>,
     /// Segments per rod of the stability test (default 20 in sweeps).
     #[serde(default)]
-    #[schema(minimum = 10, maximum = 400, example = 20)]
+    #[schema(example = 20)]
     pub stability_segments: Option<u32>,
     /// Physical limits.
     #[serde(default)]
@@ -437,7 +436,7 @@ pub struct WorkspaceRequest {
     pub limits: Option<WorkspaceLimits>,
     /// Threshold of the quasi-translational area [deg] (default 1).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 180.0, example = 1.0)]
+    #[schema(example = 1.0)]
     pub quasi_translational_deg: Option<f64>,
     /// `union` (default) or `sum`.
     #[serde(default)]
@@ -458,20 +457,20 @@ pub struct AssemblyModesRequest {
     /// 4 rods, 2 for 5 or more); the search that picks the start of a design without a
     /// stress-free home defaults to min(6, that).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 50, example = 9)]
+    #[schema(example = 9)]
     pub n_grid: Option<u32>,
     /// `Tol` on the normalised grid residual, dimensionless (default 0.5; 0.45 for the start of a
     /// design without a stress-free home).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 10.0, example = 0.5)]
+    #[schema(example = 0.5)]
     pub tol: Option<f64>,
     /// Coarse cell size (default 2).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 100, example = 2)]
+    #[schema(example = 2)]
     pub cell: Option<u32>,
     /// Maximum Newton refinements (default 4000).
     #[serde(default)]
-    #[schema(minimum = 1, maximum = 20_000, example = 4000)]
+    #[schema(example = 4000)]
     pub max_refine: Option<u32>,
 }
 
@@ -482,15 +481,12 @@ pub struct AssemblyModesRequest {
 #[schema(as = continuum_workspace::ModeSearchOut)]
 pub struct ModeSearchOut {
     /// `N_grid`.
-    #[schema(minimum = 1, maximum = 50)]
     pub n_grid: u64,
     /// `Tol` on the normalised grid residual, dimensionless.
     pub tol: f64,
     /// Coarse cell size in grid indices.
-    #[schema(minimum = 1, maximum = 100)]
     pub cell: u64,
     /// Newton refinement cap.
-    #[schema(minimum = 1, maximum = 20_000)]
     pub max_refine: u64,
 }
 
@@ -809,4 +805,171 @@ pub struct AssemblyModesResponse {
     pub preset: Option<PresetOut>,
     /// Cost and stop reason.
     pub report: SolverReport,
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+/// Largest accepted coordinate, stroke or length magnitude [m]: the scales the service is
+/// tested at run from 1e-6 m to 1e6 m; beyond, products such as EI or B x n leave the range
+/// where the scaled residual is meaningful.
+pub const MAX_COORD_M: f64 = 1e6;
+/// A coordinate, stroke end or actuator input [m].
+pub const COORDINATE_M: Range = Range::FINITE.min(-MAX_COORD_M).max(MAX_COORD_M);
+/// A rod length [m] (see [`MAX_COORD_M`]).
+pub const LENGTH_M: Range = Range::FINITE.min(1e-7).max(MAX_COORD_M);
+/// A rod diameter [m] (EI ~ d^4 must stay a normal float).
+pub const DIAMETER_M: Range = Range::FINITE.min(1e-9).max(MAX_COORD_M);
+/// Young's modulus [Pa] (gels to beyond diamond).
+pub const YOUNGS_MODULUS_PA: Range = Range::closed(1.0, 1e13);
+/// Bending stiffness given directly [N m^2].
+pub const EI_NM2: Range = Range::closed(1e-30, 1e20);
+/// Allowable stress [Pa].
+pub const SIGMA_ALLOW_PA: Range = Range::FINITE.min(f64::MIN_POSITIVE).max(1e15);
+
+/// RK4 steps per rod (spec 4.1).
+pub const RK4_STEPS: Range = Range::int(4, 4096);
+/// Newton tolerance on the scaled residual (spec 4.2).
+pub const SOLVER_TOL: Range = Range::closed(1e-14, 1e-4);
+/// Newton iterations per solve.
+pub const SOLVER_MAX_ITER: Range = Range::int(5, 200);
+/// Continuation steps from home.
+pub const CONTINUATION_STEPS: Range = Range::int(1, 10_000);
+/// Segments per rod of the stability test (spec 4.5).
+pub const STABILITY_SEGMENTS: Range = Range::int(10, 400);
+/// Sample points per returned rod shape.
+pub const ROD_SHAPE_POINTS: Range = Range::int(0, 1000);
+/// Coarse grid of the assembly-mode search (spec 4.6).
+pub const N_GRID: Range = Range::int(1, 50);
+/// Clustering tolerance of the assembly-mode search.
+pub const ASSEMBLY_MODES_TOL: Range = Range::closed(f64::MIN_POSITIVE, 10.0);
+/// Search-cell size of the assembly-mode search.
+pub const CELL: Range = Range::int(1, 100);
+/// Largest number of refined cells of the assembly-mode search.
+pub const MAX_REFINE: Range = Range::int(1, 20_000);
+/// Substeps of one workspace edge.
+pub const MAX_SUBSTEPS: Range = Range::int(1, 64);
+/// Attempts per workspace node.
+pub const MAX_TRIES: Range = Range::int(1, 8);
+/// Newton iterations per substep.
+pub const SUBSTEP_MAX_ITER: Range = Range::int(5, 200);
+/// Largest accepted jump of the platform angle between neighbours [deg].
+pub const JUMP_LIMITS_ANGLE_DEG: Range = Range::closed(1e-6, 180.0);
+/// Largest accepted position jump, in units of the grid step.
+pub const JUMP_LIMITS_POSITION_FACTOR: Range = Range::closed(1e-6, 1000.0);
+/// Largest accepted Jacobian condition number.
+pub const COND_MAX: Range = Range::closed(10.0, 1e18);
+/// Parasitic-angle threshold of the quasi-translational area [deg].
+pub const QUASI_TRANSLATIONAL_DEG: Range = Range::closed(1e-9, 180.0);
+/// Nodes per side of the workspace grid (spec 4.7).
+pub const GRID_SIDE: Range = Range::int(2, 401);
+
+crate::schema_bounds! {
+    ContinuumWorkspaceRequest {
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
+        inputs_m @items: COORDINATE_M,
+    },
+    DesignRequest {
+        sigma_allow_pa: SIGMA_ALLOW_PA,
+        home_inputs_m @items: COORDINATE_M,
+    },
+    ActuatorRequest {
+        origin_m @items: COORDINATE_M,
+        stroke_m @items: COORDINATE_M,
+    },
+    RodRequest {
+        actuator: Range::INTEGER.min(0.0).max(3.0),
+        offset_m @items: COORDINATE_M,
+        attach_m @items: COORDINATE_M,
+        length_m: LENGTH_M,
+        diameter_m: DIAMETER_M,
+        ei_nm2: EI_NM2,
+        youngs_modulus_pa: YOUNGS_MODULUS_PA,
+    },
+    SolverRequest {
+        rk4_steps: RK4_STEPS,
+        tol: SOLVER_TOL,
+        max_iter: SOLVER_MAX_ITER,
+    },
+    StartRequest {
+        index: Range::INTEGER.min(0.0),
+        continuation_steps: CONTINUATION_STEPS,
+    },
+    OutputsRequest {
+        stability_segments: STABILITY_SEGMENTS,
+        rod_shape_points: ROD_SHAPE_POINTS,
+    },
+    SeedRequest {
+        index: Range::INTEGER.min(0.0),
+    },
+    JumpLimits {
+        angle_deg: JUMP_LIMITS_ANGLE_DEG,
+        position_factor: JUMP_LIMITS_POSITION_FACTOR,
+    },
+    WorkspaceLimits {
+        min_actuator_gap_m: COORDINATE_M,
+        sigma_allow_pa: SIGMA_ALLOW_PA,
+    },
+    WorkspaceRequest {
+        grid @items: GRID_SIDE,
+        max_substeps: MAX_SUBSTEPS,
+        max_tries: MAX_TRIES,
+        substep_max_iter: SUBSTEP_MAX_ITER,
+        cond_max: COND_MAX,
+        stability_segments: STABILITY_SEGMENTS,
+        quasi_translational_deg: QUASI_TRANSLATIONAL_DEG,
+    },
+    AssemblyModesRequest {
+        n_grid: N_GRID,
+        tol: ASSEMBLY_MODES_TOL,
+        cell: CELL,
+        max_refine: MAX_REFINE,
+    },
+    ModeSearchOut {
+        n_grid: N_GRID,
+        cell: CELL,
+        max_refine: MAX_REFINE,
+    },
+}
+
+/// Bounds of nested arrays (rendered inline).
+#[must_use]
+pub fn nested_bounds() -> Vec<crate::calc::SchemaBound> {
+    vec![crate::calc::SchemaBound::at::<WorkspaceRequest>(
+        "/properties/ranges_m/items/items",
+        COORDINATE_M,
+    )]
+}
+
+/// Neighbourhood of the workspace wave: the integer 4 or 8.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "u32")]
+pub struct Neighbours(pub u32);
+
+impl TryFrom<u32> for Neighbours {
+    type Error = String;
+    fn try_from(n: u32) -> Result<Self, String> {
+        if n == 4 || n == 8 {
+            Ok(Self(n))
+        } else {
+            Err(format!("must be 4 or 8, got {n}"))
+        }
+    }
+}
+
+impl utoipa::PartialSchema for Neighbours {
+    fn schema() -> utoipa::openapi::RefOr<utoipa::openapi::schema::Schema> {
+        utoipa::openapi::schema::ObjectBuilder::new()
+            .schema_type(utoipa::openapi::schema::SchemaType::new(
+                utoipa::openapi::schema::Type::Integer,
+            ))
+            .enum_values(Some([4, 8]))
+            .description(Some("4 or 8 neighbours."))
+            .into()
+    }
+}
+
+impl ToSchema for Neighbours {
+    fn name() -> std::borrow::Cow<'static, str> {
+        std::borrow::Cow::Borrowed("continuum_workspace.Neighbours")
+    }
 }

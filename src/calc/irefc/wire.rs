@@ -8,6 +8,7 @@ use super::error::{BAD_RANGE, Issues, MISSING_FIELD};
 use super::geometry::{
     CHI_MAX, Geometry, GeometryWarning, NEAR_UNDERCUT_FRACTION, Wheel, Z2_MAX, Z2_MIN,
 };
+use crate::calc::Range;
 
 /// Millimetres per metre (wire ↔ SI).
 pub(crate) const MM: f64 = 1e3;
@@ -81,10 +82,10 @@ pub fn geometry_warnings(g: &Geometry) -> Vec<Warning> {
 pub struct Material {
     /// Young's modulus E [MPa].
     #[serde(rename = "E_MPa")]
-    #[schema(minimum = 1e3, maximum = 1e7, example = 210_000.0)]
+    #[schema(example = 210_000.0)]
     pub e_mpa: f64,
     /// Poisson's ratio ν [–], 0 ≤ ν < 0.5.
-    #[schema(minimum = 0.0, exclusive_maximum = 0.5, example = 0.3)]
+    #[schema(example = 0.3)]
     pub nu: f64,
 }
 
@@ -301,4 +302,13 @@ pub(crate) fn check_rb(issues: &mut Issues, pointer: &str, v: f64) -> Option<f64
 /// Record a missing required field.
 pub(crate) fn missing(issues: &mut Issues, pointer: &str, what: &str) {
     issues.push(MISSING_FIELD, pointer, format!("{what} is required"));
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+crate::schema_bounds! {
+    Material {
+        e_mpa as "E_MPa": Range::FINITE.min(1e3).max(1e7),
+        nu: Range::FINITE.min(0.0).lt(0.5),
+    },
 }

@@ -140,9 +140,7 @@ impl ExactIndex {
             let col = x.col(f);
             let mut idx = super::data::all_rows(n);
             idx.sort_unstable_by(|&a, &b| {
-                col[a as usize]
-                    .total_cmp(&col[b as usize])
-                    .then(a.cmp(&b))
+                col[a as usize].total_cmp(&col[b as usize]).then(a.cmp(&b))
             });
             let vals: Vec<f64> = idx.iter().map(|&r| col[r as usize]).collect();
             (idx, vals)

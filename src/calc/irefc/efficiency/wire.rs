@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::calc::Range;
 use crate::calc::irefc::wire::{GeometryOut, Warning};
 
 /// Loss model.
@@ -50,43 +51,43 @@ pub struct EfficiencyInclude {
     "include":{"elements":true}}))]
 pub struct IrefcEfficiencyRequest {
     /// Cage generating (pitch) circle radius r2 [mm].
-    #[schema(exclusive_minimum = 0.0, maximum = 10_000.0, example = 20.0)]
+    #[schema(example = 20.0)]
     pub r2_mm: f64,
     /// Number of rolling elements Z2 [–].
     #[serde(rename = "Z2")]
-    #[schema(minimum = 3, maximum = 1000, example = 26)]
+    #[schema(example = 26)]
     pub z2: i64,
     /// Displacement coefficient χ (rc = χ·r2) [–].
-    #[schema(exclusive_minimum = 1.0, maximum = 5.0, example = 1.4)]
+    #[schema(example = 1.4)]
     pub chi: f64,
     /// Rolling element radius rb [mm]; must be below rb_overlap and rb_undercut.
-    #[schema(exclusive_minimum = 0.0, example = 2.0)]
+    #[schema(example = 2.0)]
     pub rb_mm: f64,
     /// Input (motor) power P_in [W]; give this or `input_torque_Nm`, not both.
     #[serde(rename = "power_W")]
-    #[schema(exclusive_minimum = 0.0, maximum = 1e8, example = 1500.0)]
+    #[schema(example = 1500.0)]
     pub power_w: Option<f64>,
     /// Input torque M_in [N·m]; alternative to `power_W`.
     #[serde(rename = "input_torque_Nm")]
-    #[schema(exclusive_minimum = 0.0, maximum = 1e7, example = 9.549297)]
+    #[schema(example = 9.549297)]
     pub input_torque_nm: Option<f64>,
     /// Input shaft (carrier) speed n [rpm].
-    #[schema(exclusive_minimum = 0.0, maximum = 1e6, example = 1500.0)]
+    #[schema(example = 1500.0)]
     pub speed_rpm: f64,
     /// Rolling-friction lever arm μ [mm] (default 1.0, the paper's 0.001 m).
-    #[schema(minimum = 0.0, maximum = 10.0, example = 1.0)]
+    #[schema(example = 1.0)]
     pub rolling_friction_mm: Option<f64>,
     /// Sliding friction coefficient f_s [–] (default 0.1, the paper's).
-    #[schema(minimum = 0.0, maximum = 1.0, example = 0.1)]
+    #[schema(example = 0.1)]
     pub sliding_friction: Option<f64>,
     /// "paper_table" (default), "paper_abs" or "rigid_body".
     #[schema(nullable = false)]
     pub model: Option<EfficiencyModel>,
     /// Cage phase: element k at φ2 = phase + 360k/Z2 [deg], in [0, 360/Z2) (default 0, the paper).
-    #[schema(minimum = 0.0, example = 0.0)]
+    #[schema(example = 0.0)]
     pub phase_deg: Option<f64>,
     /// Number of equally spaced cage phases to average over (1 = the paper; default 1).
-    #[schema(minimum = 1, maximum = 10_000, example = 1)]
+    #[schema(example = 1)]
     pub n_phase: Option<u32>,
     /// Optional outputs.
     #[schema(nullable = false)]
@@ -244,4 +245,22 @@ pub struct IrefcEfficiencyResponse {
     pub warnings: Vec<Warning>,
     /// Cost.
     pub meta: EfficiencyMeta,
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+crate::schema_bounds! {
+    IrefcEfficiencyRequest {
+        r2_mm: Range::FINITE.gt(0.0).max(10000.0),
+        z2 as "Z2": Range::INTEGER.min(3.0).max(1000.0),
+        chi: Range::FINITE.gt(1.0).max(5.0),
+        rb_mm: Range::FINITE.gt(0.0),
+        power_w as "power_W": Range::FINITE.gt(0.0).max(1e8),
+        input_torque_nm as "input_torque_Nm": Range::FINITE.gt(0.0).max(1e7),
+        speed_rpm: Range::FINITE.gt(0.0).max(1e6),
+        rolling_friction_mm: Range::FINITE.min(0.0).max(10.0),
+        sliding_friction: Range::FINITE.min(0.0).max(1.0),
+        phase_deg: Range::FINITE.min(0.0),
+        n_phase: Range::INTEGER.min(1.0).max(10000.0),
+    },
 }

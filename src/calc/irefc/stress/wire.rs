@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::calc::Range;
 use crate::calc::irefc::wire::{GeometryOut, Material, Warning};
 use crate::numerics::SolverReport;
 
@@ -73,10 +74,10 @@ pub struct StressInclude {
 #[serde(deny_unknown_fields)]
 pub struct IntRange {
     /// First value (inclusive).
-    #[schema(minimum = 3, maximum = 1000, example = 10)]
+    #[schema(example = 10)]
     pub from: i64,
     /// Last value (inclusive).
-    #[schema(minimum = 3, maximum = 1000, example = 40)]
+    #[schema(example = 40)]
     pub to: i64,
 }
 
@@ -86,13 +87,13 @@ pub struct IntRange {
 #[serde(deny_unknown_fields)]
 pub struct StepRange {
     /// First value (inclusive).
-    #[schema(exclusive_minimum = 1.0, maximum = 5.0, example = 1.25)]
+    #[schema(example = 1.25)]
     pub from: f64,
     /// Last value (inclusive within 1e-12).
-    #[schema(exclusive_minimum = 1.0, maximum = 5.0, example = 1.67)]
+    #[schema(example = 1.67)]
     pub to: f64,
     /// Step (> 0).
-    #[schema(exclusive_minimum = 0.0, example = 0.01)]
+    #[schema(example = 0.01)]
     pub step: f64,
 }
 
@@ -124,28 +125,28 @@ pub struct IrefcStressRequest {
     #[schema(nullable = false)]
     pub mode: Option<StressMode>,
     /// Cage generating (pitch) circle radius r2 [mm]; required unless `sweep.r2_mm` is given.
-    #[schema(exclusive_minimum = 0.0, maximum = 10_000.0, example = 20.0)]
+    #[schema(example = 20.0)]
     pub r2_mm: Option<f64>,
     /// Number of rolling elements Z2 [–]; required in mode "single".
     #[serde(rename = "Z2")]
-    #[schema(minimum = 3, maximum = 1000, example = 26)]
+    #[schema(example = 26)]
     pub z2: Option<i64>,
     /// Displacement coefficient χ (element-centre circle rc = χ·r2) [–]; required in mode "single".
-    #[schema(exclusive_minimum = 1.0, maximum = 5.0, example = 1.4)]
+    #[schema(example = 1.4)]
     pub chi: Option<f64>,
     /// Rolling element radius rb [mm]; must be below rb_overlap and rb_undercut. Required unless
     /// `sweep.rb_mm` is given.
-    #[schema(exclusive_minimum = 0.0, example = 2.0)]
+    #[schema(example = 2.0)]
     pub rb_mm: Option<f64>,
     /// Output torque T_out [N·m].
     #[serde(rename = "torque_Nm")]
-    #[schema(minimum = 0.0, maximum = 1e7, example = 119.366207)]
+    #[schema(example = 119.366207)]
     pub torque_nm: f64,
     /// Output link: "cam" (crown fixed, default) or "crown" (cam rotation locked).
     #[schema(nullable = false)]
     pub output_link: Option<OutputLink>,
     /// Contact (roller) length lb [mm]; default 2·rb ("equal to the diameter"). 0 < lb ≤ 100·r2.
-    #[schema(exclusive_minimum = 0.0, example = 4.0)]
+    #[schema(example = 4.0)]
     pub lb_mm: Option<f64>,
     /// Cam and crown material; default steel {210000, 0.3}.
     #[schema(nullable = false)]
@@ -155,7 +156,7 @@ pub struct IrefcStressRequest {
     pub roller_material: Option<Material>,
     /// φ2 grid step over [0°, 180°] [deg]; 0 < step ≤ 10 and 180/step ≤ 2·10⁶. Default 1 with refine
     /// (see the module docs; the paper used 0.02 without refinement).
-    #[schema(exclusive_minimum = 0.0, maximum = 10.0, example = 1.0)]
+    #[schema(example = 1.0)]
     pub step_deg: Option<f64>,
     /// Polish each grid maximum with a bounded Brent search to |Δφ2| ≤ 1e-10 rad (default true).
     pub refine: Option<bool>,
@@ -168,10 +169,10 @@ pub struct IrefcStressRequest {
     #[schema(nullable = false)]
     pub include: Option<StressInclude>,
     /// Keep every n-th grid point in `curves` (the last point is always kept; default 1).
-    #[schema(minimum = 1, example = 1)]
+    #[schema(example = 1)]
     pub curves_stride: Option<u32>,
     /// Points per wheel in `geometry.profiles` (default 720).
-    #[schema(minimum = 8, maximum = 100_000, example = 720)]
+    #[schema(example = 720)]
     pub profile_points: Option<u32>,
     /// The structured array (mode "sweep").
     #[schema(nullable = false)]
@@ -444,4 +445,29 @@ pub enum IrefcStressResponse {
     Single(Box<StressSingleResponse>),
     /// Mode "sweep".
     Sweep(StressSweepResponse),
+}
+
+// The documented bounds of this module's wire types (one source: the validator checks
+// the same ranges, and tests/it/contract_bounds.rs probes both).
+crate::schema_bounds! {
+    IntRange {
+        from: Range::INTEGER.min(3.0).max(1000.0),
+        to: Range::INTEGER.min(3.0).max(1000.0),
+    },
+    StepRange {
+        from: Range::FINITE.gt(1.0).max(5.0),
+        to: Range::FINITE.gt(1.0).max(5.0),
+        step: Range::FINITE.gt(0.0),
+    },
+    IrefcStressRequest {
+        r2_mm: Range::FINITE.gt(0.0).max(10000.0),
+        z2 as "Z2": Range::INTEGER.min(3.0).max(1000.0),
+        chi: Range::FINITE.gt(1.0).max(5.0),
+        rb_mm: Range::FINITE.gt(0.0),
+        torque_nm as "torque_Nm": Range::FINITE.min(0.0).max(1e7),
+        lb_mm: Range::FINITE.gt(0.0),
+        step_deg: Range::FINITE.gt(0.0).max(10.0),
+        curves_stride: Range::INTEGER.min(1.0),
+        profile_points: Range::INTEGER.min(8.0).max(100000.0),
+    },
 }

@@ -1,0 +1,224 @@
+//! A minimal loopback HTTP/1.1 client and a handle on the service process, for the load and
+//! fault tests (raw sockets, so slow and broken clients can be played exactly).
+
+use std::io::{BufRead, BufReader};
+use std::net::SocketAddr;
+use std::process::{Child, ExitStatus};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::TcpStream;
+
+/// A running service process.
+pub struct Server {
+    pub addr: SocketAddr,
+    pub child: Option<Child>,
+    log: Arc<Mutex<String>>,
+}
+
+impl Server {
+    /// Start the binary on a free port and wait until `/healthz` answers.
+    pub async fn start(env: &[(&str, &str)]) -> Self {
+        let port = std::net::TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .map(|a| a.port())
+            .expect("a free port");
+        let mut child = crate::spawn(port, env);
+        let log = Arc::new(Mutex::new(String::new()));
+        if let Some(out) = child.stdout.take() {
+            let log = Arc::clone(&log);
+            std::thread::spawn(move || {
+                for line in BufReader::new(out).lines().map_while(Result::ok) {
+                    if let Ok(mut l) = log.lock() {
+                        l.push_str(&line);
+                        l.push('\n');
+                    }
+                }
+            });
+        }
+        let addr: SocketAddr = format!("127.0.0.1:{port}").parse().expect("address");
+        let t = Instant::now();
+        while get(addr, "/healthz").await.is_err() {
+            assert!(
+                t.elapsed() < Duration::from_secs(20),
+                "the service did not start"
+            );
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+        Self {
+            addr,
+            child: Some(child),
+            log,
+        }
+    }
+
+    /// Process id.
+    pub fn pid(&self) -> u32 {
+        self.child.as_ref().map_or(0, Child::id)
+    }
+
+    /// What the service logged so far.
+    pub fn log(&self) -> String {
+        // Give the reader thread a moment to catch up.
+        std::thread::sleep(Duration::from_millis(100));
+        self.log.lock().map(|l| l.clone()).unwrap_or_default()
+    }
+
+    /// SIGTERM, then wait up to `limit` for the exit.
+    pub async fn terminate_and_wait(mut self, limit: Duration) -> Option<ExitStatus> {
+        let pid = self.pid();
+        let _ = std::process::Command::new("kill")
+            .args(["-TERM", &pid.to_string()])
+            .status();
+        let t = Instant::now();
+        let mut child = self.child.take()?;
+        while t.elapsed() < limit {
+            if let Ok(Some(s)) = child.try_wait() {
+                return Some(s);
+            }
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+        let _ = child.kill();
+        None
+    }
+
+    /// Stop the service (SIGTERM, then kill if it lingers).
+    pub async fn stop(self) {
+        let _ = self.terminate_and_wait(Duration::from_secs(30)).await;
+    }
+}
+
+/// An answer.
+pub struct Reply {
+    pub status: u16,
+    pub body: Vec<u8>,
+}
+
+impl Reply {
+    pub fn json(&self) -> Value {
+        serde_json::from_slice(&self.body).unwrap_or(Value::Null)
+    }
+    pub fn text(&self) -> String {
+        String::from_utf8_lossy(&self.body).into_owned()
+    }
+}
+
+async fn exchange(addr: SocketAddr, request: Vec<u8>) -> std::io::Result<Reply> {
+    let mut s = TcpStream::connect(addr).await?;
+    s.write_all(&request).await?;
+    let mut buf = Vec::new();
+    tokio::time::timeout(Duration::from_secs(120), s.read_to_end(&mut buf))
+        .await
+        .map_err(|_| std::io::Error::other("no answer within 120 s"))??;
+    let text_end = buf
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .ok_or_else(|| std::io::Error::other("no response head"))?;
+    let head = String::from_utf8_lossy(&buf[..text_end]).into_owned();
+    let status = head
+        .split_whitespace()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| std::io::Error::other("no status"))?;
+    Ok(Reply {
+        status,
+        body: buf[text_end + 4..].to_vec(),
+    })
+}
+
+/// `GET path` on a fresh connection.
+pub async fn get(addr: SocketAddr, path: &str) -> std::io::Result<Reply> {
+    exchange(
+        addr,
+        format!("GET {path} HTTP/1.1\r\nhost: t\r\nconnection: close\r\n\r\n").into_bytes(),
+    )
+    .await
+}
+
+fn post_bytes(path: &str, body: &Value) -> Vec<u8> {
+    let b = serde_json::to_vec(body).expect("serializes");
+    let mut r = format!(
+        "POST {path} HTTP/1.1\r\nhost: t\r\ncontent-type: application/json\r\ncontent-length: {}\r\nconnection: close\r\n\r\n",
+        b.len()
+    )
+    .into_bytes();
+    r.extend_from_slice(&b);
+    r
+}
+
+/// `POST path` with a JSON body on a fresh connection.
+pub async fn post(addr: SocketAddr, path: &str, body: &Value) -> std::io::Result<Reply> {
+    exchange(addr, post_bytes(path, body)).await
+}
+
+/// Send a request head one byte every `interval`, `bytes` bytes at most; true when the server
+/// closed the connection before the head was complete.
+pub async fn slowloris(addr: SocketAddr, interval: Duration, bytes: usize) -> bool {
+    let Ok(mut s) = TcpStream::connect(addr).await else {
+        return true;
+    };
+    let head = b"POST /v1/cam-law/evaluate HTTP/1.1\r\nhost: t\r\ncontent-type: application/json\r\nx-padding: ";
+    for i in 0..bytes {
+        let byte = head.get(i).copied().unwrap_or(b'a');
+        if s.write_all(&[byte]).await.is_err() {
+            return true;
+        }
+        tokio::time::sleep(interval).await;
+        if is_closed(&mut s).await {
+            return true;
+        }
+    }
+    false
+}
+
+/// Whether the peer has closed the connection (EOF or reset), without waiting.
+pub async fn is_closed(s: &mut TcpStream) -> bool {
+    let mut b = [0u8; 512];
+    match tokio::time::timeout(Duration::from_millis(1), s.read(&mut b)).await {
+        Ok(Ok(0) | Err(_)) => true,
+        Ok(Ok(_)) | Err(_) => false,
+    }
+}
+
+/// Send a request with a large answer and do not read it for 3 s; then read what is there:
+/// true when the server gave up on the connection (the answer is cut short).
+pub async fn post_and_never_read(addr: SocketAddr, path: &'static str, body: Value) -> bool {
+    let Ok(mut s) = TcpStream::connect(addr).await else {
+        return false;
+    };
+    if s.write_all(&post_bytes(path, &body)).await.is_err() {
+        return false;
+    }
+    tokio::time::sleep(Duration::from_secs(3)).await;
+    let mut buf = Vec::new();
+    let read = tokio::time::timeout(Duration::from_secs(20), s.read_to_end(&mut buf)).await;
+    let Some(end) = buf.windows(4).position(|w| w == b"\r\n\r\n") else {
+        return true;
+    };
+    let head = String::from_utf8_lossy(&buf[..end]).to_ascii_lowercase();
+    let declared: usize = head
+        .lines()
+        .find_map(|l| l.strip_prefix("content-length: "))
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(usize::MAX);
+    matches!(read, Ok(Err(_))) || buf.len() - end - 4 < declared
+}
+
+/// Resident memory of a process [KiB].
+pub fn rss_kib(pid: u32) -> u64 {
+    std::fs::read_to_string(format!("/proc/{pid}/status"))
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("VmRSS:"))
+                .and_then(|v| v.split_whitespace().next()?.parse().ok())
+        })
+        .unwrap_or(0)
+}
+
+/// Raise this test process's descriptor limit (it opens thousands of connections).
+pub fn raise_fd_limit() {
+    let _ = rlimit::increase_nofile_limit(u64::MAX);
+}

@@ -1,0 +1,310 @@
+//! Load and fault tests against the real binary on loopback: idle and slowloris connections, a
+//! flood of heavy requests with cheap ones mixed in, client disconnects, slow readers and SIGTERM
+//! during work. Every scenario is bounded in count and time and stops by itself.
+//!
+//! `MECHCALC_LOAD_SCALE` (default 1) multiplies the connection and request counts for a longer run.
+
+mod client;
+
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use client::{Server, get, post, rss_kib};
+use serde_json::{Value, json};
+
+fn scale() -> usize {
+    std::env::var("MECHCALC_LOAD_SCALE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1)
+}
+
+/// A heavy request: a workspace sweep that runs until its time limit.
+fn heavy(time_limit_ms: u64) -> Value {
+    let mut v: Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/api/continuum_workspace/sweep_design1.json"
+        ))
+        .expect("example"),
+    )
+    .expect("JSON");
+    v["workspace"]["grid"] = json!([201, 201]);
+    v["time_limit_ms"] = json!(time_limit_ms);
+    v
+}
+
+/// A cheap request: the cam-law evaluation of the spec's Table-1 law at five points.
+fn cheap() -> Value {
+    serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/api/cam_law/evaluate_table1.json"
+        ))
+        .expect("example"),
+    )
+    .expect("JSON")
+}
+
+async fn healthz_ms(server: &Server) -> f64 {
+    let t = Instant::now();
+    let r = get(server.addr, "/healthz").await.expect("healthz answers");
+    assert_eq!(r.status, 200);
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+fn metric(text: &str, name_and_labels: &str) -> f64 {
+    text.lines()
+        .filter(|l| l.starts_with(name_and_labels))
+        .filter_map(|l| l.rsplit(' ').next()?.parse::<f64>().ok())
+        .sum()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn idle_and_slowloris_connections_cannot_take_the_service_down() {
+    client::raise_fd_limit();
+    let server = Server::start(&[("MECHCALC_HEADER_TIMEOUT_MS", "1500")]).await;
+    let n_idle = 2000 * scale();
+    let mut idle = Vec::with_capacity(n_idle);
+    for _ in 0..n_idle {
+        match tokio::net::TcpStream::connect(server.addr).await {
+            Ok(s) => idle.push(s),
+            Err(e) => panic!("connect #{} failed: {e}", idle.len()),
+        }
+    }
+    // Slowloris: half a request head, one byte at a time.
+    let slow: Vec<_> = (0..50)
+        .map(|_| {
+            tokio::spawn(client::slowloris(
+                server.addr,
+                Duration::from_millis(200),
+                40,
+            ))
+        })
+        .collect();
+    let mut worst = 0.0f64;
+    for _ in 0..10 {
+        worst = worst.max(healthz_ms(&server).await);
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    assert!(
+        worst < 50.0,
+        "/healthz took {worst:.1} ms with {n_idle} idle connections"
+    );
+    // Every slowloris connection is closed by the server before it finishes its head.
+    for s in slow {
+        let closed_early = s.await.expect("join");
+        assert!(closed_early, "a slowloris connection was kept open");
+    }
+    // The idle connections are closed by the header timeout.
+    tokio::time::sleep(Duration::from_millis(1000)).await;
+    let mut closed = 0;
+    for s in &mut idle {
+        if client::is_closed(s).await {
+            closed += 1;
+        }
+    }
+    assert_eq!(
+        closed, n_idle,
+        "idle connections outlive the header timeout"
+    );
+    drop(idle);
+    assert!(healthz_ms(&server).await < 50.0);
+    server.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn cheap_requests_are_served_during_a_flood_of_sweeps() {
+    let server = Server::start(&[("MECHCALC_QUEUE_DEPTH", "64")]).await;
+    // Teach the pool what the cheap route costs.
+    for _ in 0..5 {
+        assert_eq!(
+            post(server.addr, "/v1/cam-law/evaluate", &cheap())
+                .await
+                .expect("ok")
+                .status,
+            200
+        );
+    }
+    let heavy_tasks: Vec<_> = (0..(8 * scale()))
+        .map(|_| {
+            let addr = server.addr;
+            tokio::spawn(async move { post(addr, "/v1/continuum-workspace", &heavy(3000)).await })
+        })
+        .collect();
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    // 64 concurrent cheap clients, 5 requests each, while the sweeps hold every compute slot.
+    let cheap_tasks: Vec<_> = (0..64)
+        .map(|_| {
+            let addr = server.addr;
+            tokio::spawn(async move {
+                let mut statuses = Vec::new();
+                for _ in 0..5 {
+                    let r = post(addr, "/v1/cam-law/evaluate", &cheap())
+                        .await
+                        .expect("answers");
+                    statuses.push(r.status);
+                }
+                statuses
+            })
+        })
+        .collect();
+    let mut worst = 0.0f64;
+    for _ in 0..10 {
+        worst = worst.max(healthz_ms(&server).await);
+        tokio::time::sleep(Duration::from_millis(30)).await;
+    }
+    let mut refused = 0;
+    let mut total = 0;
+    for t in cheap_tasks {
+        for s in t.await.expect("join") {
+            total += 1;
+            if s != 200 {
+                refused += 1;
+            }
+        }
+    }
+    assert_eq!(
+        refused, 0,
+        "{refused} of {total} cheap requests were not served"
+    );
+    assert!(worst < 50.0, "/healthz took {worst:.1} ms during the flood");
+    for t in heavy_tasks {
+        let r = t.await.expect("join").expect("answers");
+        assert!(
+            r.status == 200 || r.status == 503,
+            "heavy answered {}",
+            r.status
+        );
+    }
+    server.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_disconnected_client_frees_its_slot() {
+    let server = Server::start(&[]).await;
+    let slots = get(server.addr, "/healthz").await.expect("ok").json()["compute_slots_free"]
+        .as_u64()
+        .expect("slots");
+    // Heavy requests with a long budget whose clients leave after 300 ms.
+    let n = 4;
+    let tasks: Vec<_> = (0..n)
+        .map(|_| {
+            let addr = server.addr;
+            tokio::spawn(async move {
+                let _ = tokio::time::timeout(
+                    Duration::from_millis(300),
+                    post(addr, "/v1/continuum-workspace", &heavy(60_000)),
+                )
+                .await;
+            })
+        })
+        .collect();
+    for t in tasks {
+        t.await.expect("join");
+    }
+    // Each job stops at its next budget check: the slots are free again within a second.
+    let t = Instant::now();
+    loop {
+        let free = get(server.addr, "/healthz").await.expect("ok").json()["compute_slots_free"]
+            .as_u64()
+            .unwrap_or(0);
+        if free == slots {
+            break;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(2),
+            "slots still busy {:?} after the clients left",
+            t.elapsed()
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    let m = get(server.addr, "/metrics").await.expect("metrics").text();
+    assert!(
+        metric(&m, "mechcalc_jobs_cancelled_total{cause=\"client_gone\"}") >= 1.0,
+        "no cancelled job counted:\n{m}"
+    );
+    assert!(server.log().contains("request aborted by the client"));
+    server.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn slow_readers_are_dropped_and_memory_returns() {
+    let server = Server::start(&[("MECHCALC_WRITE_TIMEOUT_MS", "1000")]).await;
+    let big = json!({"law": "modified_sine", "constraints": {"t_a": 0.0, "t_b": 1.0, "s_a": 0.0, "s_b": 1.0},
+        "abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": 200_000}}, "quantities": ["s", "v", "a", "j"]});
+    let base = rss_kib(server.pid());
+    let readers: Vec<_> = (0..8)
+        .map(|_| {
+            tokio::spawn(client::post_and_never_read(
+                server.addr,
+                "/v1/cam-law/evaluate",
+                big.clone(),
+            ))
+        })
+        .collect();
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let peak = rss_kib(server.pid());
+    // After the write timeout the server closes them.
+    for r in readers {
+        let closed = r.await.expect("join");
+        assert!(closed, "a slow reader was kept open past the write timeout");
+    }
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let after = rss_kib(server.pid());
+    assert!(healthz_ms(&server).await < 50.0);
+    // Memory returns near the baseline (allocator caches allowed: within 64 MiB).
+    assert!(
+        after < base + 64 * 1024,
+        "RSS {after} KiB after the slow readers left (baseline {base}, peak {peak})"
+    );
+    server.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn sigterm_during_work_exits_within_the_deadline() {
+    let server = Server::start(&[("MECHCALC_SHUTDOWN_GRACE_MS", "1000")]).await;
+    let addr = server.addr;
+    let work =
+        tokio::spawn(async move { post(addr, "/v1/continuum-workspace", &heavy(60_000)).await });
+    // A client holding a half-sent request.
+    let half = tokio::spawn(client::slowloris(addr, Duration::from_millis(500), 1000));
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let t = Instant::now();
+    let status = server.terminate_and_wait(Duration::from_secs(10)).await;
+    let took = t.elapsed();
+    assert!(
+        status.is_some(),
+        "the process did not exit within 10 s of SIGTERM"
+    );
+    assert!(
+        took < Duration::from_millis(3000),
+        "exit took {took:?} with a 1 s grace period"
+    );
+    let _ = work.await;
+    half.abort();
+}
+
+/// Keep the child from outliving a failed test.
+impl Drop for Server {
+    fn drop(&mut self) {
+        if let Some(c) = self.child.as_mut() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+/// Start the binary on a free loopback port with test-friendly limits plus `env`.
+pub fn spawn(port: u16, env: &[(&str, &str)]) -> Child {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_mechcalc"));
+    cmd.env("MECHCALC_BIND", format!("127.0.0.1:{port}"))
+        .env("MECHCALC_LOG", "info")
+        .env("MECHCALC_COMPUTE_SLOTS", "2")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null());
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.spawn().expect("the service binary starts")
+}
