@@ -328,10 +328,10 @@ fn train_request(ds: &DataSet, extra: serde_json::Value) -> TrainRequest {
         "validation": {"test_fraction": 0.0},
         "outputs": []
     });
-    for (k, v) in extra.as_object().unwrap() {
+    for (k, v) in extra.as_object().expect("an object of overrides") {
         body[k] = v.clone();
     }
-    serde_json::from_value(body).unwrap()
+    serde_json::from_value(body).expect("the request decodes")
 }
 
 proptest! {
