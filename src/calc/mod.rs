@@ -16,6 +16,7 @@ pub mod common;
 pub mod component_importance;
 pub mod continuum_workspace;
 pub mod irefc;
+pub mod machining_size;
 pub mod problem;
 
 pub use bounds::{Range, SchemaBound};
@@ -39,6 +40,7 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         irefc::wire::schema_bounds(),
         irefc::stress::wire::schema_bounds(),
         irefc::efficiency::wire::schema_bounds(),
+        machining_size::schema_bounds(),
     ]
     .concat()
 }

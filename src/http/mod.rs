@@ -14,6 +14,7 @@ pub mod continuum_workspace;
 pub mod irefc;
 pub mod json;
 pub mod layers;
+pub mod machining_size;
 pub mod meta;
 pub mod openapi;
 pub mod picture;
@@ -124,6 +125,7 @@ JSON pointers to the offending fields.",
         (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
         (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
+        (name = "machining-size", description = "Machined dimensions: gradient-boosted trees with XGBoost's semantics, exact SHAP explanations and the paper's data diagnostics"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -145,6 +147,9 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(irefc::stress))
         .route(routes!(irefc::efficiency))
         .route(routes!(continuum_workspace::solve))
+        .route(routes!(machining_size::train))
+        .route(routes!(machining_size::predict))
+        .route(routes!(machining_size::analyze))
         .finish()
 }
 

@@ -128,16 +128,26 @@ fn flatten(e: &jsonschema::ValidationError<'_>, out: &mut Vec<(String, String)>)
             }
         }
         ValidationErrorKind::OneOfNotValid { context } | ValidationErrorKind::AnyOf { context } => {
+            // The variant the request most likely meant: the one whose errors reach deepest
+            // (a missing or unknown member counts one level below its object), and of those the
+            // one with the fewest errors.
             let depth = |errs: &Vec<jsonschema::ValidationError<'static>>| {
                 errs.iter()
-                    .map(|x| x.instance_path().as_str().matches('/').count())
+                    .map(|x| {
+                        let member = matches!(
+                            x.kind(),
+                            ValidationErrorKind::Required { .. }
+                                | ValidationErrorKind::AdditionalProperties { .. }
+                        );
+                        x.instance_path().as_str().matches('/').count() + usize::from(member)
+                    })
                     .max()
                     .unwrap_or(0)
             };
             match context
                 .iter()
                 .filter(|c| !c.is_empty())
-                .max_by_key(|c| depth(c))
+                .max_by_key(|c| (depth(c), std::cmp::Reverse(c.len())))
             {
                 Some(best) if depth(best) > path.matches('/').count() => {
                     best.iter().for_each(|x| flatten(x, out));

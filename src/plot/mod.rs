@@ -14,6 +14,7 @@ mod cognates;
 mod component_importance;
 mod continuum_workspace;
 mod irefc;
+mod machining_size;
 pub mod style;
 
 use serde_json::Value;
@@ -89,6 +90,21 @@ const PICTURES: &[Picture] = &[
         route: "/v1/continuum-workspace",
         prepare: continuum_workspace::prepare,
         render: continuum_workspace::render,
+    },
+    Picture {
+        route: "/v1/machining-size/train",
+        prepare: machining_size::prepare_train,
+        render: machining_size::render_train,
+    },
+    Picture {
+        route: "/v1/machining-size/predict",
+        prepare: machining_size::prepare_predict,
+        render: machining_size::render_predict,
+    },
+    Picture {
+        route: "/v1/machining-size/analyze",
+        prepare: machining_size::prepare_analyze,
+        render: machining_size::render_analyze,
     },
 ];
 

@@ -35,6 +35,8 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/continuum-workspace", "/design/rods/0/diameter_m", "slenderness length_m / diameter_m ≥ 5"),
     ("/v1/continuum-workspace", "/load/moment_nm", "within 1e4 F_ref L_ref of the design's own scale"),
     ("/v1/continuum-workspace", "/load/force_n/0", "within 1e4 F_ref of the design's own scale"),
+    ("/v1/machining-size/train", "/params/colsample_bytree", "⌊colsample_bytree·d⌋ ≥ 1, d = features left after dropping constant columns"),
+    ("/v1/machining-size/train", "/params/min_child_weight", "the training split needs ≥ 2·max(1, min_child_weight) rows"),
 ];
 
 /// A number in an example request with its documented bound, if any.

@@ -10,4 +10,5 @@ pub mod bus_demo_motor;
 pub mod cam_table1;
 pub mod finite;
 pub mod http;
+pub mod machining_size;
 pub mod proptest_cfg;

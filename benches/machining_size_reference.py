@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""XGBoost and shap reference timings for `benches/machining_size.rs` (same data, same parameters).
+
+Pinned: xgboost==3.2.0, shap==0.51.0 (the virtualenv of tests/fixtures/machining_size/generate.py).
+Run `cargo bench --bench machining_size sweep` once (it writes the data sets to
+target/machining_size_bench/), then
+
+    /tmp/venv-ms/bin/python benches/machining_size_reference.py
+
+which writes target/machining_size_bench/reference.json and paper_xgb_model.json; the next
+bench run prints the XGBoost/shap columns from it. Not run in CI.
+
+Timings: `xgb.train` on a prebuilt DMatrix (tree_method exact, nthread 1 or 2) and the
+scikit-learn-style fit including the DMatrix; median of repeated runs (1 run on 100 000 × 20).
+SHAP: shap.TreeExplainer(booster) (path-dependent; shap delegates to XGBoost's C++
+pred_contribs), interventional with a background of |B| rows (shap's own C++), interaction values;
+XGBoost pred_contribs with nthread 1. Microseconds per explained row.
+"""
+
+import json
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+import shap
+import xgboost as xgb
+
+if xgb.__version__ != "3.2.0" or shap.__version__ != "0.51.0":
+    sys.exit(f"pinned xgboost 3.2.0 / shap 0.51.0, found {xgb.__version__} / {shap.__version__}")
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
+DIR = os.path.join(ROOT, "target", "machining_size_bench")
+
+
+def load(name):
+    meta = json.load(open(os.path.join(DIR, f"{name}.json")))
+    n, d = meta["n"], meta["d"]
+    x = np.fromfile(os.path.join(DIR, f"{name}.x.f64"), dtype="<f8").reshape(n, d)
+    y = np.fromfile(os.path.join(DIR, f"{name}.y.f64"), dtype="<f8")
+    fold = np.fromfile(os.path.join(DIR, f"{name}.fold.u8"), dtype=np.uint8)
+    return x, y, fold
+
+
+def table2(**kw):
+    p = {"objective": "reg:squarederror", "tree_method": "exact", "max_depth": 6, "eta": 0.05,
+         "lambda": 0.1, "alpha": 0.05, "gamma": 0.0, "min_child_weight": 1.0,
+         "colsample_bytree": 1.0, "subsample": 1.0, "seed": 0, "nthread": 2}
+    p.update(kw)
+    return p
+
+
+def timed(f, runs):
+    f()  # warm-up
+    ts = []
+    for _ in range(runs):
+        t = time.perf_counter()
+        f()
+        ts.append(time.perf_counter() - t)
+    return statistics.median(ts) * 1e3, max(ts) * 1e3
+
+
+def main():
+    ref = {"xgboost": xgb.__version__, "shap": shap.__version__, "paper": {}, "big": {},
+           "grid": {}, "shap": {}}
+    x, y, fold = load("paper")
+    # Drop the constant columns as the bench does (trees never split on them anyway).
+    keep = [j for j in range(x.shape[1]) if np.ptp(x[:, j]) > 0]
+    xk = x[:, keep]
+    dtrain = xgb.DMatrix(xk, label=y)
+    for colsample in (1.0, 0.8):
+        ref["paper"][f"colsample_{colsample}"] = {}
+        for threads in (1, 2):
+            p = table2(colsample_bytree=colsample, nthread=threads)
+            train_ms, train_worst = timed(lambda: xgb.train(p, dtrain, 400), 7)
+            fit_ms, _ = timed(lambda: xgb.train(p, xgb.DMatrix(xk, label=y), 400), 7)
+            ref["paper"][f"colsample_{colsample}"][f"threads_{threads}"] = {
+                "train_ms": train_ms, "train_worst_ms": train_worst, "fit_ms": fit_ms}
+            print(f"paper colsample {colsample} threads {threads}: train {train_ms:.1f} ms, "
+                  f"fit {fit_ms:.1f} ms")
+    # Spec §9 grid with the bench's 5 folds (colsample = subsample = 1).
+    for depth in (2, 4, 6, 8):
+        for trees in (25, 50, 100, 200, 400, 800):
+            rmse = []
+            for k in range(5):
+                tr, te = fold != k, fold == k
+                b = xgb.train(table2(max_depth=depth, nthread=1),
+                              xgb.DMatrix(xk[tr], label=y[tr]), trees)
+                pred = b.predict(xgb.DMatrix(xk[te])).astype(np.float64)
+                rmse.append(float(np.sqrt(np.mean((pred - y[te]) ** 2))))
+            ref["grid"][f"{trees}_{depth}"] = {"rmse": float(np.mean(rmse))}
+    print("grid done")
+    # SHAP on the 400-tree Table-2 model (colsample 1.0).
+    b = xgb.train(table2(nthread=2), dtrain, 400)
+    model = json.loads(b.save_raw("json"))
+    # The bench imports the model with all 8 columns: map the kept columns back.
+    for t in model["learner"]["gradient_booster"]["model"]["trees"]:
+        t["split_indices"] = [keep[i] if i < len(keep) else i for i in t["split_indices"]]
+    model["learner"]["learner_model_param"]["num_feature"] = str(x.shape[1])
+    model["learner"]["feature_names"] = []
+    model["learner"]["feature_types"] = []
+    json.dump(model, open(os.path.join(DIR, "paper_xgb_model.json"), "w"))
+    s = {}
+    explainer = shap.TreeExplainer(b)
+    ms, _ = timed(lambda: explainer.shap_values(xk), 3)
+    s["path_dependent_us"] = ms * 1e3 / len(y)
+    b1 = xgb.train(table2(nthread=1), dtrain, 400)
+    dx = xgb.DMatrix(xk)
+    ms, _ = timed(lambda: b1.predict(dx, pred_contribs=True), 3)
+    s["pred_contribs_us_1t"] = ms * 1e3 / len(y)
+    for nb in (10, 100, 1000):
+        bg = xk[:: max(1, len(y) // nb)][:nb]
+        ex = shap.TreeExplainer(b, data=bg, feature_perturbation="interventional")
+        rows = 5 if nb >= 1000 else 40
+        ms, _ = timed(lambda: ex.shap_values(xk[:rows], check_additivity=False), 2)
+        s[f"interventional_{nb}_us"] = ms * 1e3 / rows
+    ms, _ = timed(lambda: explainer.shap_interaction_values(xk[:40]), 2)
+    s["interactions_us"] = ms * 1e3 / 40
+    ref["shap"]["xgb400"] = s
+    print("shap", s)
+    # 100 000 × 20, 400 trees, 2 threads: one run each.
+    xb, yb, _ = load("big")
+    db = xgb.DMatrix(xb, label=yb)
+    for method in ("exact", "hist"):
+        p = table2(tree_method=method, max_bin=256, nthread=2)
+        t = time.perf_counter()
+        xgb.train(p, db, 400)
+        ref["big"][method] = {"train_ms": (time.perf_counter() - t) * 1e3}
+        print(f"big {method}: {ref['big'][method]['train_ms']:.0f} ms")
+    json.dump(ref, open(os.path.join(DIR, "reference.json"), "w"), indent=1)
+    print("written", os.path.join(DIR, "reference.json"))
+
+
+if __name__ == "__main__":
+    main()
