@@ -326,7 +326,7 @@ pub fn simulate(
         let t_eval = t_del.clamp(-t_max, t_max);
         let le = if vbar > 0.0 {
             out.evaluations += 1;
-            if t_eval != t_del && motor.clamps_beyond_envelope() {
+            if t_del.abs() > t_max && motor.clamps_beyond_envelope() {
                 out.n_loss_clamped += 1;
             }
             motor.loss(w, t_del, t_eval, t_max, set.breakdown)

@@ -43,8 +43,9 @@
 //! * SHAP: path-dependent values equal brute-force enumeration of the cover-weighted game and
 //!   shap 0.51 / XGBoost `pred_contribs` to their f32 precision; local accuracy holds in f64 to
 //!   ~1e-15 of the output scale (a residual above 1e-9 of it is reported as a warning).
-//! * Memory: the feature matrix (8 bytes per cell) plus the exact index (4 bytes per cell, shared
-//!   by the holdout model and every CV fold) or the hist bins (2 bytes per cell per model being
+//! * Memory: the feature matrix (8 bytes per cell) plus the exact index (12 bytes per cell: row
+//!   order and sorted values, shared by the holdout model and every CV fold; 400 MB in all for
+//!   100 000 × 200) or the hist bins (2 bytes per cell per model being
 //!   trained), O(rows) per model, and O(2^depth · bins) histogram space per thread.
 //! * Outside the range: a 422 with a pointer (`INVALID_INPUT`, `TOO_LARGE`, `MODEL_INVALID`,
 //!   `UNSUPPORTED_MODEL`, `SMOGN_DEGENERATE_RELEVANCE`, `GRA_ZERO_MEAN`, `DEADLINE_EXCEEDED`).
