@@ -43,8 +43,9 @@ const MAX_COMBINATIONS: f64 = 1e8;
 pub const MAX_TIME_LIMIT_MS: u64 = 600_000;
 /// Default stability segments in sweeps (spec 8 targets use M = 20; the sign is what matters).
 const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
-/// Worker threads of the sweep (the service machine has 2 cores; results do not depend on it).
-pub const SWEEP_THREADS: usize = 2;
+/// Upper limit on worker threads of the sweep: none of its own, the job's budget decides (the
+/// compute pool's threads per job); results do not depend on it.
+pub const SWEEP_THREADS: usize = usize::MAX;
 
 /// How the FK starts.
 #[derive(Debug, Clone, PartialEq)]

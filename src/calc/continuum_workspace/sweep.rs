@@ -18,14 +18,12 @@
 #![allow(clippy::suboptimal_flops)]
 
 use std::collections::BTreeMap;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::fk::{self, STABLE_MARGIN};
 use super::linalg;
 use super::model::{Model, Params};
 use super::newton::{self, Counter, NewtonFailure, NewtonOptions, Solution};
-use crate::numerics::{Budget, StopReason};
+use crate::numerics::{Budget, StopReason, par_map};
 
 /// Sub-step solves give up when the residual has not halved over this many iterations: from the
 /// tangent predictor Newton at least halves it every iteration or two, while creeping damped steps
@@ -88,7 +86,8 @@ pub struct SweepSettings {
     pub segments: usize,
     /// Physical limits.
     pub limits: Limits,
-    /// Worker threads (results do not depend on it).
+    /// Upper limit on worker threads; the job's budget ([`Budget::threads`]) decides within it
+    /// (results do not depend on it).
     pub threads: usize,
 }
 
@@ -96,7 +95,7 @@ impl SweepSettings {
     /// The settings of a `workspace` request that gives only the grid and the ranges (spec 4.7
     /// defaults): axis neighbours, predictor on, up to 8 sub-steps of at most 20 Newton iterations,
     /// 4 tries, jump limits 5 deg and 5x the input change, cond(J) <= 1e12, full stability test
-    /// with 20 segments per rod, no physical limits, 2 threads. The request parser takes its
+    /// with 20 segments per rod, no physical limits, the budget's threads. The request parser takes its
     /// defaults from here.
     #[must_use]
     pub fn with_defaults(grid: [usize; 2], ranges: [[f64; 2]; 2]) -> Self {
@@ -118,7 +117,7 @@ impl SweepSettings {
                 sigma_allow: None,
                 rod_crossing: false,
             },
-            threads: 2,
+            threads: usize::MAX,
         }
     }
 }
@@ -510,39 +509,6 @@ fn neighbours(s: &SweepSettings, i: usize, j: usize) -> Vec<(usize, usize)> {
     out
 }
 
-/// Run `f` over `jobs` on up to `threads` scoped threads; results in job order.
-fn run_jobs<T: Sync, R: Send>(jobs: &[T], threads: usize, f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    if threads <= 1 || jobs.len() < 2 {
-        return jobs.iter().map(f).collect();
-    }
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<(usize, R)>> = Mutex::new(Vec::with_capacity(jobs.len()));
-    std::thread::scope(|scope| {
-        for _ in 0..threads.min(jobs.len()) {
-            scope.spawn(|| {
-                let mut local = Vec::new();
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    if k >= jobs.len() {
-                        break;
-                    }
-                    local.push((k, f(&jobs[k])));
-                }
-                // A poisoned lock only means another worker panicked; keep its partial results.
-                let mut guard = results
-                    .lock()
-                    .unwrap_or_else(std::sync::PoisonError::into_inner);
-                guard.extend(local);
-            });
-        }
-    });
-    let mut all = results
-        .into_inner()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    all.sort_by_key(|(k, _)| *k);
-    all.into_iter().map(|(_, r)| r).collect()
-}
-
 struct Job {
     target: usize,
     source: usize,
@@ -568,6 +534,8 @@ pub fn wave(
     nodes[seed_idx] = Some(seed_data);
     let mut frontier = vec![seed_idx];
     let mut stop = StopReason::Completed;
+    // The job's threads (the compute pool's setting), capped by the settings.
+    let threads = s.threads.min(budget.threads()).max(1);
     let mut attempts = 0u64;
     let mut evaluations = 0u64;
     while !frontier.is_empty() && stop == StopReason::Completed {
@@ -607,7 +575,7 @@ pub fn wave(
             if jobs.is_empty() {
                 break;
             }
-            let results = run_jobs(&jobs, s.threads, |job| {
+            let results = par_map(threads, &jobs, |_, job| {
                 let mut counter = Counter::default();
                 let src = nodes[job.source].as_ref();
                 let out = match src {

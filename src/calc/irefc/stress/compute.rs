@@ -2,16 +2,15 @@
 //! "Algorithm" and "Sweep").
 
 use std::f64::consts::{PI, TAU};
-use std::num::NonZeroUsize;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::input::{Design, StressParams, SweepInput};
 use super::wire::{LoadSharing, OutputLink};
 use crate::calc::irefc::brent;
 use crate::calc::irefc::error::IrefcError;
 use crate::calc::irefc::geometry::{AnglePoint, Geometry, Trig, Wheel};
-use crate::numerics::{Budget, StopReason};
+use crate::numerics::{Budget, StopReason, par_map_while};
 
 /// Refinement stops when the bracket half-width is below this [rad] (spec step 6).
 pub const REFINE_TOL_RAD: f64 = 1e-10;
@@ -858,11 +857,13 @@ pub struct SweepResult {
     pub threads: u32,
 }
 
-/// Run every combination of the sweep (spec "Sweep") on `available_parallelism()` scoped threads.
+/// Run every combination of the sweep (spec "Sweep") on the job's threads
+/// ([`Budget::threads`], through [`par_map_while`]).
 ///
-/// Work is claimed one combination at a time from a shared counter; results land at their index, so the
-/// order is deterministic. Before each combination the budget is checked: on a deadline, or once the
-/// evaluation cap (counted in combinations) is reached, the remaining combinations are `NotEvaluated`.
+/// Work is claimed one combination at a time; results land at their index, so the order is
+/// deterministic. Before each combination the budget is checked: on a deadline, or once the
+/// evaluation cap (counted in combinations) is reached, the remaining combinations are
+/// `NotEvaluated`.
 #[must_use]
 pub fn compute_sweep(input: &SweepInput, budget: &Budget) -> SweepResult {
     let total = input.len();
@@ -870,75 +871,40 @@ pub fn compute_sweep(input: &SweepInput, budget: &Budget) -> SweepResult {
     let n = p.n_intervals;
     let table = (n < TRIG_TABLE_MAX_POINTS).then(|| TrigTable::new(n));
     let grid = table.as_ref().map_or(GridTrig::OnTheFly, GridTrig::Table);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, NonZeroUsize::get)
-        .min(total)
-        .max(1);
-    let next = AtomicUsize::new(0);
+    let threads = budget.threads().min(total).max(1);
     let evaluated = AtomicU64::new(0);
-    let stopped = AtomicBool::new(false);
     let stop_reason = Mutex::new(None::<StopReason>);
-
-    let worker = || {
-        let mut local: Vec<(usize, ComboOutcome)> = Vec::new();
-        loop {
-            if stopped.load(Ordering::Relaxed) {
-                break;
-            }
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            if i >= total {
-                break;
-            }
-            if let Some(r) = budget.check(i as u64) {
-                stopped.store(true, Ordering::Relaxed);
-                if let Ok(mut g) = stop_reason.lock() {
-                    g.get_or_insert(r);
-                }
-                break;
-            }
-            let d = input.design(i);
-            let outcome = match compute_design(&d, &p, grid, None, Some(budget)) {
-                Ok(r) => ComboOutcome::Valid(Box::new(r)),
-                Err(IrefcError::Deadline { .. }) => {
-                    stopped.store(true, Ordering::Relaxed);
-                    if let Ok(mut g) = stop_reason.lock() {
-                        g.get_or_insert(StopReason::Deadline);
-                    }
-                    break;
-                }
-                Err(e) => ComboOutcome::Invalid {
-                    code: e.code(),
-                    message: e.to_string(),
-                    geometry: Geometry::new_unchecked(d.r2, d.z2, d.chi, d.rb),
-                },
-            };
-            evaluated.fetch_add(1, Ordering::Relaxed);
-            local.push((i, outcome));
+    let record = |r: StopReason| {
+        if let Ok(mut g) = stop_reason.lock() {
+            g.get_or_insert(r);
         }
-        local
     };
-
-    let mut outcomes: Vec<ComboOutcome> = vec![ComboOutcome::NotEvaluated; total];
-    let parts: Vec<Vec<(usize, ComboOutcome)>> = if threads <= 1 {
-        vec![worker()]
-    } else {
-        std::thread::scope(|s| {
-            let handles: Vec<_> = (0..threads).map(|_| s.spawn(worker)).collect();
-            handles
-                .into_iter()
-                .map(|h| match h.join() {
-                    Ok(v) => v,
-                    // A panicking worker is a bug: propagate it (the HTTP layer turns panics into 500).
-                    Err(e) => std::panic::resume_unwind(e),
-                })
-                .collect()
-        })
-    };
-    for (i, o) in parts.into_iter().flatten() {
-        if let Some(slot) = outcomes.get_mut(i) {
-            *slot = o;
+    let combos: Vec<usize> = (0..total).collect();
+    let results = par_map_while(threads, &combos, |_, &i| {
+        if let Some(r) = budget.check(i as u64) {
+            record(r);
+            return None;
         }
-    }
+        let d = input.design(i);
+        let outcome = match compute_design(&d, &p, grid, None, Some(budget)) {
+            Ok(r) => ComboOutcome::Valid(Box::new(r)),
+            Err(IrefcError::Deadline { .. }) => {
+                record(StopReason::Deadline);
+                return None;
+            }
+            Err(e) => ComboOutcome::Invalid {
+                code: e.code(),
+                message: e.to_string(),
+                geometry: Geometry::new_unchecked(d.r2, d.z2, d.chi, d.rb),
+            },
+        };
+        evaluated.fetch_add(1, Ordering::Relaxed);
+        Some(outcome)
+    });
+    let outcomes: Vec<ComboOutcome> = results
+        .into_iter()
+        .map(|o| o.unwrap_or(ComboOutcome::NotEvaluated))
+        .collect();
     let stop = stop_reason
         .into_inner()
         .ok()
