@@ -21,6 +21,7 @@ pub mod pool;
 pub mod problem;
 pub mod serve;
 pub mod shape;
+pub mod spatial_coupling;
 pub mod state;
 pub mod stream;
 pub mod telemetry;
@@ -124,6 +125,7 @@ JSON pointers to the offending fields.",
         (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
         (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
+        (name = "spatial-linkages", description = "Spatial couplings: closed-form kinematics of the RP1PR coupling between crossed shafts"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -145,6 +147,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(irefc::stress))
         .route(routes!(irefc::efficiency))
         .route(routes!(continuum_workspace::solve))
+        .route(routes!(spatial_coupling::evaluate))
         .finish()
 }
 
