@@ -14,6 +14,7 @@ mod cognates;
 mod component_importance;
 mod continuum_workspace;
 mod irefc;
+mod spatial_coupling;
 pub mod style;
 
 use serde_json::Value;
@@ -89,6 +90,11 @@ const PICTURES: &[Picture] = &[
         route: "/v1/continuum-workspace",
         prepare: continuum_workspace::prepare,
         render: continuum_workspace::render,
+    },
+    Picture {
+        route: "/v1/spatial-coupling",
+        prepare: spatial_coupling::prepare,
+        render: spatial_coupling::render,
     },
 ];
 

@@ -11,3 +11,4 @@ pub mod cam_table1;
 pub mod finite;
 pub mod http;
 pub mod proptest_cfg;
+pub mod spatial_coupling;

@@ -104,7 +104,8 @@ impl TryFrom<SpatialCouplingRequest> for SpatialCouplingInput {
     fn try_from(req: SpatialCouplingRequest) -> Result<Self, Self::Error> {
         let mut v = Validator::new();
         let alpha_deg = req.alpha_deg.unwrap_or(DEFAULT_ALPHA_DEG);
-        if v.range("/alpha_deg", "alpha_deg", alpha_deg, ALPHA_DEG) {
+        let alpha_ok = v.range("/alpha_deg", "alpha_deg", alpha_deg, ALPHA_DEG);
+        if alpha_ok {
             let c2a = sin_cos_deg(2.0 * alpha_deg).1;
             v.ensure_code(
                 c2a.abs() >= MIN_ABS_COS_2ALPHA,
@@ -123,7 +124,10 @@ impl TryFrom<SpatialCouplingRequest> for SpatialCouplingInput {
         let a = req.a_m.unwrap_or(1.0);
         v.range("/a_m", "a_m", a, A_M);
         let beta_deg = req.beta_deg.unwrap_or(alpha_deg);
-        v.range("/beta_deg", "beta_deg", beta_deg, BETA_DEG);
+        // β defaults to α: an invalid α is reported once, at /alpha_deg.
+        if req.beta_deg.is_some() || alpha_ok {
+            v.range("/beta_deg", "beta_deg", beta_deg, BETA_DEG);
+        }
         let omega1 = req.omega1_rad_s.unwrap_or(1.0);
         v.range("/omega1_rad_s", "omega1_rad_s", omega1, OMEGA1);
         let points = req.theta1_deg.unwrap_or_default();

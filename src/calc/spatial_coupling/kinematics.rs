@@ -330,7 +330,10 @@ impl Coupling {
             dz: dot(b.dr, k2),
             // θ32 = atan2(k3·i2, k3·k2) = atan2(−sin2α c1, −σρ) (exact reduction).
             theta: (-self.s2a * core.c1).atan2(-self.sigma * core.rho),
-            omega: -self.s2a * core.s1 / core.rho,
+            // dθ32/dθ1 of the angle above: −σ sin2α s1/ρ. The spec's §3.4 prints it without σ
+            // ("ω32 does not depend on σ"): true of the vector ω32·j2 (j2 flips with σ), not of the
+            // signed rate about j2 that goes with θ32.
+            omega: -self.sigma * self.s2a * core.s1 / core.rho,
         }
     }
 
