@@ -49,7 +49,14 @@ async fn optional_groups_are_omitted_unless_asked() {
     let b = r.json();
     assert!(b.get("summary").is_none() && b.get("series").is_none());
     for p in b["points"].as_array().expect("points") {
-        for k in ["contact", "relative_1", "relative_2", "frames", "body3_points", "check"] {
+        for k in [
+            "contact",
+            "relative_1",
+            "relative_2",
+            "frames",
+            "body3_points",
+            "check",
+        ] {
             assert!(p.get(k).is_none(), "{k} present without being asked");
         }
     }
@@ -63,9 +70,21 @@ async fn optional_groups_are_omitted_unless_asked() {
 #[tokio::test]
 async fn invalid_fields_point_at_themselves() {
     let cases = [
-        (json!({"alpha_deg": 45}), "/alpha_deg", "PERPENDICULAR_SHAFTS"),
-        (json!({"alpha_deg": -45}), "/alpha_deg", "PERPENDICULAR_SHAFTS"),
-        (json!({"alpha_deg": 45.000_000_01}), "/alpha_deg", "PERPENDICULAR_SHAFTS"),
+        (
+            json!({"alpha_deg": 45}),
+            "/alpha_deg",
+            "PERPENDICULAR_SHAFTS",
+        ),
+        (
+            json!({"alpha_deg": -45}),
+            "/alpha_deg",
+            "PERPENDICULAR_SHAFTS",
+        ),
+        (
+            json!({"alpha_deg": 45.000_000_01}),
+            "/alpha_deg",
+            "PERPENDICULAR_SHAFTS",
+        ),
         (json!({"alpha_deg": 90}), "/alpha_deg", "INVALID_INPUT"),
         (json!({"alpha_deg": -90.5}), "/alpha_deg", "INVALID_INPUT"),
         (json!({"a_m": 0}), "/a_m", "INVALID_INPUT"),
@@ -73,12 +92,36 @@ async fn invalid_fields_point_at_themselves() {
         (json!({"a_m": 2e6}), "/a_m", "INVALID_INPUT"),
         (json!({"beta_deg": -90}), "/beta_deg", "INVALID_INPUT"),
         (json!({"beta_deg": 90.001}), "/beta_deg", "INVALID_INPUT"),
-        (json!({"omega1_rad_s": 1e7}), "/omega1_rad_s", "INVALID_INPUT"),
-        (json!({"sweep": {"n_points": 1}}), "/sweep/n_points", "INVALID_INPUT"),
-        (json!({"sweep": {"n_points": 1_000_001}}), "/sweep/n_points", "INVALID_INPUT"),
-        (json!({"outputs": {"decimate": 0}}), "/outputs/decimate", "INVALID_INPUT"),
-        (json!({"body3_points_m": [[0, 0, 0], [0, 2e6, 0]]}), "/body3_points_m/1/1", "INVALID_INPUT"),
-        (json!({"time_limit_ms": 0}), "/time_limit_ms", "INVALID_INPUT"),
+        (
+            json!({"omega1_rad_s": 1e7}),
+            "/omega1_rad_s",
+            "INVALID_INPUT",
+        ),
+        (
+            json!({"sweep": {"n_points": 1}}),
+            "/sweep/n_points",
+            "INVALID_INPUT",
+        ),
+        (
+            json!({"sweep": {"n_points": 1_000_001}}),
+            "/sweep/n_points",
+            "INVALID_INPUT",
+        ),
+        (
+            json!({"outputs": {"decimate": 0}}),
+            "/outputs/decimate",
+            "INVALID_INPUT",
+        ),
+        (
+            json!({"body3_points_m": [[0, 0, 0], [0, 2e6, 0]]}),
+            "/body3_points_m/1/1",
+            "INVALID_INPUT",
+        ),
+        (
+            json!({"time_limit_ms": 0}),
+            "/time_limit_ms",
+            "INVALID_INPUT",
+        ),
     ];
     for (body, pointer, code) in cases {
         let r = post_json(PATH, &body).await;
@@ -152,28 +195,66 @@ async fn invalid_support_plane_sweep_is_refused_points_answer_per_point() {
     .await;
     assert_eq!(b.status, 200, "{}", String::from_utf8_lossy(&b.bytes));
     let v = b.json();
-    assert!(!v["configuration"]["support_plane"]["valid"].as_bool().expect("bool"));
-    let roots = v["configuration"]["support_plane"]["d_roots_theta1_deg"].as_array().expect("roots");
+    assert!(
+        !v["configuration"]["support_plane"]["valid"]
+            .as_bool()
+            .expect("bool")
+    );
+    let roots = v["configuration"]["support_plane"]["d_roots_theta1_deg"]
+        .as_array()
+        .expect("roots");
     assert_eq!(roots.len(), 4);
     assert!((num(&roots[0]) - root).abs() < 1e-12);
     let pts = v["points"].as_array().expect("points");
     assert_eq!(pts[0]["error"]["code"], "CONTACT_AT_INFINITY", "{}", pts[0]);
     assert!(pts[1]["contact"]["rB_m"][0].is_number(), "{}", pts[1]);
     assert_eq!(pts[2]["error"]["code"], "CONTACT_AT_INFINITY", "{}", pts[2]);
-    assert!(v["warnings"].as_array().expect("warnings").iter().any(|w| w["code"] == "SUPPORT_PLANE_INVALID"));
+    assert!(
+        v["warnings"]
+            .as_array()
+            .expect("warnings")
+            .iter()
+            .any(|w| w["code"] == "SUPPORT_PLANE_INVALID")
+    );
     // A request with both points and a sweep follows the sweep rule (422).
-    let r = post_json(PATH, &json!({"alpha_deg": 15, "beta_deg": 80, "theta1_deg": [10], "sweep": {}})).await;
+    let r = post_json(
+        PATH,
+        &json!({"alpha_deg": 15, "beta_deg": 80, "theta1_deg": [10], "sweep": {}}),
+    )
+    .await;
     assert_eq!(r.problem(422)["code"], "SUPPORT_PLANE_INVALID");
 }
 
 #[tokio::test]
 async fn warnings_name_the_hazard() {
-    let b = post_json(PATH, &json!({"alpha_deg": 44, "beta_deg": 0, "theta1_deg": [0]})).await.json();
-    let codes: Vec<&str> = b["warnings"].as_array().expect("warnings").iter().filter_map(|w| w["code"].as_str()).collect();
+    let b = post_json(
+        PATH,
+        &json!({"alpha_deg": 44, "beta_deg": 0, "theta1_deg": [0]}),
+    )
+    .await
+    .json();
+    let codes: Vec<&str> = b["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(|w| w["code"].as_str())
+        .collect();
     assert!(codes.contains(&"NEAR_PERPENDICULAR_SHAFTS"), "{codes:?}");
     // β close to α − 90°: D(0) = cos(α−β)·cos 2α nearly 0, valid but ill-conditioned.
-    let b = post_json(PATH, &json!({"alpha_deg": 15, "beta_deg": -74.99, "sweep": {"n_points": 33}})).await;
+    let b = post_json(
+        PATH,
+        &json!({"alpha_deg": 15, "beta_deg": -74.99, "sweep": {"n_points": 33}}),
+    )
+    .await;
     assert_eq!(b.status, 200, "{}", String::from_utf8_lossy(&b.bytes));
-    let codes: Vec<String> = b.json()["warnings"].as_array().expect("warnings").iter().filter_map(|w| w["code"].as_str().map(str::to_owned)).collect();
-    assert!(codes.iter().any(|c| c == "CONTACT_ILL_CONDITIONED"), "{codes:?}");
+    let codes: Vec<String> = b.json()["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(|w| w["code"].as_str().map(str::to_owned))
+        .collect();
+    assert!(
+        codes.iter().any(|c| c == "CONTACT_ILL_CONDITIONED"),
+        "{codes:?}"
+    );
 }

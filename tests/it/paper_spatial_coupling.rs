@@ -72,24 +72,81 @@ fn golden_points_of_spec_section_6_at_printed_digits() {
         let (alpha, beta, a, sigma, t) = g.case;
         let p = point(alpha, beta, a, sigma, t);
         let w = format!("α={alpha} β={beta} a={a} θ1={t}");
-        close_angle(num(&p["theta2_deg"]), g.theta2, PRINTED_6, &format!("{w} θ2"));
+        close_angle(
+            num(&p["theta2_deg"]),
+            g.theta2,
+            PRINTED_6,
+            &format!("{w} θ2"),
+        );
         close(num(&p["i12"]), g.i12, PRINTED_8, &format!("{w} i12"));
         let rb = v3(&p["contact"]["rB_m"]);
         for k in 0..3 {
             close(rb[k], g.rb[k], PRINTED_8, &format!("{w} rB[{k}]"));
         }
-        close(num(&p["relative_1"]["x1B_m"]), g.x1z1[0], PRINTED_8, &format!("{w} x1B"));
-        close(num(&p["relative_1"]["z1B_m"]), g.x1z1[1], PRINTED_8, &format!("{w} z1B"));
-        close(num(&p["relative_2"]["x2B_m"]), g.x2z2[0], PRINTED_8, &format!("{w} x2B"));
-        close(num(&p["relative_2"]["z2B_m"]), g.x2z2[1], PRINTED_8, &format!("{w} z2B"));
-        close_angle(num(&p["relative_1"]["theta31_deg"]), g.th31, PRINTED_6, &format!("{w} θ31"));
-        close(num(&p["relative_1"]["omega31_rad_s"]), g.w31, PRINTED_8, &format!("{w} ω31"));
-        close_angle(num(&p["relative_2"]["theta32_deg"]), g.th32, PRINTED_6, &format!("{w} θ32"));
-        close(num(&p["relative_2"]["omega32_rad_s"]), g.w32, PRINTED_8, &format!("{w} ω32"));
-        close(num(&p["contact"]["vB_mag"]), g.vb, PRINTED_8, &format!("{w} |vB|"));
+        close(
+            num(&p["relative_1"]["x1B_m"]),
+            g.x1z1[0],
+            PRINTED_8,
+            &format!("{w} x1B"),
+        );
+        close(
+            num(&p["relative_1"]["z1B_m"]),
+            g.x1z1[1],
+            PRINTED_8,
+            &format!("{w} z1B"),
+        );
+        close(
+            num(&p["relative_2"]["x2B_m"]),
+            g.x2z2[0],
+            PRINTED_8,
+            &format!("{w} x2B"),
+        );
+        close(
+            num(&p["relative_2"]["z2B_m"]),
+            g.x2z2[1],
+            PRINTED_8,
+            &format!("{w} z2B"),
+        );
+        close_angle(
+            num(&p["relative_1"]["theta31_deg"]),
+            g.th31,
+            PRINTED_6,
+            &format!("{w} θ31"),
+        );
+        close(
+            num(&p["relative_1"]["omega31_rad_s"]),
+            g.w31,
+            PRINTED_8,
+            &format!("{w} ω31"),
+        );
+        close_angle(
+            num(&p["relative_2"]["theta32_deg"]),
+            g.th32,
+            PRINTED_6,
+            &format!("{w} θ32"),
+        );
+        close(
+            num(&p["relative_2"]["omega32_rad_s"]),
+            g.w32,
+            PRINTED_8,
+            &format!("{w} ω32"),
+        );
+        close(
+            num(&p["contact"]["vB_mag"]),
+            g.vb,
+            PRINTED_8,
+            &format!("{w} |vB|"),
+        );
         // Single points report angles in [0°, 360°).
-        for ang in [&p["theta2_deg"], &p["relative_1"]["theta31_deg"], &p["relative_2"]["theta32_deg"]] {
-            assert!((0.0..360.0).contains(&num(ang)), "{w}: {ang} outside [0, 360)");
+        for ang in [
+            &p["theta2_deg"],
+            &p["relative_1"]["theta31_deg"],
+            &p["relative_2"]["theta32_deg"],
+        ] {
+            assert!(
+                (0.0..360.0).contains(&num(ang)),
+                "{w}: {ang} outside [0, 360)"
+            );
         }
     }
 }
@@ -155,7 +212,10 @@ fn closed_forms_match_the_independent_reference_to_1e_12() {
         let mut chk = |got: f64, want: f64, scale: f64, what: &str| {
             let e = (got - want).abs() / scale;
             worst = worst.max(e);
-            assert!(e <= EXACT, "{w} {what}: got {got:.17e}, want {want:.17e}, rel {e:e}");
+            assert!(
+                e <= EXACT,
+                "{w} {what}: got {got:.17e}, want {want:.17e}, rel {e:e}"
+            );
         };
         chk(dang(num(&p["theta2_deg"]), r.theta2), 0.0, 360.0, "θ2");
         chk(num(&p["i12"]), r.i12, 1.0, "i12");
@@ -190,27 +250,67 @@ fn closed_forms_match_the_independent_reference_to_1e_12() {
 fn other_assembly_mode_and_di12() {
     let p = point(15.0, 15.0, 1.0, -1, 30.0);
     close_angle(num(&p["theta2_deg"]), 236.309_932, PRINTED_6, "θ2 σ=−1");
-    close(num(&p["relative_2"]["x2B_m"]), -0.901_387_82, PRINTED_8, "x2B σ=−1");
-    close_angle(num(&p["relative_1"]["theta31_deg"]), 163.897_886, PRINTED_6, "θ31 σ=−1");
-    close_angle(num(&p["relative_2"]["theta32_deg"]), 334.341_094, PRINTED_6, "θ32 σ=−1");
+    close(
+        num(&p["relative_2"]["x2B_m"]),
+        -0.901_387_82,
+        PRINTED_8,
+        "x2B σ=−1",
+    );
+    close_angle(
+        num(&p["relative_1"]["theta31_deg"]),
+        163.897_886,
+        PRINTED_6,
+        "θ31 σ=−1",
+    );
+    close_angle(
+        num(&p["relative_2"]["theta32_deg"]),
+        334.341_094,
+        PRINTED_6,
+        "θ32 σ=−1",
+    );
     let q = point(15.0, 15.0, 1.0, 1, 30.0);
     for k in ["i12", "di12_dtheta1"] {
         close(num(&p[k]), num(&q[k]), EXACT, k);
     }
     for k in 0..3 {
-        close(num(&p["contact"]["rB_m"][k]), num(&q["contact"]["rB_m"][k]), EXACT, "rB");
+        close(
+            num(&p["contact"]["rB_m"][k]),
+            num(&q["contact"]["rB_m"][k]),
+            EXACT,
+            "rB",
+        );
     }
-    close(num(&p["relative_1"]["omega31_rad_s"]), num(&q["relative_1"]["omega31_rad_s"]), EXACT, "ω31");
+    close(
+        num(&p["relative_1"]["omega31_rad_s"]),
+        num(&q["relative_1"]["omega31_rad_s"]),
+        EXACT,
+        "ω31",
+    );
     // Spec §3.4/§6 say ω32 is unchanged by σ; the rate of the returned θ32 (which the golden
     // table confirms: 334.341094 for σ = −1) is −σ·sin2α·s1/ρ, and the vector ω32·j2 — the
     // physical relative rotation, the same in both modes since j2 flips with σ — is unchanged.
     // The deciding properties: ω32 = dθ32/dt (tested against central differences) and
     // ω1 k1 + ω31 j1 = ω2 k2 + ω32 j2 (tests/slow/props_spatial_coupling.rs).
-    close(num(&p["relative_2"]["omega32_rad_s"]), -num(&q["relative_2"]["omega32_rad_s"]), EXACT, "ω32 flips with σ");
+    close(
+        num(&p["relative_2"]["omega32_rad_s"]),
+        -num(&q["relative_2"]["omega32_rad_s"]),
+        EXACT,
+        "ω32 flips with σ",
+    );
     let fd = crate::support::spatial_coupling::fd_error(15.0, 15.0, 1.0, -1, 30.0, 1.0);
     assert!(fd < 1e-8, "σ = −1 rates vs central differences: {fd:e}");
-    close(num(&q["di12_dtheta1"]), 0.284_023_67, PRINTED_8, "di12 at 30°");
-    close(num(&point(15.0, 15.0, 1.0, 1, 60.0)["di12_dtheta1"]), 0.213_333_33, PRINTED_8, "di12 at 60°");
+    close(
+        num(&q["di12_dtheta1"]),
+        0.284_023_67,
+        PRINTED_8,
+        "di12 at 30°",
+    );
+    close(
+        num(&point(15.0, 15.0, 1.0, 1, 60.0)["di12_dtheta1"]),
+        0.213_333_33,
+        PRINTED_8,
+        "di12 at 60°",
+    );
 }
 
 /// A 3600-point sweep of the paper-like case (α = β = 15°, a = 1): the statements of spec §6.
@@ -226,26 +326,76 @@ fn paper_statements_over_a_revolution() {
     let b = paper_sweep(15.0);
     let s = &b["summary"];
     let c2a = 30f64.to_radians().cos();
-    close(num(&s["ratio_range_abs"][0]), c2a, EXACT, "|i12| min = cos 2α");
-    close(num(&s["ratio_range_abs"][1]), 1.0 / c2a, EXACT, "|i12| max = 1/cos 2α");
+    close(
+        num(&s["ratio_range_abs"][0]),
+        c2a,
+        EXACT,
+        "|i12| min = cos 2α",
+    );
+    close(
+        num(&s["ratio_range_abs"][1]),
+        1.0 / c2a,
+        EXACT,
+        "|i12| max = 1/cos 2α",
+    );
     assert!(num(&s["i12_max"]) < 0.0, "i12 < 0");
-    close(num(&s["fluctuation"]), 30f64.to_radians().sin() * 30f64.to_radians().tan(), EXACT, "δ");
+    close(
+        num(&s["fluctuation"]),
+        30f64.to_radians().sin() * 30f64.to_radians().tan(),
+        EXACT,
+        "δ",
+    );
     assert!(!s["homokinetic"].as_bool().expect("bool"));
     for k in 0..2 {
         close(num(&s["rB_radius_range_m"][k]), 1.0, EXACT, "|rB| ≡ a");
         close(num(&s["vB_range_m_s"][k]), 2.0, EXACT, "|vB| ≡ 2aω1");
     }
-    close(num(&s["lemniscate_box_m"]["x"][1]) - num(&s["lemniscate_box_m"]["x"][0]), 4.0, EXACT, "box 4a");
-    close(num(&s["lemniscate_box_m"]["z"][1]) - num(&s["lemniscate_box_m"]["z"][0]), 1.0, EXACT, "box 1a");
-    close(num(&s["theta31_amplitude_deg"]), 30.0, 1e-10, "θ31 amplitude 2α");
-    close(num(&s["theta32_amplitude_deg"]), 30.0, 1e-10, "θ32 amplitude 2α");
-    close(num(&s["omega31_max_abs"]), 30f64.to_radians().tan(), EXACT, "max|ω31| = tan 2α");
+    close(
+        num(&s["lemniscate_box_m"]["x"][1]) - num(&s["lemniscate_box_m"]["x"][0]),
+        4.0,
+        EXACT,
+        "box 4a",
+    );
+    close(
+        num(&s["lemniscate_box_m"]["z"][1]) - num(&s["lemniscate_box_m"]["z"][0]),
+        1.0,
+        EXACT,
+        "box 1a",
+    );
+    close(
+        num(&s["theta31_amplitude_deg"]),
+        30.0,
+        1e-10,
+        "θ31 amplitude 2α",
+    );
+    close(
+        num(&s["theta32_amplitude_deg"]),
+        30.0,
+        1e-10,
+        "θ32 amplitude 2α",
+    );
+    close(
+        num(&s["omega31_max_abs"]),
+        30f64.to_radians().tan(),
+        EXACT,
+        "max|ω31| = tan 2α",
+    );
     close(num(&s["omega32_max_abs"]), 0.5, EXACT, "max|ω32| = sin 2α");
-    close(num(&s["D_min_over_max"]), 1.0, EXACT, "D constant for β = α");
+    close(
+        num(&s["D_min_over_max"]),
+        1.0,
+        EXACT,
+        "D constant for β = α",
+    );
     let series = b["series"].as_array().expect("series");
     assert_eq!(series.len(), 3601);
     let (mut x1_lo, mut x1_hi, mut z1_max) = (f64::INFINITY, f64::NEG_INFINITY, 0f64);
-    let (mut th31_lo, mut th31_hi, mut th32_lo, mut th32_hi) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut th31_lo, mut th31_hi, mut th32_lo, mut th32_hi) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     let (mut w31_signs, mut w32_signs) = (Vec::new(), Vec::new());
     for p in series {
         let r1 = &p["relative_1"];
@@ -277,15 +427,32 @@ fn paper_statements_over_a_revolution() {
     close(th32_lo, 150.0, 1e-10, "θ32 min");
     close(th32_hi, 210.0, 1e-10, "θ32 max");
     // Sign changes per (periodic) revolution: twice each (body 3 oscillates about both shafts).
-    let cyclic = |v: &[bool]| (0..v.len()).filter(|&i| v[i] != v[(i + 1) % v.len()]).count();
-    assert_eq!(cyclic(&w31_signs), 2, "ω31 changes sign twice per revolution");
-    assert_eq!(cyclic(&w32_signs), 2, "ω32 changes sign twice per revolution");
+    let cyclic = |v: &[bool]| {
+        (0..v.len())
+            .filter(|&i| v[i] != v[(i + 1) % v.len()])
+            .count()
+    };
+    assert_eq!(
+        cyclic(&w31_signs),
+        2,
+        "ω31 changes sign twice per revolution"
+    );
+    assert_eq!(
+        cyclic(&w32_signs),
+        2,
+        "ω32 changes sign twice per revolution"
+    );
     // Lemniscate boxes of spec §6 for other α: 4a × 2a sin 2α.
     for (alpha, h) in [(10.0, 0.684), (20.0, 1.286), (30.0, 1.732)] {
         let s = &paper_sweep(alpha)["summary"];
         let hz = num(&s["lemniscate_box_m"]["z"][1]) - num(&s["lemniscate_box_m"]["z"][0]);
         assert!((hz - h).abs() < 5e-4, "α = {alpha}: box height {hz} vs {h}");
-        close(hz, 2.0 * (2.0 * alpha).to_radians().sin(), EXACT, "box height 2a sin 2α");
+        close(
+            hz,
+            2.0 * (2.0 * alpha).to_radians().sin(),
+            EXACT,
+            "box height 2a sin 2α",
+        );
     }
 }
 
@@ -301,13 +468,29 @@ fn eq21_jumps_by_pi_the_two_argument_form_does_not() {
         let th2 = num(&p["points"][0]["theta2_deg"]);
         let eq21 = (c2a / t.to_radians().tan()).atan().to_degrees();
         let want = if t < 180.0 { 0.0 } else { 180.0 };
-        assert!((dang(th2, eq21).abs() - want).abs() < 1e-9, "θ1 = {t}: θ2 {th2}, Eq. (21) {eq21}");
+        assert!(
+            (dang(th2, eq21).abs() - want).abs() < 1e-9,
+            "θ1 = {t}: θ2 {th2}, Eq. (21) {eq21}"
+        );
     }
     let s = paper_sweep(15.0);
-    let th: Vec<f64> = s["series"].as_array().expect("series").iter().map(|p| num(&p["theta2_deg"])).collect();
-    assert!(th.windows(2).all(|w| (w[1] - w[0]).abs() < 0.2), "continuous along the sweep");
+    let th: Vec<f64> = s["series"]
+        .as_array()
+        .expect("series")
+        .iter()
+        .map(|p| num(&p["theta2_deg"]))
+        .collect();
+    assert!(
+        th.windows(2).all(|w| (w[1] - w[0]).abs() < 0.2),
+        "continuous along the sweep"
+    );
     close(th[0], 90.0, EXACT, "θ2(0)");
-    close(th[th.len() - 1], -270.0, EXACT, "θ2(360) = θ2(0) − 360 (one output turn, −z2 sense)");
+    close(
+        th[th.len() - 1],
+        -270.0,
+        EXACT,
+        "θ2(360) = θ2(0) − 360 (one output turn, −z2 sense)",
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -323,12 +506,20 @@ fn loop_closure_of_the_returned_configuration() {
         let (alpha, beta, a, sigma, t) = random_config(&mut rng);
         let p = point(alpha, beta, a, sigma, t);
         let r = closure_residual(alpha, beta, a, &p);
-        assert!(r < 1e-12, "α={alpha} β={beta} a={a} σ={sigma} θ1={t}: closure residual {r:e}");
+        assert!(
+            r < 1e-12,
+            "α={alpha} β={beta} a={a} σ={sigma} θ1={t}: closure residual {r:e}"
+        );
         worst = worst.max(r);
         worst_check = worst_check.max(num(&p["check"]["max_residual"]));
     }
-    assert!(worst_check < 1e-12, "the module's own check: {worst_check:e}");
-    eprintln!("closure residual over 2000 random configurations: {worst:e} (module check {worst_check:e})");
+    assert!(
+        worst_check < 1e-12,
+        "the module's own check: {worst_check:e}"
+    );
+    eprintln!(
+        "closure residual over 2000 random configurations: {worst:e} (module check {worst_check:e})"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -341,17 +532,30 @@ fn rates_match_central_differences_of_positions() {
     let mut worst: f64 = 0.0;
     for i in 0..200 {
         let (alpha, beta, a, sigma, t) = random_config(&mut rng);
-        let omega1 = if i % 2 == 0 { 1.0 } else { rng.random_range(-50.0..50.0) };
+        let omega1 = if i % 2 == 0 {
+            1.0
+        } else {
+            rng.random_range(-50.0..50.0)
+        };
         let e = fd_error(alpha, beta, a, sigma, t, omega1);
         // FD truncation h²/6·f''' grows with 1/|cos 2α|³ and 1/min|D|³; the sample keeps
         // |cos 2α| ≥ 0.05 and min|D|/max|D| ≥ 1e-3, so the bound is the differences' own error.
-        assert!(e < 1e-6, "α={alpha} β={beta} a={a} σ={sigma} θ1={t} ω1={omega1}: FD error {e:e}");
+        assert!(
+            e < 1e-6,
+            "α={alpha} β={beta} a={a} σ={sigma} θ1={t} ω1={omega1}: FD error {e:e}"
+        );
         worst = worst.max(e);
     }
     eprintln!("worst rate vs central difference (h = 1e-5 rad): {worst:e}");
     // The spec's bound (< 1e-8) on its own validation cases.
     for r in REFERENCE {
         let e = fd_error(r.alpha, r.beta, r.a, r.sigma, r.theta1 + 7.0, 1.0);
-        assert!(e < 1e-8, "α={} β={} θ1={}: FD error {e:e}", r.alpha, r.beta, r.theta1 + 7.0);
+        assert!(
+            e < 1e-8,
+            "α={} β={} θ1={}: FD error {e:e}",
+            r.alpha,
+            r.beta,
+            r.theta1 + 7.0
+        );
     }
 }

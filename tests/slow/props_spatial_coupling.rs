@@ -22,13 +22,23 @@ use crate::support::spatial_coupling::{
 
 /// α with |cos 2α| ≥ 0.05 (either side of 45°), β giving a valid plane with min|D|/max|D| ≥ 1e-3.
 fn config() -> impl Strategy<Value = (f64, f64, f64, i64)> {
-    (-89.0f64..89.0, -89.9f64..90.0, -3.0f64..3.0, prop::bool::ANY)
-        .prop_filter("valid, well-conditioned configuration", |&(alpha, beta, _, _)| {
-            let c2a = (2.0 * alpha).to_radians().cos();
-            let d0 = (alpha - beta).to_radians().cos() * c2a;
-            let d90 = (alpha + beta).to_radians().cos();
-            c2a.abs() >= 0.05 && d0 * d90 > 0.0 && d0.abs().min(d90.abs()) >= 1e-3 * d0.abs().max(d90.abs())
-        })
+    (
+        -89.0f64..89.0,
+        -89.9f64..90.0,
+        -3.0f64..3.0,
+        prop::bool::ANY,
+    )
+        .prop_filter(
+            "valid, well-conditioned configuration",
+            |&(alpha, beta, _, _)| {
+                let c2a = (2.0 * alpha).to_radians().cos();
+                let d0 = (alpha - beta).to_radians().cos() * c2a;
+                let d90 = (alpha + beta).to_radians().cos();
+                c2a.abs() >= 0.05
+                    && d0 * d90 > 0.0
+                    && d0.abs().min(d90.abs()) >= 1e-3 * d0.abs().max(d90.abs())
+            },
+        )
         .prop_map(|(alpha, beta, la, s)| (alpha, beta, 10f64.powf(la), if s { 1 } else { -1 }))
 }
 

@@ -69,7 +69,11 @@ pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// Shaft frames from the returned angles, built here from T01 = X(π/2 − α, a)·Z(θ1),
@@ -84,8 +88,16 @@ pub fn shaft_frames(alpha_deg: f64, t1_deg: f64, t2_deg: f64) -> [[[f64; 3]; 3];
     };
     let p1 = std::f64::consts::FRAC_PI_2 - alpha_deg.to_radians();
     let p2 = -p1;
-    let f1 = [rx(p1, [c1, s1, 0.0]), rx(p1, [-s1, c1, 0.0]), rx(p1, [0.0, 0.0, 1.0])];
-    let f2 = [rx(p2, [c2, s2, 0.0]), rx(p2, [-s2, c2, 0.0]), rx(p2, [0.0, 0.0, 1.0])];
+    let f1 = [
+        rx(p1, [c1, s1, 0.0]),
+        rx(p1, [-s1, c1, 0.0]),
+        rx(p1, [0.0, 0.0, 1.0]),
+    ];
+    let f2 = [
+        rx(p2, [c2, s2, 0.0]),
+        rx(p2, [-s2, c2, 0.0]),
+        rx(p2, [0.0, 0.0, 1.0]),
+    ];
     [f1, f2]
 }
 
@@ -124,8 +136,20 @@ pub fn closure_residual(alpha: f64, beta: f64, a: f64, p: &Value) -> f64 {
     r.push((num(&r1["z1B_m"]) - dot(sub(rb, a1), k1)) / l);
     r.push((num(&r2["x2B_m"]) - dot(sub(rb, a2), i2)) / l);
     r.push((num(&r2["z2B_m"]) - dot(sub(rb, a2), k2)) / l);
-    r.push(dang(num(&r1["theta31_deg"]), dot(k3, i1).atan2(dot(k3, k1)).to_degrees()).to_radians());
-    r.push(dang(num(&r2["theta32_deg"]), dot(k3, i2).atan2(dot(k3, k2)).to_degrees()).to_radians());
+    r.push(
+        dang(
+            num(&r1["theta31_deg"]),
+            dot(k3, i1).atan2(dot(k3, k1)).to_degrees(),
+        )
+        .to_radians(),
+    );
+    r.push(
+        dang(
+            num(&r2["theta32_deg"]),
+            dot(k3, i2).atan2(dot(k3, k2)).to_degrees(),
+        )
+        .to_radians(),
+    );
     r.into_iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
@@ -140,7 +164,10 @@ pub fn random_config(rng: &mut ChaCha8Rng) -> (f64, f64, f64, i64, f64) {
             (alpha + beta).to_radians().cos(),
         );
         let (d0, d90) = (cm * c2a, cp);
-        if c2a.abs() < 0.05 || d0 * d90 <= 0.0 || d0.abs().min(d90.abs()) < 1e-3 * d0.abs().max(d90.abs()) {
+        if c2a.abs() < 0.05
+            || d0 * d90 <= 0.0
+            || d0.abs().min(d90.abs()) < 1e-3 * d0.abs().max(d90.abs())
+        {
             continue;
         }
         let a = 10f64.powf(rng.random_range(-3.0..3.0));
@@ -172,17 +199,57 @@ pub fn fd_error(alpha: f64, beta: f64, a: f64, sigma: i64, t: f64, omega1: f64) 
         worst = worst.max((analytic - numeric).abs() / scale);
     };
     let w = omega1.abs();
-    cmp(num(&c["omega2_rad_s"]), fd_angle(&|v| num(&v["theta2_deg"])), w);
-    cmp(num(&c["epsilon2_rad_s2"]), fd(&|v| num(&v["omega2_rad_s"])), w * w);
+    cmp(
+        num(&c["omega2_rad_s"]),
+        fd_angle(&|v| num(&v["theta2_deg"])),
+        w,
+    );
+    cmp(
+        num(&c["epsilon2_rad_s2"]),
+        fd(&|v| num(&v["omega2_rad_s"])),
+        w * w,
+    );
     for k in 0..3 {
-        cmp(num(&c["contact"]["vB_m_s"][k]), fd(&|v| num(&v["contact"]["rB_m"][k])), a * w);
-        cmp(num(&c["body3_points"][0]["v0_m_s"][k]), fd(&|v| num(&v["body3_points"][0]["r0_m"][k])), a * w);
-        cmp(num(&c["body3_points"][0]["v1_m_s"][k]), fd(&|v| num(&v["body3_points"][0]["r1_m"][k])), a * w);
-        cmp(num(&c["body3_points"][0]["v2_m_s"][k]), fd(&|v| num(&v["body3_points"][0]["r2_m"][k])), a * w);
+        cmp(
+            num(&c["contact"]["vB_m_s"][k]),
+            fd(&|v| num(&v["contact"]["rB_m"][k])),
+            a * w,
+        );
+        cmp(
+            num(&c["body3_points"][0]["v0_m_s"][k]),
+            fd(&|v| num(&v["body3_points"][0]["r0_m"][k])),
+            a * w,
+        );
+        cmp(
+            num(&c["body3_points"][0]["v1_m_s"][k]),
+            fd(&|v| num(&v["body3_points"][0]["r1_m"][k])),
+            a * w,
+        );
+        cmp(
+            num(&c["body3_points"][0]["v2_m_s"][k]),
+            fd(&|v| num(&v["body3_points"][0]["r2_m"][k])),
+            a * w,
+        );
     }
     for (g, x, z, vx, vz, th, om) in [
-        ("relative_1", "x1B_m", "z1B_m", "vx1B_m_s", "vz1B_m_s", "theta31_deg", "omega31_rad_s"),
-        ("relative_2", "x2B_m", "z2B_m", "vx2B_m_s", "vz2B_m_s", "theta32_deg", "omega32_rad_s"),
+        (
+            "relative_1",
+            "x1B_m",
+            "z1B_m",
+            "vx1B_m_s",
+            "vz1B_m_s",
+            "theta31_deg",
+            "omega31_rad_s",
+        ),
+        (
+            "relative_2",
+            "x2B_m",
+            "z2B_m",
+            "vx2B_m_s",
+            "vz2B_m_s",
+            "theta32_deg",
+            "omega32_rad_s",
+        ),
     ] {
         cmp(num(&c[g][vx]), fd(&|v| num(&v[g][x])), a * w);
         cmp(num(&c[g][vz]), fd(&|v| num(&v[g][z])), a * w);
@@ -190,4 +257,3 @@ pub fn fd_error(alpha: f64, beta: f64, a: f64, sigma: i64, t: f64, omega1: f64) 
     }
     worst
 }
-

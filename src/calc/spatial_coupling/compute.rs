@@ -610,13 +610,19 @@ fn first_in_first_turn(v: &mut [PointKin]) {
     let o2 = turns(first.theta2_deg);
     let o31 = first.rel1.map_or(0.0, |r| turns(r.theta_deg));
     let o32 = first.rel2.map_or(0.0, |r| turns(r.theta_deg));
+    // Beyond ~1e307° the shift itself can overflow; such angles (flagged `LARGE_ANGLE`) carry no
+    // revolution information anyway and are wrapped to [0°, 360°) instead.
+    let shift = |x: f64, o: f64| {
+        let y = x - o;
+        if y.is_finite() { y } else { wrap_360(x) }
+    };
     for p in v.iter_mut() {
-        p.theta2_deg -= o2;
+        p.theta2_deg = shift(p.theta2_deg, o2);
         if let Some(r) = &mut p.rel1 {
-            r.theta_deg -= o31;
+            r.theta_deg = shift(r.theta_deg, o31);
         }
         if let Some(r) = &mut p.rel2 {
-            r.theta_deg -= o32;
+            r.theta_deg = shift(r.theta_deg, o32);
         }
     }
 }

@@ -44,7 +44,13 @@ impl Sweep {
         }
         // Counts are ≤ 10⁶: exact in f64.
         let t = k as f64 / (self.n_points - 1) as f64;
-        self.start_deg + t * (self.end_deg - self.start_deg)
+        let span = self.end_deg - self.start_deg;
+        if span.is_finite() {
+            self.start_deg + t * span
+        } else {
+            // Ends of opposite sign near ±f64::MAX: the convex form cannot overflow.
+            (1.0 - t) * self.start_deg + t * self.end_deg
+        }
     }
 }
 
