@@ -35,6 +35,8 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/continuum-workspace", "/design/rods/0/diameter_m", "slenderness length_m / diameter_m ≥ 5"),
     ("/v1/continuum-workspace", "/load/moment_nm", "within 1e4 F_ref L_ref of the design's own scale"),
     ("/v1/continuum-workspace", "/load/force_n/0", "within 1e4 F_ref of the design's own scale"),
+    ("/v1/spatial-coupling", "/alpha_deg", "|cos 2α| ≥ 1e-9 (α ≠ ±45°, perpendicular shafts)"),
+    ("/v1/spatial-coupling", "/beta_deg", "with a sweep: cos(α−β)·cos 2α·cos(α+β) > 0 (422 infeasible otherwise)"),
 ];
 
 /// A number in an example request with its documented bound, if any.
