@@ -60,6 +60,20 @@ async fn optional_groups_are_omitted_unless_asked() {
             assert!(p.get(k).is_none(), "{k} present without being asked");
         }
     }
+    // A series carries only the groups asked for, though the summary needs B and both motions.
+    let b = post_json(
+        PATH,
+        &json!({"sweep": {"n_points": 5}, "outputs": {"series": true, "relative_2": true}}),
+    )
+    .await
+    .json();
+    for p in b["series"].as_array().expect("series") {
+        assert!(
+            p.get("contact").is_none() && p.get("relative_1").is_none(),
+            "{p}"
+        );
+        assert!(p["relative_2"]["x2B_m"].is_number());
+    }
     // Neither points nor a sweep: the default sweep's summary.
     let b = post_json(PATH, &json!({})).await.json();
     assert_eq!(b["summary"]["n_points"], 721);

@@ -575,6 +575,19 @@ fn sweep(
             };
             summary.add(&p);
             if keep(k) {
+                // The summary needed B and both relative motions; the series carries only what
+                // was asked.
+                let g = input.groups;
+                let mut p = p;
+                if !g.contact {
+                    p.contact = None;
+                }
+                if !g.relative_1 {
+                    p.rel1 = None;
+                }
+                if !g.relative_2 {
+                    p.rel2 = None;
+                }
                 kept.push(p);
             }
         }

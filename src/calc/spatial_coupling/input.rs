@@ -56,10 +56,6 @@ impl Sweep {
 
 /// Requested output groups.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[expect(
-    clippy::struct_excessive_bools,
-    reason = "one flag per optional output group of the spec"
-)]
 pub struct Groups {
     /// Contact point.
     pub contact: bool,

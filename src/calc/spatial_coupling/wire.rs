@@ -395,7 +395,8 @@ pub struct Relative2 {
     /// Rotation θ32 of body 3 relative to shaft 2 about j3 ≡ j2 [deg] ([0°, 360°) for single
     /// points, unwrapped along a sweep).
     pub theta32_deg: f64,
-    /// ω32 = dθ32/dt [rad/s].
+    /// ω32 = dθ32/dt = −σ·ω1·sin2α·sin θ1/√(sin²θ1 + cos²2α·cos²θ1) [rad/s] (flips with σ
+    /// because j2 does; the vector ω32·j2 is the same in both assembly modes).
     pub omega32_rad_s: f64,
 }
 
