@@ -558,7 +558,7 @@ fn sweep(
         body3: !input.body3.is_empty(),
         summary: input.summary,
     };
-    let keep = |k: usize| input.series && (k % input.decimate == 0 || k + 1 == s.n_points);
+    let keep = |k: usize| input.series && (k.is_multiple_of(input.decimate) || k + 1 == s.n_points);
     let chunks = chunk_bounds(s.n_points);
     let done = par_map_while(budget.threads(), &chunks, |_, &(lo, hi)| {
         if budget.check((done_before + lo) as u64).is_some() {

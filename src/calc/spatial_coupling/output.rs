@@ -50,7 +50,7 @@ pub fn respond(
         out.points
             .iter()
             .map(|p| match p {
-                PointResult::Ok(p) => PointEntry::Point(point(p)),
+                PointResult::Ok(p) => PointEntry::Point(Box::new(point(p))),
                 PointResult::AtInfinity { theta1_deg, d } => PointEntry::Error(PointFailure {
                     error: PointError {
                         code: "CONTACT_AT_INFINITY".to_owned(),

@@ -272,7 +272,7 @@ pub struct SupportPlane {
 #[serde(untagged)]
 pub enum PointEntry {
     /// The kinematics at this input angle.
-    Point(Point),
+    Point(Box<Point>),
     /// No finite contact point at this input angle.
     Error(PointFailure),
 }
