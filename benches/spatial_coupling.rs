@@ -10,6 +10,8 @@
 // `criterion_group!` generates an undocumented public function.
 #![allow(missing_docs)]
 
+// The shared helpers keep their own formatting (first user of this file; not reformatted here).
+#[rustfmt::skip]
 #[path = "support/mod.rs"]
 mod support;
 
