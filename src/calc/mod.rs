@@ -18,6 +18,7 @@ pub mod continuum_workspace;
 pub mod irefc;
 pub mod machining_size;
 pub mod problem;
+pub mod spatial_coupling;
 
 pub use bounds::{Range, SchemaBound};
 pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validator};
@@ -41,6 +42,8 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         irefc::stress::wire::schema_bounds(),
         irefc::efficiency::wire::schema_bounds(),
         machining_size::schema_bounds(),
+        spatial_coupling::wire::schema_bounds(),
+        spatial_coupling::wire::nested_bounds(),
     ]
     .concat()
 }

@@ -22,6 +22,7 @@ pub mod pool;
 pub mod problem;
 pub mod serve;
 pub mod shape;
+pub mod spatial_coupling;
 pub mod state;
 pub mod stream;
 pub mod telemetry;
@@ -126,6 +127,7 @@ JSON pointers to the offending fields.",
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
         (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
         (name = "machining-size", description = "Machined dimensions: gradient-boosted trees with XGBoost's semantics, exact SHAP explanations and the paper's data diagnostics"),
+        (name = "spatial-linkages", description = "Spatial couplings: closed-form kinematics of the RP1PR coupling between crossed shafts"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -150,6 +152,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(machining_size::train))
         .route(routes!(machining_size::predict))
         .route(routes!(machining_size::analyze))
+        .route(routes!(spatial_coupling::evaluate))
         .finish()
 }
 

@@ -47,6 +47,29 @@ pub fn unwrap_in_place(angles: &mut [f64]) {
     }
 }
 
+/// Sine and cosine of an angle given in degrees, `(sin, cos)`, exact at every multiple of 90°
+/// (`sin_cos_deg(90.0) == (1.0, 0.0)`, not `cos(π/2) ≈ 6e-17`) and for any finite argument: the
+/// angle is reduced modulo 360° first (exact in floating point), then to the nearest multiple of
+/// 90° plus a remainder in [−45°, 45°]. Zero results are `+0.0`.
+#[must_use]
+pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
+    let d = deg % 360.0;
+    let q = (d / 90.0).round();
+    let r = d - 90.0 * q;
+    let (s, c) = if r == 0.0 {
+        (0.0, 1.0)
+    } else {
+        r.to_radians().sin_cos()
+    };
+    // q is a whole number in [−4, 4] (|d| < 360): the cast is exact.
+    match (q as i64).rem_euclid(4) {
+        1 => (c, 0.0 - s),
+        2 => (0.0 - s, 0.0 - c),
+        3 => (0.0 - c, s),
+        _ => (s, c),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -71,6 +94,31 @@ mod tests {
         assert!((wrap_deg(PI) - 180.0).abs() < 1e-12);
         assert!((wrap_deg(-PI) - 180.0).abs() < 1e-12);
         assert!((wrap_deg(-0.5 * PI) + 90.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sin_cos_deg_is_exact_at_quadrants() {
+        for (d, s, c) in [
+            (0.0, 0.0, 1.0),
+            (90.0, 1.0, 0.0),
+            (180.0, 0.0, -1.0),
+            (270.0, -1.0, 0.0),
+            (-90.0, -1.0, 0.0),
+            (720.0, 0.0, 1.0),
+            (-450.0, -1.0, 0.0),
+        ] {
+            let (gs, gc) = sin_cos_deg(d);
+            assert!(
+                gs.to_bits() == f64::to_bits(s) && gc.to_bits() == f64::to_bits(c),
+                "{d}: {gs} {gc}"
+            );
+        }
+        for i in -800..800 {
+            let d = f64::from(i) * 0.7 + 0.013;
+            let (s, c) = sin_cos_deg(d);
+            let (es, ec) = d.to_radians().sin_cos();
+            assert!((s - es).abs() < 1e-14 && (c - ec).abs() < 1e-14, "{d}");
+        }
     }
 
     #[test]

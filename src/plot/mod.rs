@@ -15,6 +15,7 @@ mod component_importance;
 mod continuum_workspace;
 mod irefc;
 mod machining_size;
+mod spatial_coupling;
 pub mod style;
 
 use serde_json::Value;
@@ -105,6 +106,11 @@ const PICTURES: &[Picture] = &[
         route: "/v1/machining-size/analyze",
         prepare: machining_size::prepare_analyze,
         render: machining_size::render_analyze,
+    },
+    Picture {
+        route: "/v1/spatial-coupling",
+        prepare: spatial_coupling::prepare,
+        render: spatial_coupling::render,
     },
 ];
 

@@ -37,6 +37,8 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/continuum-workspace", "/load/force_n/0", "within 1e4 F_ref of the design's own scale"),
     ("/v1/machining-size/train", "/params/colsample_bytree", "⌊colsample_bytree·d⌋ ≥ 1, d = features left after dropping constant columns"),
     ("/v1/machining-size/train", "/params/min_child_weight", "the training split needs ≥ 2·max(1, min_child_weight) rows"),
+    ("/v1/spatial-coupling", "/alpha_deg", "|cos 2α| ≥ 1e-9 (α ≠ ±45°, perpendicular shafts)"),
+    ("/v1/spatial-coupling", "/beta_deg", "with a sweep: cos(α−β)·cos 2α·cos(α+β) > 0 (422 infeasible otherwise)"),
 ];
 
 /// A number in an example request with its documented bound, if any.

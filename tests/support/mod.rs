@@ -12,3 +12,4 @@ pub mod finite;
 pub mod http;
 pub mod machining_size;
 pub mod proptest_cfg;
+pub mod spatial_coupling;

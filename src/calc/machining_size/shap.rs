@@ -14,7 +14,7 @@
 //! clamped to [0, 1] and are 0 under a node of zero cover ([`cover_fraction`]). Local accuracy
 //! holds for any such fractions because φ₀ uses the same ones.
 
-use super::model::{Model, Tree, cover_fraction};
+use super::model::{MAX_TREE_DEPTH, Model, Tree, cover_fraction};
 
 /// One element of the unique path: feature (−1 for the root's dummy), the fraction of zero paths
 /// (x's feature not in the coalition) and of one paths (in the coalition) flowing through it, and
@@ -27,6 +27,19 @@ struct PathElem {
     w: f64,
 }
 
+/// Reciprocals 1/k for k ≤ [`MAX_TREE_DEPTH`] + 2 (1/0 stored as 0, never used): the path
+/// algebra divides by small integers in its inner loops, and a multiplication is several times
+/// cheaper than a division. A path holds at most depth + 1 elements, so indices stay in range.
+const RECIP: [f64; MAX_TREE_DEPTH + 3] = {
+    let mut r = [0.0; MAX_TREE_DEPTH + 3];
+    let mut k = 1;
+    while k < MAX_TREE_DEPTH + 3 {
+        r[k] = 1.0 / k as f64;
+        k += 1;
+    }
+    r
+};
+
 /// Grows the path by one element (the spec's EXTEND).
 fn extend(path: &mut [PathElem], ud: usize, zero: f64, one: f64, feature: i64) {
     path[ud] = PathElem {
@@ -35,10 +48,11 @@ fn extend(path: &mut [PathElem], ud: usize, zero: f64, one: f64, feature: i64) {
         one,
         w: if ud == 0 { 1.0 } else { 0.0 },
     };
-    let l1 = (ud + 1) as f64;
+    let inv_l1 = RECIP[ud + 1];
+    let (one_l, zero_l) = (one * inv_l1, zero * inv_l1);
     for i in (0..ud).rev() {
-        path[i + 1].w += one * path[i].w * (i + 1) as f64 / l1;
-        path[i].w = zero * path[i].w * (ud - i) as f64 / l1;
+        path[i + 1].w += one_l * path[i].w * (i + 1) as f64;
+        path[i].w = zero_l * path[i].w * (ud - i) as f64;
     }
 }
 
@@ -46,14 +60,29 @@ fn extend(path: &mut [PathElem], ud: usize, zero: f64, one: f64, feature: i64) {
 fn unwind(path: &mut [PathElem], ud: usize, idx: usize) {
     let (one, zero) = (path[idx].one, path[idx].zero);
     let l1 = (ud + 1) as f64;
+    let zero_l = zero * RECIP[ud + 1];
     let mut next = path[ud].w;
-    for i in (0..ud).rev() {
-        if one != 0.0 {
+    // l1/one and l1/zero overflow for subnormal fractions (hostile covers): then divide as the
+    // published algorithm does, which keeps 0·∞ out.
+    if one != 0.0 {
+        let a = l1 / one;
+        for i in (0..ud).rev() {
             let t = path[i].w;
-            path[i].w = next * l1 / ((i + 1) as f64 * one);
-            next = t - path[i].w * zero * (ud - i) as f64 / l1;
-        } else {
-            path[i].w = path[i].w * l1 / (zero * (ud - i) as f64);
+            path[i].w = if a.is_finite() {
+                next * a * RECIP[i + 1]
+            } else {
+                next * l1 / ((i + 1) as f64 * one)
+            };
+            next = t - path[i].w * zero_l * (ud - i) as f64;
+        }
+    } else {
+        let a = l1 / zero;
+        for i in (0..ud).rev() {
+            path[i].w = if a.is_finite() {
+                path[i].w * a * RECIP[ud - i]
+            } else {
+                path[i].w * l1 / (zero * (ud - i) as f64)
+            };
         }
     }
     for i in idx..ud {
@@ -68,16 +97,28 @@ fn unwound_sum(path: &[PathElem], ud: usize, idx: usize) -> f64 {
     let (one, zero) = (path[idx].one, path[idx].zero);
     let l1 = (ud + 1) as f64;
     let mut total = 0.0;
+    // As in `unwind`: the multiplied form where l1/one (l1/zero) is finite.
     if one != 0.0 {
+        let a = l1 / one;
+        let zero_l = zero * RECIP[ud + 1];
         let mut next = path[ud].w;
         for i in (0..ud).rev() {
-            let t = next * l1 / ((i + 1) as f64 * one);
+            let t = if a.is_finite() {
+                next * a * RECIP[i + 1]
+            } else {
+                next * l1 / ((i + 1) as f64 * one)
+            };
             total += t;
-            next = path[i].w - t * zero * (ud - i) as f64 / l1;
+            next = path[i].w - t * zero_l * (ud - i) as f64;
         }
     } else if zero != 0.0 {
+        let a = l1 / zero;
         for i in (0..ud).rev() {
-            total += path[i].w * l1 / (zero * (ud - i) as f64);
+            total += if a.is_finite() {
+                path[i].w * a * RECIP[ud - i]
+            } else {
+                path[i].w * l1 / (zero * (ud - i) as f64)
+            };
         }
     }
     total
