@@ -17,6 +17,7 @@ pub mod component_importance;
 pub mod continuum_workspace;
 pub mod irefc;
 pub mod problem;
+pub mod vibration_absorber;
 
 pub use bounds::{Range, SchemaBound};
 pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validator};
@@ -39,6 +40,7 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         irefc::wire::schema_bounds(),
         irefc::stress::wire::schema_bounds(),
         irefc::efficiency::wire::schema_bounds(),
+        vibration_absorber::wire::schema_bounds(),
     ]
     .concat()
 }

@@ -24,6 +24,7 @@ pub mod shape;
 pub mod state;
 pub mod stream;
 pub mod telemetry;
+pub mod vibration_absorber;
 
 pub mod finite;
 
@@ -124,6 +125,7 @@ JSON pointers to the offending fields.",
         (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
         (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
+        (name = "vibration", description = "Structural vibration control: active electromagnetic vibration absorber on a cantilever"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -145,6 +147,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(irefc::stress))
         .route(routes!(irefc::efficiency))
         .route(routes!(continuum_workspace::solve))
+        .route(routes!(vibration_absorber::analyse))
         .finish()
 }
 

@@ -29,4 +29,5 @@ mod paper_cognates;
 mod paper_component_importance;
 mod paper_continuum_workspace;
 mod paper_irefc;
+mod paper_vibration_absorber;
 mod pictures;
