@@ -15,6 +15,7 @@ mod component_importance;
 mod continuum_workspace;
 mod irefc;
 pub mod style;
+mod vibration_absorber;
 
 use serde_json::Value;
 
@@ -89,6 +90,11 @@ const PICTURES: &[Picture] = &[
         route: "/v1/continuum-workspace",
         prepare: continuum_workspace::prepare,
         render: continuum_workspace::render,
+    },
+    Picture {
+        route: "/v1/vibration-absorber",
+        prepare: vibration_absorber::prepare,
+        render: vibration_absorber::render,
     },
 ];
 

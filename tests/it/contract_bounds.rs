@@ -35,6 +35,16 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/continuum-workspace", "/design/rods/0/diameter_m", "slenderness length_m / diameter_m ≥ 5"),
     ("/v1/continuum-workspace", "/load/moment_nm", "within 1e4 F_ref L_ref of the design's own scale"),
     ("/v1/continuum-workspace", "/load/force_n/0", "within 1e4 F_ref of the design's own scale"),
+    ("/v1/vibration-absorber", "/absorber/position_m", "x_a ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/excitation/position_m", "x_p ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/excitation/resonance_of_mode", "k ≤ beam.n_modes"),
+    ("/v1/vibration-absorber", "/absorber/passive_tuning_mode", "k ≤ beam.n_modes"),
+    ("/v1/vibration-absorber", "/control/tuning_mode", "k ≤ beam.n_modes"),
+    ("/v1/vibration-absorber", "/outputs/frequency_response/f_max_hz", "f_max_hz > f_min_hz"),
+    ("/v1/vibration-absorber", "/outputs/frequency_response/points_m/0", "x_o ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/outputs/time_response/points_m/0", "x_o ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/outputs/time_response/dt_s", "t_end_s / dt_s ≤ 2e6 samples"),
+    ("/v1/vibration-absorber", "/actuator/force_constant_n_a", "≠ 0 with control.mode = active"),
 ];
 
 /// A number in an example request with its documented bound, if any.

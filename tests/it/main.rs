@@ -21,6 +21,7 @@ mod http_error_contract;
 mod http_irefc;
 mod http_mutated_examples;
 mod http_service;
+mod http_vibration_absorber;
 mod openapi;
 mod paper_bus_fuel_economy;
 mod paper_cam_law;
