@@ -11,6 +11,7 @@ mod props_cognates;
 mod props_component_importance;
 mod props_continuum_workspace;
 mod props_irefc;
+mod props_vibration_absorber;
 mod stress_bus_fuel_economy;
 mod stress_cam_law;
 mod stress_cam_law_fit;
