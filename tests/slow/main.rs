@@ -19,3 +19,4 @@ mod stress_cognates;
 mod stress_component_importance;
 mod stress_continuum_workspace;
 mod stress_irefc;
+mod stress_vibration_absorber;
