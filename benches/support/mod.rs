@@ -1,10 +1,7 @@
 //! Timing helpers shared by every benchmark's accuracy-vs-cost tables (criterion measures the
 //! headline numbers; these tables need a median and a worst time per knob value next to an error).
 //! Each bench includes this file with `#[path = "support/mod.rs"] mod support;`.
-#![allow(
-    dead_code,
-    reason = "shared by several bench crates; each uses a part"
-)]
+#![allow(dead_code, reason = "shared by several bench crates; each uses a part")]
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -65,7 +62,11 @@ pub fn process_cpu_ms() -> f64 {
         return f64::NAN;
     };
     let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| f.get(i).and_then(|s| s.parse::<f64>().ok()).unwrap_or(f64::NAN);
+    let ticks = |i: usize| {
+        f.get(i)
+            .and_then(|s| s.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
     (ticks(11) + ticks(12)) * 10.0
 }
 

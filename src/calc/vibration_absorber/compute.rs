@@ -18,6 +18,9 @@ use crate::numerics::{Budget, SolverReport, StopReason};
 /// (nearly) uncontrollable (spec §2 warning).
 pub const NODE_WARN_REL: f64 = 1e-3;
 
+/// A complex response per frequency; `None` where `jω` is (numerically) a pole.
+pub type Response = Vec<Option<Complex<f64>>>;
+
 /// Everything `compute` found, in SI units.
 #[derive(Debug, Clone)]
 pub struct VibrationAbsorberOutput {
@@ -42,9 +45,9 @@ pub struct VibrationAbsorberOutput {
     /// Absorber step responses `(G_ec, G_err)`.
     pub ava_step: Option<(StepMetrics, Option<StepMetrics>)>,
     /// Absorber closed-loop FRF `(f [Hz], G_cl)`.
-    pub ava_frf: Option<(Vec<f64>, Vec<Option<Complex<f64>>>)>,
+    pub ava_frf: Option<(Vec<f64>, Response)>,
     /// Coupled FRF `(f [Hz], x_o, H[point][frequency])`.
-    pub frf: Option<(Vec<f64>, Vec<f64>, Vec<Vec<Option<Complex<f64>>>>)>,
+    pub frf: Option<(Vec<f64>, Vec<f64>, Vec<Response>)>,
     /// Time response.
     pub time: Option<TimeOutput>,
     /// Warnings.
@@ -176,17 +179,17 @@ pub fn compute(
             ),
         ));
     }
-    if let Some(g) = &gains {
-        if g.kp < 0.0 {
-            warnings.push(Warning::at(
-                "NEGATIVE_KP",
-                "/control",
-                format!(
-                    "K_p = {:.6e} V/m < 0: the actuator must act as a negative spring",
-                    g.kp
-                ),
-            ));
-        }
+    if let Some(g) = &gains
+        && g.kp < 0.0
+    {
+        warnings.push(Warning::at(
+            "NEGATIVE_KP",
+            "/control",
+            format!(
+                "K_p = {:.6e} V/m < 0: the actuator must act as a negative spring",
+                g.kp
+            ),
+        ));
     }
 
     let natural = o
@@ -227,7 +230,7 @@ pub fn compute(
         .ava_step
         .then(|| ava_steps(&model.dev, gains.as_ref(), o.ava_step_series));
     if let Some((ec, err)) = &ava_step {
-        evaluations += 2 * response::SETTLING_SAMPLES as u64 / 1000;
+        evaluations += ec.expms + err.as_ref().map_or(0, |e| e.expms);
         if ec.settling.is_none() || err.as_ref().is_some_and(|e| e.settling.is_none()) {
             warnings.push(Warning::new(
                 "NO_SETTLING",
@@ -352,7 +355,7 @@ fn ava_frequency_response(
     dev: &Device,
     gains: Option<&Gains>,
     grid: &Grid,
-) -> (Vec<f64>, Vec<Option<Complex<f64>>>) {
+) -> (Vec<f64>, Response) {
     let f = grid.frequencies();
     let (kp, kd) = gains.map_or((0.0, 0.0), |g| (g.kp, g.kd));
     let h = f

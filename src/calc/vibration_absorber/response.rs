@@ -267,6 +267,8 @@ pub struct StepMetrics {
     pub dc: Option<f64>,
     /// Samples `(t, y)` when asked.
     pub series: Option<(Vec<f64>, Vec<f64>)>,
+    /// Matrix exponentials evaluated (one for the transition matrix, one per refinement step).
+    pub expms: u64,
 }
 
 /// Step response `y = c·x` of `ẋ = A x + b·1(t)`, `x(0) = 0`, computed exactly (augmented
@@ -303,6 +305,7 @@ pub fn step_metrics(
         overshoot_pct: 0.0,
         dc,
         series: None,
+        expms: 1,
     };
     let Some(phi) = expm(&(&aug * h)) else {
         return none;
@@ -323,10 +326,12 @@ pub fn step_metrics(
     let overshoot_pct = ((peak - yinf.abs()) / yinf.abs() * 100.0).max(0.0);
     let band = SETTLING_BAND * yinf.abs();
     let last_out = ys.iter().rposition(|y| (y - yinf).abs() > band);
+    let mut expms = 1;
     let settling = match last_out {
         Some(k) if decays && k + 1 < ys.len() => {
             let sk = &states[k];
             let g = |tau: f64| {
+                expms += 1;
                 expm(&(&aug * tau)).map_or(f64::NAN, |e| (caug.dot(&(e * sk)) - yinf).abs() - band)
             };
             bisect(g, 0.0, h).map(|tau| k as f64 * h + tau)
@@ -339,5 +344,6 @@ pub fn step_metrics(
         overshoot_pct,
         dc: Some(yinf),
         series,
+        expms,
     }
 }
