@@ -3,19 +3,27 @@
 
 use nalgebra::{Complex, DMatrix};
 
-/// `exp(a)` by nalgebra's scaling-and-squaring Padé (Al-Mohy–Higham, ported from SciPy), or `None`
-/// when `a` or the result is not finite.
+/// `exp(a)` by nalgebra's scaling-and-squaring Padé (Al-Mohy–Higham, ported from SciPy) applied to
+/// the balanced matrix, `exp(A) = D exp(D⁻¹AD) D⁻¹` (power-of-two `D`, exact), or `None` when `a`
+/// or the result is not finite.
 ///
-/// nalgebra solves the Padé denominator with `lu().solve(..).unwrap()`, which panics if that
-/// denominator is singular; the call is isolated with `catch_unwind` so such a matrix is a typed
-/// failure for the caller, never a crashed job. Finite inputs were never observed to reach it.
+/// Balancing lowers the norm of badly unit-scaled matrices (a coil row with `K_p/L_c ≈ 1e6` next to
+/// unit entries), which saves squarings and the rounding they amplify. nalgebra solves the Padé
+/// denominator with `lu().solve(..).unwrap()`, which panics if that denominator is singular; the
+/// call is isolated with `catch_unwind` so such a matrix is a typed failure for the caller, never
+/// a crashed job. Finite inputs were never observed to reach it.
 #[must_use]
 pub fn expm(a: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     if !a.iter().all(|x| x.is_finite()) {
         return None;
     }
-    let m = a.clone();
-    let e = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || m.exp())).ok()?;
+    let (b, d) = balance_with_scaling(a);
+    let mut e = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || b.exp())).ok()?;
+    for i in 0..e.nrows() {
+        for j in 0..e.ncols() {
+            e[(i, j)] *= d[i] / d[j];
+        }
+    }
     e.iter().all(|x| x.is_finite()).then_some(e)
 }
 
@@ -24,7 +32,14 @@ pub fn expm(a: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 /// for badly scaled matrices (unit scaling mixing 1e-3 and 1e6 entries).
 #[must_use]
 pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
+    balance_with_scaling(a).0
+}
+
+/// [`balance`] and its diagonal `d` (`B = D⁻¹ A D`, `D = diag(d)`).
+#[must_use]
+pub fn balance_with_scaling(a: &DMatrix<f64>) -> (DMatrix<f64>, Vec<f64>) {
     let n = a.nrows();
+    let mut d = vec![1.0; n];
     let mut b = a.clone();
     let radix = 2.0_f64;
     for _sweep in 0..64 {
@@ -55,6 +70,7 @@ pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
             }
             if (cc + rr) < 0.95 * s {
                 converged = false;
+                d[i] *= f;
                 for j in 0..n {
                     b[(i, j)] /= f;
                 }
@@ -67,7 +83,7 @@ pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
             break;
         }
     }
-    b
+    (b, d)
 }
 
 /// Eigenvalues of a real square matrix (balanced, then real Schur form), or `None` when the QR
@@ -132,6 +148,16 @@ mod tests {
         assert!((e[(0, 0)] - 1.0_f64.cos()).abs() < 1e-15);
         assert!((e[(0, 1)] - 1.0_f64.sin()).abs() < 1e-15);
         assert!(expm(&DMatrix::from_element(2, 2, f64::NAN)).is_none());
+    }
+
+    #[test]
+    fn expm_of_a_badly_scaled_triangular_matrix() {
+        let a = DMatrix::from_row_slice(2, 2, &[-1.0, 1e6, 0.0, -2.0]);
+        let e = expm(&a).expect("finite");
+        let (e1, e2) = ((-1.0_f64).exp(), (-2.0_f64).exp());
+        assert!((e[(0, 0)] - e1).abs() < 1e-15 && (e[(1, 1)] - e2).abs() < 1e-15);
+        assert!((e[(0, 1)] / (1e6 * (e1 - e2)) - 1.0).abs() < 1e-14);
+        assert!(e[(1, 0)] == 0.0);
     }
 
     #[test]

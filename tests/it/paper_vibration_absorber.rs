@@ -496,3 +496,36 @@ fn exact_time_response_agrees_with_a_fine_rk4() {
         assert!(worst <= 1e-8 * scale, "{mode}: {worst:e} vs max {scale:e}");
     }
 }
+
+#[test]
+fn mode_shapes_on_request() {
+    let mut req = paper_case();
+    req["outputs"] = json!({"mode_shapes": {"n_points": 11}});
+    let a = answer(req);
+    let s = &a["mode_shapes"];
+    assert_eq!(nums(&s["x_m"]).len(), 11);
+    for (k, shape) in s["shapes"].as_array().expect("shapes").iter().enumerate() {
+        let phi = nums(shape);
+        close("φ(0)", phi[0], 0.0, 1e-12);
+        close("φ(L)", phi[10], if k % 2 == 0 { 2.0 } else { -2.0 }, 1e-12);
+    }
+    assert!(answer(paper_case()).get("mode_shapes").is_none(), "omitted unless asked");
+}
+
+#[test]
+fn a_negative_dc_gain_keeps_the_settling_and_overshoot_convention() {
+    // K_c < 0 flips the sign of G_ec: the DC gain changes sign, the settling time and overshoot
+    // (measured with the sign of y∞ divided out) do not.
+    let step = |kc: f64| {
+        let mut req = paper_case();
+        req["control"] = json!({"mode": "passive_shorted"});
+        req["actuator"]["force_constant_n_a"] = json!(kc);
+        req["actuator"]["back_emf_v_s_m"] = json!(kc.abs());
+        req["outputs"] = json!({"ava_step": true});
+        answer(req)["ava_step"]["xa_over_ec"].clone()
+    };
+    let (pos, neg) = (step(3.5), step(-3.5));
+    close("DC sign", num(&neg["dc_gain"]), -num(&pos["dc_gain"]), 1e-15);
+    close("settling", num(&neg["settling_time_s"]), num(&pos["settling_time_s"]), 1e-12);
+    close("overshoot", num(&neg["overshoot_pct"]), num(&pos["overshoot_pct"]), 1e-9);
+}

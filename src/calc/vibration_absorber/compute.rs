@@ -50,6 +50,8 @@ pub struct VibrationAbsorberOutput {
     pub frf: Option<(Vec<f64>, Vec<f64>, Vec<Response>)>,
     /// Time response.
     pub time: Option<TimeOutput>,
+    /// Mode shapes `(x [m], φ_k(x))`.
+    pub mode_shapes: Option<(Vec<f64>, Vec<Vec<f64>>)>,
     /// Warnings.
     pub warnings: Vec<Warning>,
     /// Cost.
@@ -296,6 +298,16 @@ pub fn compute(
         None => None,
     };
 
+    let mode_shapes = o.mode_shapes.map(|np| {
+        let xi: Vec<f64> = (0..np).map(|i| i as f64 / (np - 1) as f64).collect();
+        let shapes = model
+            .shapes
+            .iter()
+            .map(|m| xi.iter().map(|x| m.phi(*x)).collect())
+            .collect();
+        (xi.iter().map(|x| x * model.length).collect(), shapes)
+    });
+
     Ok(VibrationAbsorberOutput {
         beta_l: model.shapes.iter().map(|m| m.beta).collect(),
         beam_mass: model.modal_mass,
@@ -310,6 +322,7 @@ pub fn compute(
         ava_frf,
         frf,
         time,
+        mode_shapes,
         warnings,
         report: SolverReport {
             stop_reason: StopReason::Completed,

@@ -187,6 +187,8 @@ pub struct Outputs {
     pub frf: Option<(Grid, Vec<f64>)>,
     /// Time response.
     pub time: Option<TimeRequest>,
+    /// Mode-shape samples.
+    pub mode_shapes: Option<usize>,
 }
 
 /// The validated request.
@@ -655,6 +657,15 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
                 .as_ref()
                 .map(|f| frf(&mut v, f, length)),
             time: o.time_response.as_ref().map(|t| time(&mut v, t, length)),
+            mode_shapes: o.mode_shapes.map(|m| {
+                v.uint(
+                    "/outputs/mode_shapes/n_points",
+                    "n_points",
+                    u64::from(m.n_points),
+                    wire::SHAPE_POINTS,
+                );
+                m.n_points.max(2) as usize
+            }),
         };
         v.finish()?;
         Ok(Self {

@@ -9,7 +9,7 @@ use super::input::VibrationAbsorberInput;
 use super::response::{Stab, StepMetrics};
 use super::wire::{
     AbsorberOut, AvaFrfOut, AvaStepOut, BeamOut, ClosedLoopOut, EigenvalueOut, FrfOut, FrfPointOut,
-    GainsOut, NaturalFrequenciesOut, Stability, StepOut, TimeOut, TimePointOut,
+    GainsOut, ModeShapesOut, NaturalFrequenciesOut, Stability, StepOut, TimeOut, TimePointOut,
     VibrationAbsorberResponse,
 };
 use crate::numerics::Budget;
@@ -167,6 +167,10 @@ pub fn respond(
                 .collect(),
         }),
         time_response,
+        mode_shapes: out.mode_shapes.as_ref().map(|(x, s)| ModeShapesOut {
+            x_m: x.clone(),
+            shapes: s.clone(),
+        }),
         warnings: out.warnings.clone(),
         report,
     }

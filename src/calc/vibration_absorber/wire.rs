@@ -57,6 +57,8 @@ pub const DT: Range = Range::FINITE.gt(0.0).max(1e3);
 pub const DECIMATE: Range = Range::int(1, 2_000_000);
 /// Largest number of time samples `t_end_s / dt_s` (spec §2).
 pub const MAX_SAMPLES: f64 = 2e6;
+/// Mode-shape samples along the beam.
+pub const SHAPE_POINTS: Range = Range::int(2, 10_001);
 /// Largest number of output abscissae per analysis.
 pub const MAX_POINTS: usize = 64;
 
@@ -319,6 +321,30 @@ pub struct OutputsIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub time_response: Option<TimeResponseIn>,
+    /// Bare-beam mode shapes sampled along the beam.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub mode_shapes: Option<ModeShapesIn>,
+}
+
+/// Mode-shape sampling.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[schema(as = vibration_absorber::ModeShapesIn)]
+#[serde(deny_unknown_fields)]
+pub struct ModeShapesIn {
+    /// Equally spaced abscissae from the clamp to the tip, 2…10001.
+    #[schema(example = 101)]
+    pub n_points: u32,
+}
+
+/// Bare-beam mode shapes `φ_k(x)` (dimensionless, `∫₀ᴸ φ_k² dx = L`, `φ_k(L) = 2(−1)^{k+1}`).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = vibration_absorber::ModeShapesOut)]
+pub struct ModeShapesOut {
+    /// Abscissae [m].
+    pub x_m: Vec<f64>,
+    /// `shapes[k][i] = φ_{k+1}(x_i)`.
+    pub shapes: Vec<Vec<f64>>,
 }
 
 /// A frequency grid.
@@ -427,6 +453,10 @@ pub struct VibrationAbsorberResponse {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub time_response: Option<TimeOut>,
+    /// Bare-beam mode shapes (`outputs.mode_shapes`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub mode_shapes: Option<ModeShapesOut>,
     /// Results returned with a caveat (marginal stability, nodes, resonance points, ...).
     pub warnings: Vec<Warning>,
     /// How the work stopped and what it cost (iterations = time steps, evaluations = matrix
@@ -718,4 +748,5 @@ crate::schema_bounds! {
         points_m @items: ABSCISSA,
     },
     TimeResponseIn { t_end_s: T_END, dt_s: DT, points_m @items: ABSCISSA, decimate: DECIMATE },
+    ModeShapesIn { n_points: SHAPE_POINTS },
 }
