@@ -20,6 +20,8 @@ pub const NODE_WARN_REL: f64 = 1e-3;
 
 /// A complex response per frequency; `None` where `jω` is (numerically) a pole.
 pub type Response = Vec<Option<Complex<f64>>>;
+/// Coupled FRF: frequencies [Hz], abscissae [m], one [`Response`] per abscissa.
+pub type Frf = (Vec<f64>, Vec<f64>, Vec<Response>);
 
 /// Everything `compute` found, in SI units.
 #[derive(Debug, Clone)]
@@ -47,7 +49,7 @@ pub struct VibrationAbsorberOutput {
     /// Absorber closed-loop FRF `(f [Hz], G_cl)`.
     pub ava_frf: Option<(Vec<f64>, Response)>,
     /// Coupled FRF `(f [Hz], x_o, H[point][frequency])`.
-    pub frf: Option<(Vec<f64>, Vec<f64>, Vec<Response>)>,
+    pub frf: Option<Frf>,
     /// Time response.
     pub time: Option<TimeOutput>,
     /// Mode shapes `(x [m], φ_k(x))`.
@@ -150,49 +152,8 @@ pub fn compute(
     let mut evaluations = 0_u64;
     let mut iterations = 0_u64;
     let o = &input.outputs;
-    let has_absorber = model.config != Config::None;
 
-    // Tuned mode and its nodes (where the absorber cannot act on it).
-    let tuned_hz = match (&gains, has_absorber) {
-        (Some(g), _) => g.tuning_hz,
-        (None, true) => Some((model.dev.ka / model.dev.ma).sqrt() / (2.0 * PI)),
-        (None, false) => None,
-    }
-    .filter(|f| *f > 0.0);
-    let tuned_nodes = tuned_hz.map(|f| {
-        let k = nearest_mode(f, &freqs);
-        model.shapes[k]
-            .nodes()
-            .into_iter()
-            .map(|x| x * model.length)
-            .collect::<Vec<f64>>()
-    });
-    if let Some(nodes) = &tuned_nodes
-        && let Some(x) = nodes
-            .iter()
-            .find(|x| (*x - input.absorber.position).abs() <= NODE_WARN_REL * model.length)
-    {
-        warnings.push(Warning::at(
-            "ABSORBER_AT_NODE",
-            "/absorber/position_m",
-            format!(
-                "the absorber at {} m is within {NODE_WARN_REL}·L of the node {x:.6} m of the tuned mode: it cannot act on that mode",
-                input.absorber.position
-            ),
-        ));
-    }
-    if let Some(g) = &gains
-        && g.kp < 0.0
-    {
-        warnings.push(Warning::at(
-            "NEGATIVE_KP",
-            "/control",
-            format!(
-                "K_p = {:.6e} V/m < 0: the actuator must act as a negative spring",
-                g.kp
-            ),
-        ));
-    }
+    let tuned_nodes = design_warnings(&model, &freqs, gains.as_ref(), input, &mut warnings);
 
     let natural = o
         .natural_frequencies
@@ -207,26 +168,7 @@ pub fn compute(
     } else {
         None
     };
-    if model.config == Config::Active && input.beam.zeta == 0.0 {
-        let rate = eigen.as_ref().map_or(String::new(), |e| {
-            format!(" (max Re λ = {:+.3e} 1/s)", e.max_re)
-        });
-        warnings.push(Warning::at(
-            "MARGINAL_STABILITY",
-            "/beam/modal_damping_ratio",
-            format!("modal_damping_ratio = 0 with active control: the closed loop is marginal{rate}; any ζ ≥ 1e-4 makes it stable"),
-        ));
-    } else if let Some(e) = &eigen
-        && e.stability == response::Stab::Unstable
-    {
-        warnings.push(Warning::new(
-            "UNSTABLE",
-            format!(
-                "the coupled system is unstable: max Re λ = {:+.3e} 1/s",
-                e.max_re
-            ),
-        ));
-    }
+    stability_warning(&model, input.beam.zeta, eigen.as_ref(), &mut warnings);
 
     let ava_step = o
         .ava_step
@@ -247,27 +189,20 @@ pub fn compute(
 
     let frf = match &o.frf {
         Some((grid, points)) => {
-            let f = grid.frequencies();
-            let w: Vec<f64> = f.iter().map(|f| 2.0 * PI * f).collect();
-            let rows: Vec<DVector<f64>> = points.iter().map(|x| model.row_deflection(*x)).collect();
             let eig = eigen
                 .as_ref()
                 .map(|e| e.values.as_slice())
                 .unwrap_or_default();
-            let h = response::frequency_response(&a, &b, &rows, &w, eig, budget)?;
-            evaluations += w.len() as u64;
-            let nulls = h.iter().filter(|r| r.iter().any(Option::is_none)).count();
-            if nulls > 0 {
-                warnings.push(Warning::at(
-                    "UNDAMPED_RESONANCE",
-                    "/outputs/frequency_response",
-                    format!("{nulls} grid frequencies coincide with an undamped eigenvalue: |H| is null there"),
-                ));
-            }
-            let per_point = (0..points.len())
-                .map(|j| h.iter().map(|r| r[j]).collect())
-                .collect();
-            Some((f, points.clone(), per_point))
+            evaluations += grid.n as u64;
+            Some(coupled_frf(
+                &model,
+                (&a, &b),
+                grid,
+                points,
+                eig,
+                budget,
+                &mut warnings,
+            )?)
         }
         None => None,
     };
@@ -276,18 +211,7 @@ pub fn compute(
         Forcing::Harmonic { freq, .. } => Some(hz(freq, &freqs)),
         _ => None,
     };
-    if let (Some(g), Some(fe)) = (&gains, excitation_hz)
-        && let Some(fc) = g.tuning_hz
-    {
-        let rel = (fe - fc).abs() / fc;
-        if rel > 1e-9 && rel < 0.02 {
-            warnings.push(Warning::at(
-                "EXCITATION_OFF_TUNING",
-                "/excitation",
-                format!("excitation at {fe:.6} Hz, tuning at {fc:.6} Hz: the response beats instead of being cancelled (tune by mode index to use the model's own frequency)"),
-            ));
-        }
-    }
+    tuning_warning(gains.as_ref(), excitation_hz, &mut warnings);
     let time = match &o.time {
         Some(t) => {
             let out = time_response(&model, &a, &b, input, t, excitation_hz, budget)?;
@@ -331,6 +255,131 @@ pub fn compute(
             elapsed_ms: budget.elapsed_ms(),
         },
     })
+}
+
+/// Nodes of the tuned mode (the bare-beam mode nearest the tuning, active, or the passive
+/// frequency) [m], with the design warnings: absorber at a node, negative K_p.
+fn design_warnings(
+    model: &Model,
+    freqs: &[f64],
+    gains: Option<&Gains>,
+    input: &VibrationAbsorberInput,
+    warnings: &mut Vec<Warning>,
+) -> Option<Vec<f64>> {
+    let has_absorber = model.config != Config::None;
+    // Tuned mode and its nodes (where the absorber cannot act on it).
+    let tuned_hz = match (gains, has_absorber) {
+        (Some(g), _) => g.tuning_hz,
+        (None, true) => Some((model.dev.ka / model.dev.ma).sqrt() / (2.0 * PI)),
+        (None, false) => None,
+    }
+    .filter(|f| *f > 0.0);
+    let tuned_nodes = tuned_hz.map(|f| {
+        let k = nearest_mode(f, freqs);
+        model.shapes[k]
+            .nodes()
+            .into_iter()
+            .map(|x| x * model.length)
+            .collect::<Vec<f64>>()
+    });
+    if let Some(nodes) = &tuned_nodes
+        && let Some(x) = nodes
+            .iter()
+            .find(|x| (*x - input.absorber.position).abs() <= NODE_WARN_REL * model.length)
+    {
+        warnings.push(Warning::at(
+            "ABSORBER_AT_NODE",
+            "/absorber/position_m",
+            format!(
+                "the absorber at {} m is within {NODE_WARN_REL}·L of the node {x:.6} m of the tuned mode: it cannot act on that mode",
+                input.absorber.position
+            ),
+        ));
+    }
+    if let Some(g) = gains
+        && g.kp < 0.0
+    {
+        warnings.push(Warning::at(
+            "NEGATIVE_KP",
+            "/control",
+            format!(
+                "K_p = {:.6e} V/m < 0: the actuator must act as a negative spring",
+                g.kp
+            ),
+        ));
+    }
+    tuned_nodes
+}
+
+/// The coupled receptance on a grid at each abscissa, with the undamped-resonance warning.
+fn coupled_frf(
+    model: &Model,
+    (a, b): (&DMatrix<f64>, &DVector<f64>),
+    grid: &Grid,
+    points: &[f64],
+    eig: &[Complex<f64>],
+    budget: &Budget,
+    warnings: &mut Vec<Warning>,
+) -> Result<Frf, Error> {
+    let f = grid.frequencies();
+    let w: Vec<f64> = f.iter().map(|f| 2.0 * PI * f).collect();
+    let rows: Vec<DVector<f64>> = points.iter().map(|x| model.row_deflection(*x)).collect();
+    let h = response::frequency_response(a, b, &rows, &w, eig, budget)?;
+    let nulls = h.iter().filter(|r| r.iter().any(Option::is_none)).count();
+    if nulls > 0 {
+        warnings.push(Warning::at(
+            "UNDAMPED_RESONANCE",
+            "/outputs/frequency_response",
+            format!(
+                "{nulls} grid frequencies coincide with an undamped eigenvalue: |H| is null there"
+            ),
+        ));
+    }
+    let per_point = (0..points.len())
+        .map(|j| h.iter().map(|r| r[j]).collect())
+        .collect();
+    Ok((f, points.to_vec(), per_point))
+}
+
+/// The marginal-stability warning (ζ = 0 with active control, spec §7 item 1) or, otherwise, an
+/// unstable label.
+fn stability_warning(model: &Model, zeta: f64, eigen: Option<&Eigen>, warnings: &mut Vec<Warning>) {
+    if model.config == Config::Active && zeta == 0.0 {
+        let rate = eigen.map_or(String::new(), |e| {
+            format!(" (max Re λ = {:+.3e} 1/s)", e.max_re)
+        });
+        warnings.push(Warning::at(
+            "MARGINAL_STABILITY",
+            "/beam/modal_damping_ratio",
+            format!("modal_damping_ratio = 0 with active control: the closed loop is marginal{rate}; any ζ ≥ 1e-4 makes it stable"),
+        ));
+    } else if let Some(e) = eigen
+        && e.stability == response::Stab::Unstable
+    {
+        warnings.push(Warning::new(
+            "UNSTABLE",
+            format!(
+                "the coupled system is unstable: max Re λ = {:+.3e} 1/s",
+                e.max_re
+            ),
+        ));
+    }
+}
+
+/// Excitation near but not at the tuning frequency: beating, not cancellation (spec §4 item 10).
+fn tuning_warning(gains: Option<&Gains>, excitation_hz: Option<f64>, warnings: &mut Vec<Warning>) {
+    if let (Some(g), Some(fe)) = (gains, excitation_hz)
+        && let Some(fc) = g.tuning_hz
+    {
+        let rel = (fe - fc).abs() / fc;
+        if rel > 1e-9 && rel < 0.02 {
+            warnings.push(Warning::at(
+                "EXCITATION_OFF_TUNING",
+                "/excitation",
+                format!("excitation at {fe:.6} Hz, tuning at {fc:.6} Hz: the response beats instead of being cancelled (tune by mode index to use the model's own frequency)"),
+            ));
+        }
+    }
 }
 
 /// Index (0-based) of the bare-beam mode nearest `f` on a log scale.

@@ -4,9 +4,9 @@ use std::f64::consts::PI;
 
 use nalgebra::Complex;
 
-use super::compute::VibrationAbsorberOutput;
+use super::compute::{TimeOutput, VibrationAbsorberOutput};
 use super::input::VibrationAbsorberInput;
-use super::response::{Stab, StepMetrics};
+use super::response::{Eigen, Stab, StepMetrics};
 use super::wire::{
     AbsorberOut, AvaFrfOut, AvaStepOut, BeamOut, ClosedLoopOut, EigenvalueOut, FrfOut, FrfPointOut,
     GainsOut, ModeShapesOut, NaturalFrequenciesOut, Stability, StepOut, TimeOut, TimePointOut,
@@ -31,6 +31,68 @@ fn step_out(s: &StepMetrics) -> StepOut {
     }
 }
 
+fn closed_loop_out(e: &Eigen, size: usize) -> ClosedLoopOut {
+    let mut ev: Vec<EigenvalueOut> = e
+        .values
+        .iter()
+        .filter(|z| z.im >= 0.0)
+        .map(|z| EigenvalueOut {
+            re_1_s: z.re,
+            im_hz: z.im / (2.0 * PI),
+        })
+        .collect();
+    ev.sort_by(|a, b| {
+        a.im_hz
+            .total_cmp(&b.im_hz)
+            .then(a.re_1_s.total_cmp(&b.re_1_s))
+    });
+    ClosedLoopOut {
+        eigenvalues: ev,
+        max_real_part_1_s: e.max_re,
+        stability: match e.stability {
+            Stab::Stable => Stability::Stable,
+            Stab::Marginal => Stability::Marginal,
+            Stab::Unstable => Stability::Unstable,
+        },
+        state_size: size,
+    }
+}
+
+fn time_out(t: &TimeOutput) -> TimeOut {
+    let s = &t.series;
+    let row = |i: Option<usize>, v: &Vec<f64>| i.map(|i| v[i]);
+    TimeOut {
+        method: "expm-exosystem".to_owned(),
+        excitation_frequency_hz: t.excitation_hz,
+        n_samples: t.n_samples,
+        points: t
+            .points
+            .iter()
+            .enumerate()
+            .map(|(j, x)| TimePointOut {
+                x_m: *x,
+                max_abs_m: s.max_abs[j],
+                max_abs_last_period_m: s.max_last[j],
+                rms_m: s.rms[j],
+                w_m: s.series.as_ref().map(|ser| ser[j].clone()),
+            })
+            .collect(),
+        stroke_max_m: row(t.extra[0], &s.max_abs),
+        force_max_n: row(t.extra[1], &s.max_abs),
+        current_max_a: row(t.extra[2], &s.max_abs),
+        voltage_max_v: row(t.extra[3], &s.max_abs),
+        t_s: s.t.clone(),
+        stroke_m: s
+            .series
+            .as_ref()
+            .and_then(|ser| t.extra[0].map(|i| ser[i].clone())),
+        force_n: s
+            .series
+            .as_ref()
+            .and_then(|ser| t.extra[1].map(|i| ser[i].clone())),
+    }
+}
+
 /// Builds the response.
 #[must_use]
 pub fn respond(
@@ -44,66 +106,8 @@ pub fn respond(
         .eigen
         .as_ref()
         .filter(|_| input.outputs.eigenvalues)
-        .map(|e| {
-            let mut ev: Vec<EigenvalueOut> = e
-                .values
-                .iter()
-                .filter(|z| z.im >= 0.0)
-                .map(|z| EigenvalueOut {
-                    re_1_s: z.re,
-                    im_hz: z.im / (2.0 * PI),
-                })
-                .collect();
-            ev.sort_by(|a, b| {
-                a.im_hz
-                    .total_cmp(&b.im_hz)
-                    .then(a.re_1_s.total_cmp(&b.re_1_s))
-            });
-            ClosedLoopOut {
-                eigenvalues: ev,
-                max_real_part_1_s: e.max_re,
-                stability: match e.stability {
-                    Stab::Stable => Stability::Stable,
-                    Stab::Marginal => Stability::Marginal,
-                    Stab::Unstable => Stability::Unstable,
-                },
-                state_size: m.size(),
-            }
-        });
-    let time_response = out.time.as_ref().map(|t| {
-        let s = &t.series;
-        let row = |i: Option<usize>, v: &Vec<f64>| i.map(|i| v[i]);
-        TimeOut {
-            method: "expm-exosystem".to_owned(),
-            excitation_frequency_hz: t.excitation_hz,
-            n_samples: t.n_samples,
-            points: t
-                .points
-                .iter()
-                .enumerate()
-                .map(|(j, x)| TimePointOut {
-                    x_m: *x,
-                    max_abs_m: s.max_abs[j],
-                    max_abs_last_period_m: s.max_last[j],
-                    rms_m: s.rms[j],
-                    w_m: s.series.as_ref().map(|ser| ser[j].clone()),
-                })
-                .collect(),
-            stroke_max_m: row(t.extra[0], &s.max_abs),
-            force_max_n: row(t.extra[1], &s.max_abs),
-            current_max_a: row(t.extra[2], &s.max_abs),
-            voltage_max_v: row(t.extra[3], &s.max_abs),
-            t_s: s.t.clone(),
-            stroke_m: s
-                .series
-                .as_ref()
-                .and_then(|ser| t.extra[0].map(|i| ser[i].clone())),
-            force_n: s
-                .series
-                .as_ref()
-                .and_then(|ser| t.extra[1].map(|i| ser[i].clone())),
-        }
-    });
+        .map(|e| closed_loop_out(e, m.size()));
+    let time_response = out.time.as_ref().map(time_out);
     let mut report = out.report.clone();
     report.elapsed_ms = budget.elapsed_ms();
     VibrationAbsorberResponse {
