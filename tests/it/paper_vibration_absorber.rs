@@ -553,3 +553,30 @@ fn a_negative_dc_gain_keeps_the_settling_and_overshoot_convention() {
         1e-9,
     );
 }
+
+#[test]
+fn absorber_closed_loop_frf_peaks_at_the_tuning() {
+    // Paper Fig. 6: |G_cl| has its (infinite) peak at f_c; at DC G_cl = K_c K_p / (k_a R + K_c K_p).
+    let mut req = paper_case();
+    req["outputs"] =
+        json!({"ava_frequency_response": {"f_min_hz": 25.0, "f_max_hz": 27.5, "n_points": 101}});
+    let a = answer(req.clone());
+    let g = &a["ava_frequency_response"];
+    close(
+        "peak frequency",
+        num(&g["peak_frequency_hz"]),
+        26.26,
+        0.0125 + 1e-9,
+    );
+    req["outputs"] =
+        json!({"ava_frequency_response": {"f_min_hz": 1e-6, "f_max_hz": 1e-6, "n_points": 1}});
+    let a = answer(req);
+    let (kp, ka) = (606.851_090_171_872_2, 33.832_214_318_582_22);
+    let dc = 3.5 * kp / (ka * 1.6 + 3.5 * kp);
+    close_rel(
+        "|G_cl(0)|",
+        num(&a["ava_frequency_response"]["magnitude"][0]),
+        dc,
+        1e-9,
+    );
+}

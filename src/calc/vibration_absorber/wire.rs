@@ -397,7 +397,9 @@ pub struct TimeResponseIn {
     /// Horizon [s].
     #[schema(example = 10.0)]
     pub t_end_s: f64,
-    /// Output step `h` [s] (the result is exact for any h; `t_end_s/dt_s` ≤ 2e6 samples).
+    /// Output step `h` [s] (the result is exact for any h; `t_end_s/dt_s` ≤ 2e6 samples). Samples
+    /// are `t = k·h`, `k = 0…K`, `K = ⌈t_end_s/dt_s⌉` (a ratio within 1e-9 of an integer is that
+    /// integer).
     #[schema(example = 0.001)]
     pub dt_s: f64,
     /// Output abscissae `x_o` [m], each in [0, `beam.length_m`], at most 64; default the tip.
