@@ -19,6 +19,7 @@ pub mod irefc;
 pub mod machining_size;
 pub mod problem;
 pub mod spatial_coupling;
+pub mod vibration_absorber;
 
 pub use bounds::{Range, SchemaBound};
 pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validator};
@@ -44,6 +45,7 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         machining_size::schema_bounds(),
         spatial_coupling::wire::schema_bounds(),
         spatial_coupling::wire::nested_bounds(),
+        vibration_absorber::wire::schema_bounds(),
     ]
     .concat()
 }

@@ -26,6 +26,7 @@ pub mod spatial_coupling;
 pub mod state;
 pub mod stream;
 pub mod telemetry;
+pub mod vibration_absorber;
 
 pub mod finite;
 
@@ -128,6 +129,7 @@ JSON pointers to the offending fields.",
         (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
         (name = "machining-size", description = "Machined dimensions: gradient-boosted trees with XGBoost's semantics, exact SHAP explanations and the paper's data diagnostics"),
         (name = "spatial-linkages", description = "Spatial couplings: closed-form kinematics of the RP1PR coupling between crossed shafts"),
+        (name = "vibration", description = "Structural vibration control: active electromagnetic vibration absorber on a cantilever"),
     ),
     components(schemas(Problem, ProblemField))
 )]
@@ -153,6 +155,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(machining_size::predict))
         .route(routes!(machining_size::analyze))
         .route(routes!(spatial_coupling::evaluate))
+        .route(routes!(vibration_absorber::analyse))
         .finish()
 }
 

@@ -5,6 +5,7 @@
 pub mod angles;
 pub mod budget;
 pub mod elliptic;
+pub mod linalg;
 pub mod parallel;
 pub mod pchip;
 

@@ -17,6 +17,7 @@ mod irefc;
 mod machining_size;
 mod spatial_coupling;
 pub mod style;
+mod vibration_absorber;
 
 use serde_json::Value;
 
@@ -111,6 +112,11 @@ const PICTURES: &[Picture] = &[
         route: "/v1/spatial-coupling",
         prepare: spatial_coupling::prepare,
         render: spatial_coupling::render,
+    },
+    Picture {
+        route: "/v1/vibration-absorber",
+        prepare: vibration_absorber::prepare,
+        render: vibration_absorber::render,
     },
 ];
 

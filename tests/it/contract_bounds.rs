@@ -39,6 +39,16 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/machining-size/train", "/params/min_child_weight", "the training split needs ≥ 2·max(1, min_child_weight) rows"),
     ("/v1/spatial-coupling", "/alpha_deg", "|cos 2α| ≥ 1e-9 (α ≠ ±45°, perpendicular shafts)"),
     ("/v1/spatial-coupling", "/beta_deg", "with a sweep: cos(α−β)·cos 2α·cos(α+β) > 0 (422 infeasible otherwise)"),
+    ("/v1/vibration-absorber", "/absorber/position_m", "x_a ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/excitation/position_m", "x_p ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/excitation/resonance_of_mode", "k ≤ beam.n_modes"),
+    ("/v1/vibration-absorber", "/absorber/passive_tuning_mode", "k ≤ beam.n_modes"),
+    ("/v1/vibration-absorber", "/control/tuning_mode", "k ≤ beam.n_modes"),
+    ("/v1/vibration-absorber", "/outputs/frequency_response/f_max_hz", "f_max_hz > f_min_hz"),
+    ("/v1/vibration-absorber", "/outputs/frequency_response/points_m/0", "x_o ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/outputs/time_response/points_m/0", "x_o ≤ beam.length_m"),
+    ("/v1/vibration-absorber", "/outputs/time_response/dt_s", "t_end_s / dt_s ≤ 2e6 samples"),
+    ("/v1/vibration-absorber", "/actuator/force_constant_n_a", "≠ 0 with control.mode = active"),
 ];
 
 /// A number in an example request with its documented bound, if any.

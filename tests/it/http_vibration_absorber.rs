@@ -1,0 +1,239 @@
+//! `POST /v1/vibration-absorber` over HTTP: the spec example comes back, optional outputs are
+//! omitted unless asked, and every kind of invalid request gets a 422 problem+json with a pointer
+//! per offending field and the module's code.
+
+use crate::common;
+
+use common::post_json;
+use serde_json::{Value, json};
+
+const PATH: &str = "/v1/vibration-absorber";
+
+fn base() -> Value {
+    json!({"control": {"mode": "active", "tuning_hz": 26.26},
+           "absorber": {"passive_tuning_hz": 4.14}})
+}
+
+fn patched(patch: &Value) -> Value {
+    let mut b = base();
+    for (k, v) in patch.as_object().expect("object") {
+        match (b.get_mut(k), v) {
+            (Some(Value::Object(dst)), Value::Object(src)) => {
+                for (kk, vv) in src {
+                    dst.insert(kk.clone(), vv.clone());
+                }
+            }
+            _ => b[k] = v.clone(),
+        }
+    }
+    b
+}
+
+#[tokio::test]
+async fn defaults_answer_with_modes_and_gains_only() {
+    let r = post_json(PATH, &json!({})).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let b = r.json();
+    assert_eq!(b["beam"]["beta_l"].as_array().map(Vec::len), Some(3));
+    // Default tuning: the model's own f₂ (mode index), so K_p follows f₂ = 26.1805 Hz.
+    let kp = b["gains"]["kp_v_m"].as_f64().expect("kp");
+    assert!((kp - 602.0).abs() < 5.0, "kp {kp}");
+    for k in [
+        "natural_frequencies",
+        "closed_loop",
+        "ava_step",
+        "ava_frequency_response",
+        "frequency_response",
+        "time_response",
+    ] {
+        assert!(b.get(k).is_none(), "{k} must be omitted unless asked");
+    }
+    assert_eq!(b["report"]["stop_reason"], "completed");
+}
+
+#[tokio::test]
+async fn passive_configuration_has_no_gains_and_no_coil_outputs() {
+    let body = json!({"control": {"mode": "passive"},
+                      "outputs": {"time_response": {"t_end_s": 1.0, "dt_s": 0.001}}});
+    let r = post_json(PATH, &body).await;
+    assert_eq!(r.status, 200);
+    let b = r.json();
+    assert!(b.get("gains").is_none());
+    let t = &b["time_response"];
+    assert!(t.get("stroke_max_m").is_some());
+    assert!(
+        t.get("force_max_n").is_none()
+            && t.get("current_max_a").is_none()
+            && t.get("voltage_max_v").is_none()
+    );
+}
+
+/// One 422 per case, with the offending pointer (and code when the module names one).
+#[tokio::test]
+async fn invalid_requests_point_at_the_field() {
+    let cases: [(&str, Option<&str>, Value); 20] = [
+        ("/beam/length_m", None, json!({"beam": {"length_m": 0.0}})),
+        (
+            "/beam/youngs_modulus_pa",
+            None,
+            json!({"beam": {"youngs_modulus_pa": -1.0}}),
+        ),
+        (
+            "/beam/density_kg_m3",
+            None,
+            json!({"beam": {"density_kg_m3": 0.0}}),
+        ),
+        ("/beam/n_modes", None, json!({"beam": {"n_modes": 51}})),
+        ("/beam/n_modes", None, json!({"beam": {"n_modes": 0}})),
+        (
+            "/beam/modal_damping_ratio",
+            None,
+            json!({"beam": {"modal_damping_ratio": 1.0}}),
+        ),
+        (
+            "/beam/section",
+            None,
+            json!({"beam": {"section": {"width_m": 0.05, "thickness_m": 0.005}, "area_m2": 1e-4}}),
+        ),
+        (
+            "/absorber/mass_kg",
+            None,
+            json!({"absorber": {"mass_kg": 0.0}}),
+        ),
+        (
+            "/absorber/position_m",
+            Some("POSITION_OUT_OF_BEAM"),
+            json!({"absorber": {"position_m": 1.5}}),
+        ),
+        (
+            "/absorber/position_m",
+            None,
+            json!({"absorber": {"position_m": 0.0}}),
+        ),
+        (
+            "/excitation/position_m",
+            Some("POSITION_OUT_OF_BEAM"),
+            json!({"excitation": {"position_m": 2.0}}),
+        ),
+        (
+            "/actuator/resistance_ohm",
+            None,
+            json!({"actuator": {"resistance_ohm": 0.0}}),
+        ),
+        (
+            "/actuator/inductance_h",
+            None,
+            json!({"actuator": {"inductance_h": 0.0}}),
+        ),
+        (
+            "/actuator/force_constant_n_a",
+            Some("ZERO_FORCE_CONSTANT"),
+            json!({"actuator": {"force_constant_n_a": 0.0}}),
+        ),
+        (
+            "/control/tuning_mode",
+            Some("MODE_OUT_OF_RANGE"),
+            json!({"control": {"mode": "active", "tuning_mode": 4}}),
+        ),
+        (
+            "/excitation/resonance_of_mode",
+            Some("MODE_OUT_OF_RANGE"),
+            json!({"excitation": {"resonance_of_mode": 9}}),
+        ),
+        (
+            "/outputs/time_response/dt_s",
+            Some("TOO_MANY_SAMPLES"),
+            json!({"outputs": {"time_response": {"t_end_s": 100.0, "dt_s": 1e-5}}}),
+        ),
+        (
+            "/outputs/time_response/t_end_s",
+            None,
+            json!({"outputs": {"time_response": {"t_end_s": 0.0, "dt_s": 1e-3}}}),
+        ),
+        (
+            "/outputs/frequency_response/f_max_hz",
+            None,
+            json!({"outputs": {"frequency_response": {"f_min_hz": 10.0, "f_max_hz": 5.0, "n_points": 10}}}),
+        ),
+        (
+            "/outputs/frequency_response/points_m/1",
+            Some("POSITION_OUT_OF_BEAM"),
+            json!({"outputs": {"frequency_response": {"f_min_hz": 1.0, "f_max_hz": 5.0, "n_points": 10, "points_m": [0.5, 1.2]}}}),
+        ),
+    ];
+    for (pointer, code, patch) in cases {
+        let body =
+            if patch.get("control").is_some() && patch["control"].get("tuning_mode").is_some() {
+                json!({"control": patch["control"]})
+            } else {
+                patched(&patch)
+            };
+        let r = post_json(PATH, &body).await;
+        assert_eq!(
+            r.status,
+            422,
+            "{pointer}: {}",
+            String::from_utf8_lossy(&r.bytes)
+        );
+        assert!(
+            r.pointers().contains(&pointer.to_owned()),
+            "{pointer}: got {:?}",
+            r.pointers()
+        );
+        if let Some(code) = code {
+            assert_eq!(r.json()["code"], code, "{pointer}");
+        }
+    }
+}
+
+#[tokio::test]
+async fn every_offending_field_is_listed_at_once() {
+    let body =
+        json!({"beam": {"length_m": -1.0, "density_kg_m3": 0.0}, "absorber": {"mass_kg": -2.0}});
+    let r = post_json(PATH, &body).await;
+    assert_eq!(r.status, 422);
+    let p = r.pointers();
+    for want in ["/beam/length_m", "/beam/density_kg_m3", "/absorber/mass_kg"] {
+        assert!(p.contains(&want.to_owned()), "{want} missing from {p:?}");
+    }
+}
+
+#[tokio::test]
+async fn unknown_members_and_bad_enums_are_rejected_with_their_path() {
+    for (body, pointer) in [
+        (json!({"beam": {"lenght_m": 1.0}}), "/beam"),
+        (json!({"control": {"mode": "semi_active"}}), "/control/mode"),
+        (json!({"excitation": {"type": "chirp"}}), "/excitation/type"),
+    ] {
+        let r = post_json(PATH, &body).await;
+        assert_eq!(r.status, 422, "{body}");
+        assert!(
+            r.pointers().iter().any(|p| p.starts_with(pointer)),
+            "{body}: {:?}",
+            r.pointers()
+        );
+    }
+}
+
+#[tokio::test]
+async fn undamped_resonance_on_the_grid_is_null_with_a_warning() {
+    // Bare undamped beam, a one-point grid exactly at the model's f₁.
+    let f1 = post_json(PATH, &json!({"control": {"mode": "none"}}))
+        .await
+        .json()["beam"]["natural_frequencies_hz"][0]
+        .as_f64()
+        .expect("f1");
+    let body = json!({"control": {"mode": "none"},
+        "outputs": {"frequency_response": {"f_min_hz": f1, "f_max_hz": f1, "n_points": 1}}});
+    let r = post_json(PATH, &body).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let b = r.json();
+    assert!(b["frequency_response"]["points"][0]["magnitude_m_per_n"][0].is_null());
+    assert!(
+        b["warnings"]
+            .as_array()
+            .expect("warnings")
+            .iter()
+            .any(|w| w["code"] == "UNDAMPED_RESONANCE")
+    );
+}

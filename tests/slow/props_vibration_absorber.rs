@@ -1,0 +1,305 @@
+//! Property tests of the vibration-absorber spec (§6 "Property tests" and the list): passive
+//! configurations dissipate energy, FRF(0) = static compliance, the exact time response converges
+//! to the FRF's steady state, stable designs decay, the colocated antiresonance, the n-independence
+//! of the colocated receptance at a bare-beam resonance, gains on the imaginary axis, mode-shape
+//! orthogonality, linear scaling. Case counts are modest by default; `PROPTEST_CASES` runs more.
+
+use std::f64::consts::PI;
+
+use crate::support::proptest_cfg::cases;
+use mechcalc::calc::vibration_absorber::beam::ModeShape;
+use mechcalc::calc::vibration_absorber::compute::build_model;
+use mechcalc::calc::vibration_absorber::input::{Config, VibrationAbsorberInput};
+use mechcalc::calc::vibration_absorber::model::{Device, Model};
+use mechcalc::calc::vibration_absorber::response::{eigen, frequency_response};
+use mechcalc::calc::vibration_absorber::{VibrationAbsorberRequest, run};
+use mechcalc::numerics::Budget;
+use nalgebra::{Complex, DMatrix, SymmetricEigen};
+use proptest::prelude::*;
+use serde_json::{Value, json};
+
+fn input(v: Value) -> VibrationAbsorberInput {
+    let req: VibrationAbsorberRequest = serde_json::from_value(v).expect("request JSON");
+    VibrationAbsorberInput::try_from(req).expect("valid input")
+}
+
+fn model(v: Value) -> Model {
+    build_model(&input(v)).0
+}
+
+fn answer(v: Value) -> Value {
+    let req: VibrationAbsorberRequest = serde_json::from_value(v).expect("request JSON");
+    serde_json::to_value(run(req, &Budget::unlimited()).expect("succeeds")).expect("JSON")
+}
+
+/// `C (jωI − A)⁻¹ B` at one abscissa and one ω (no singularity screening).
+fn receptance(m: &Model, x: f64, w: f64) -> Complex<f64> {
+    let h = frequency_response(
+        &m.a_matrix(),
+        &m.b_vector(),
+        &[m.row_deflection(x)],
+        &[w],
+        &[],
+        &Budget::unlimited(),
+    )
+    .expect("no budget limit");
+    h[0][0].expect("finite")
+}
+
+/// A random design: configuration, modes, damping, absorber and actuator (ideal transducer
+/// `K_b = K_c`, the condition under which a shorted coil is passive).
+fn design() -> impl Strategy<Value = Value> {
+    (
+        prop_oneof![Just("passive"), Just("passive_shorted"), Just("active"), Just("none")],
+        1_u32..=6,
+        0.0_f64..0.05,
+        (0.01_f64..0.2, 1_u32..=2, 0.0_f64..0.5, 0.2_f64..1.0),
+        (0.5_f64..5.0, 1e-4_f64..5e-3, 0.5_f64..8.0),
+        (0.1_f64..1.0, 1_u32..=2),
+    )
+        .prop_map(|(mode, n, zeta, (ma, ptm, ba, xa), (r, lc, kc), (xp, tm))| {
+            json!({
+                "beam": {"n_modes": n, "modal_damping_ratio": zeta},
+                "absorber": {"mass_kg": ma, "passive_tuning_mode": ptm.min(n), "damping_n_s_m": ba, "position_m": xa},
+                "actuator": {"resistance_ohm": r, "inductance_h": lc, "force_constant_n_a": kc, "back_emf_v_s_m": kc},
+                "control": {"mode": mode, "tuning_mode": tm.min(n)},
+                "excitation": {"position_m": xp}
+            })
+        })
+}
+
+/// Energy matrix `P` with `E = ½ sᵀ P s` (kinetic + potential + magnetic) in the state order
+/// `[q, q̇, z, ż, i]`.
+fn energy_matrix(m: &Model) -> DMatrix<f64> {
+    let n = m.n();
+    let big = m.size();
+    let mut p = DMatrix::zeros(big, big);
+    let d = &m.dev;
+    for k in 0..n {
+        p[(k, k)] = m.modal_mass * m.omega[k] * m.omega[k];
+        p[(n + k, n + k)] = m.modal_mass;
+    }
+    if m.config != Config::None {
+        let z = 2 * n;
+        // ½ k_a (z − φ_aᵀq)².
+        for i in 0..n {
+            for j in 0..n {
+                p[(i, j)] += d.ka * m.phi_a[i] * m.phi_a[j];
+            }
+            p[(i, z)] = -d.ka * m.phi_a[i];
+            p[(z, i)] = -d.ka * m.phi_a[i];
+        }
+        p[(z, z)] = d.ka;
+        p[(z + 1, z + 1)] = d.ma;
+        if m.has_coil() {
+            p[(z + 2, z + 2)] = d.lc;
+        }
+    }
+    p
+}
+
+proptest! {
+    #![proptest_config(cases(32))]
+
+    /// dE/dt = ½ sᵀ(PA + AᵀP)s ≤ 0 for every state: passive configurations never create energy.
+    #[test]
+    fn passive_configurations_dissipate_energy(d in design()) {
+        let m = model(d);
+        prop_assume!(matches!(m.config, Config::None | Config::Passive | Config::PassiveShorted));
+        let a = m.a_matrix();
+        let p = energy_matrix(&m);
+        let q = &p * &a;
+        let sym = (&q + q.transpose()) * 0.5;
+        let top = SymmetricEigen::new(sym.clone()).eigenvalues.max();
+        let scale = sym.abs().max();
+        prop_assert!(top <= 1e-10 * scale, "max eigenvalue of PA + AᵀP: {top:e} (scale {scale:e})");
+        // And its eigenvalues never leave the closed left half-plane.
+        let e = eigen(&a).expect("converges");
+        let big = e.values.iter().map(|z| z.norm()).fold(0.0, f64::max);
+        prop_assert!(e.max_re <= 1e-9 * big, "max Re λ {:e}", e.max_re);
+    }
+
+    /// H(x_o, x_p, 0) = Σ φ_k(x_o) φ_k(x_p) / (m ω_k²): the absorber carries no static load.
+    #[test]
+    fn frf_at_zero_frequency_is_the_static_compliance(d in design(), xo in 0.05_f64..1.0) {
+        let m = model(d);
+        let h = receptance(&m, xo, 0.0);
+        let want = m.static_compliance(xo);
+        prop_assert!((h.re - want).abs() <= 1e-9 * want.abs().max(1e-12), "{h} vs {want}");
+        prop_assert!(h.im.abs() <= 1e-12 * want.abs().max(1e-12));
+    }
+
+    /// On a damped design the exact response settles to |H| P0 sin(Ωt + φ0 + arg H): checked
+    /// pointwise on the last period.
+    #[test]
+    fn time_response_converges_to_the_frf_steady_state(
+        d in design(), f in 1.0_f64..60.0, phase in -3.0_f64..3.0, zeta in 0.01_f64..0.05,
+    ) {
+        let mut d = d;
+        d["beam"]["modal_damping_ratio"] = json!(zeta);
+        d["absorber"]["damping_n_s_m"] = json!(0.5);
+        let m = model(d.clone());
+        let e = eigen(&m.a_matrix()).expect("converges");
+        prop_assume!(e.max_re < 0.0);
+        let t_end = 21.0 / -e.max_re;
+        prop_assume!(t_end <= 200.0);
+        let period = 1.0 / f;
+        let dt = period / 16.0;
+        d["excitation"] = json!({"type": "harmonic", "frequency_hz": f, "phase_rad": phase,
+                                 "position_m": d["excitation"]["position_m"]});
+        d["outputs"] = json!({"time_response": {"t_end_s": t_end, "dt_s": dt, "points_m": [0.8], "return_series": true}});
+        let a = answer(d);
+        let t: Vec<f64> = a["time_response"]["t_s"].as_array().expect("t").iter().filter_map(Value::as_f64).collect();
+        let w: Vec<f64> = a["time_response"]["points"][0]["w_m"].as_array().expect("w").iter().filter_map(Value::as_f64).collect();
+        let h = receptance(&m, 0.8, 2.0 * PI * f);
+        let amp = h.norm();
+        for (ti, wi) in t.iter().zip(&w).rev().take(17) {
+            let ss = amp * (2.0 * PI * f * ti + phase + h.arg()).sin();
+            prop_assert!((wi - ss).abs() <= 1e-6 * amp, "t = {ti}: {wi:e} vs {ss:e} (|H| {amp:e})");
+        }
+    }
+
+    /// A design labelled stable decays: its impulse response over the last second is below its
+    /// peak, and every eigenvalue has a negative real part.
+    #[test]
+    fn stable_designs_have_negative_real_parts_and_decay(d in design(), zeta in 1e-3_f64..0.05) {
+        let mut d = d;
+        d["beam"]["modal_damping_ratio"] = json!(zeta);
+        d["outputs"] = json!({"eigenvalues": true});
+        let a = answer(d.clone());
+        let cl = &a["closed_loop"];
+        prop_assume!(cl["stability"] == "stable");
+        for ev in cl["eigenvalues"].as_array().expect("eigenvalues") {
+            prop_assert!(ev["re_1_s"].as_f64().expect("re") < 0.0);
+        }
+        let rate = -cl["max_real_part_1_s"].as_f64().expect("max re");
+        let t_end = (5.0 / rate).min(400.0);
+        d["excitation"] = json!({"type": "impulse", "position_m": d["excitation"]["position_m"]});
+        d["outputs"] = json!({"time_response": {"t_end_s": t_end, "dt_s": t_end / 20000.0}});
+        let p = &answer(d)["time_response"]["points"][0];
+        let (peak, last) = (p["max_abs_m"].as_f64().expect("max"), p["max_abs_last_period_m"].as_f64().expect("last"));
+        prop_assert!(last < peak, "last {last:e} peak {peak:e}");
+    }
+
+    /// Tuned gains put two roots of the fixed-base polynomial on ±jω_c; the third is
+    /// −(R/L_c + b_a/m_a).
+    #[test]
+    fn tuned_gains_place_the_absorber_poles_on_the_axis(
+        ma in 1e-3_f64..10.0, ka in 0.0_f64..1e4, ba in 0.0_f64..10.0, r in 0.1_f64..10.0,
+        lc in 1e-5_f64..1e-1, kc in 0.1_f64..20.0, kb in 0.0_f64..20.0, fc in 0.5_f64..500.0,
+    ) {
+        let dev = Device { ma, ka, ba, r, lc, kc, kb };
+        let g = dev.tuned_gains(fc).expect("K_c ≠ 0");
+        let s = Complex::new(0.0, 2.0 * PI * fc);
+        let p = dev.d_poly(s) + (s * g.kd + g.kp) * kc;
+        let scale = dev.d_poly(s).norm() + ((s * g.kd + g.kp) * kc).norm();
+        prop_assert!(p.norm() < 1e-9 * scale, "|P(jω_c)| = {:e} (scale {scale:e})", p.norm());
+        let s3 = Complex::new(g.third_pole, 0.0);
+        let p3 = dev.d_poly(s3) + (s3 * g.kd + g.kp) * kc;
+        let scale3 = dev.d_poly(s3).norm() + ((s3 * g.kd + g.kp) * kc).norm();
+        prop_assert!(p3.norm() < 1e-9 * scale3);
+    }
+
+    /// Force and active absorber colocated: H(x_a, jω_c) = 0 for any n.
+    #[test]
+    fn colocated_active_absorber_cancels_at_the_tuning(n in 1_u32..=8, xa in 0.3_f64..1.0, fc in 2.0_f64..80.0) {
+        let d = json!({
+            "beam": {"n_modes": n}, "absorber": {"position_m": xa},
+            "control": {"mode": "active", "tuning_hz": fc}, "excitation": {"position_m": xa}
+        });
+        let m = model(d);
+        let h = receptance(&m, xa, 2.0 * PI * fc);
+        let reference = m.static_compliance(xa);
+        prop_assert!(h.norm() <= 1e-9 * reference, "|H| = {:e} vs static {reference:e}", h.norm());
+    }
+
+    /// ζ = 0, force and absorber colocated, driven exactly at a bare-beam ω_k: the receptance is
+    /// the same for n = 2, 3, 8 (the absorber force cancels the applied force), every configuration.
+    #[test]
+    fn colocated_receptance_at_a_bare_resonance_is_independent_of_n(
+        mode in prop_oneof![Just("passive"), Just("passive_shorted"), Just("active")],
+        xa in 0.2_f64..1.0, k in 1_usize..=2,
+    ) {
+        let at = |n: u32| {
+            let m = model(json!({
+                "beam": {"n_modes": n}, "absorber": {"position_m": xa},
+                "control": {"mode": mode, "tuning_mode": 2}, "excitation": {"position_m": xa}
+            }));
+            (receptance(&m, xa, m.omega[k - 1]), m.static_compliance(xa))
+        };
+        let ((h2, c2), (h3, _), (h8, _)) = (at(2), at(3), at(8));
+        prop_assume!(ModeShape::new(k).phi(xa).abs() > 1e-3);
+        // Active tuned to the driven mode is the antiresonance (H = 0): an absolute floor at
+        // 1e-12 of the static compliance covers it.
+        let tol = 1e-9 * h2.norm() + 1e-12 * c2;
+        prop_assert!((h3 - h2).norm() <= tol, "{h2} vs {h3}");
+        prop_assert!((h8 - h2).norm() <= tol, "{h2} vs {h8}");
+    }
+
+    /// Multiplying P0 scales every output; shifting the phase by π flips the signs.
+    #[test]
+    fn response_is_linear_in_the_force(d in design(), p0 in 0.1_f64..100.0) {
+        let mut d = d;
+        d["outputs"] = json!({"time_response": {"t_end_s": 0.5, "dt_s": 0.001, "return_series": true}});
+        let base = answer(d.clone());
+        d["excitation"]["amplitude_n"] = json!(p0);
+        let scaled = answer(d.clone());
+        d["excitation"]["amplitude_n"] = json!(1.0);
+        d["excitation"]["phase_rad"] = json!(PI);
+        let flipped = answer(d);
+        let w = |a: &Value| -> Vec<f64> { a["time_response"]["points"][0]["w_m"].as_array().expect("w").iter().filter_map(Value::as_f64).collect() };
+        let (w0, w1, w2) = (w(&base), w(&scaled), w(&flipped));
+        let scale = w0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        for i in 0..w0.len() {
+            prop_assert!((w1[i] - p0 * w0[i]).abs() <= 1e-9 * p0 * scale);
+            prop_assert!((w2[i] + w0[i]).abs() <= 1e-9 * scale);
+        }
+    }
+}
+
+/// Composite Simpson on [0, 1].
+fn simpson(f: impl Fn(f64) -> f64, n: usize) -> f64 {
+    let h = 1.0 / n as f64;
+    let mut s = f(0.0) + f(1.0);
+    for i in 1..n {
+        s += f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    s * h / 3.0
+}
+
+#[test]
+fn mode_shapes_are_orthogonal_in_mass_and_stiffness() {
+    let modes: Vec<ModeShape> = (1..=8).map(ModeShape::new).collect();
+    for (k, a) in modes.iter().enumerate() {
+        for (j, b) in modes.iter().enumerate().skip(k) {
+            let m = simpson(|x| a.phi(x) * b.phi(x), 20_000);
+            let s = simpson(|x| a.phi_dd_scaled(x) * b.phi_dd_scaled(x), 20_000)
+                * (a.beta * b.beta).powi(2);
+            let (m_want, s_want) = if k == j {
+                (1.0, a.beta.powi(4))
+            } else {
+                (0.0, 0.0)
+            };
+            assert!((m - m_want).abs() < 1e-9, "∫φ{}φ{} = {m}", k + 1, j + 1);
+            assert!(
+                (s - s_want).abs() < 1e-9 * a.beta.powi(4),
+                "∫φ''{}φ''{} = {s}",
+                k + 1,
+                j + 1
+            );
+        }
+    }
+}
+
+#[test]
+fn static_tip_compliance_converges_to_l3_over_3ei() {
+    // Defaults: L = 1, E = 210 GPa, I = 0.05·0.005³/12.
+    let exact = 1.0 / (3.0 * 210e9 * (0.05 * 0.005_f64.powi(3) / 12.0));
+    let rel = |n: u32| {
+        let m = model(json!({"beam": {"n_modes": n}, "control": {"mode": "none"}}));
+        m.static_compliance(1.0) / exact - 1.0
+    };
+    assert!((rel(3) + 0.00144).abs() < 5e-5, "n = 3: {}", rel(3));
+    assert!(rel(30).abs() < 2e-6, "n = 30: {}", rel(30));
+    assert!(rel(10).abs() < rel(5).abs() && rel(5).abs() < rel(3).abs());
+}
