@@ -139,6 +139,26 @@ impl Budget {
         });
     }
 
+    /// The larger of the fractions of the time limit and of the evaluation cap spent after
+    /// `evaluations` evaluations: a progress estimate for open-ended solvers.
+    #[must_use]
+    pub fn spent_fraction(&self, evaluations: u64) -> f64 {
+        let total = self
+            .deadline
+            .saturating_duration_since(self.start)
+            .as_secs_f64();
+        let by_time = if total > 0.0 {
+            self.start.elapsed().as_secs_f64() / total
+        } else {
+            1.0
+        };
+        // Evaluation counts are far below 2^53: exact in f64.
+        let by_evaluations = self
+            .max_evaluations
+            .map_or(0.0, |m| evaluations as f64 / m.max(1) as f64);
+        by_time.max(by_evaluations).clamp(0.0, 1.0)
+    }
+
     /// A budget that, for practical purposes, never runs out (one day). For tests and benchmarks.
     #[must_use]
     pub fn unlimited() -> Self {

@@ -36,3 +36,4 @@ mod paper_machining_size;
 mod paper_spatial_coupling;
 mod paper_vibration_absorber;
 mod pictures;
+mod progress_stream;

@@ -188,9 +188,12 @@ impl<'a, M: CurveModel> Ctx<'a, M> {
     }
 
     /// Record the best-so-far in the history (called once per generation/iteration).
+    /// Streaming clients see the best objective so far and the share of the budget spent.
     pub fn record_iteration(&mut self) {
         self.iterations += 1;
         let best = self.best_f;
+        self.budget
+            .progress(self.budget.spent_fraction(self.evaluations), Some(best));
         if let Some(h) = self.history.as_mut() {
             h.push(best);
         }

@@ -538,7 +538,10 @@ pub fn wave(
     let threads = s.threads.min(budget.threads()).max(1);
     let mut attempts = 0u64;
     let mut evaluations = 0u64;
+    let mut n_ok = 1usize;
     while !frontier.is_empty() && stop == StopReason::Completed {
+        // Share of the grid reached so far (streaming clients; node counts are exact in f64).
+        budget.progress(n_ok as f64 / (n1 * n2) as f64, None);
         // Ordered source lists per target, in FIFO order of (source position, neighbour rank).
         let mut order: Vec<usize> = Vec::new();
         let mut sources: BTreeMap<usize, Vec<(usize, usize, usize)>> = BTreeMap::new();
@@ -600,6 +603,7 @@ pub fn wave(
                         match r {
                             Ok(d) => {
                                 status[job.target] = NodeStatus::Ok;
+                                n_ok += 1;
                                 nodes[job.target] = Some(d);
                                 accepted.push((key.0, key.1, job.target));
                             }

@@ -313,6 +313,8 @@ pub fn boost(data: &TrainData<'_>, p: &BoostParams, budget: &Budget, threads: us
             stop = reason;
             break;
         }
+        // Round counts are far below 2^53: exact in f64.
+        budget.progress(trees.len() as f64 / p.n_estimators as f64, None);
         let cols: Vec<usize> = if k_cols == d {
             (0..d).collect()
         } else {

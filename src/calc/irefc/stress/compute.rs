@@ -898,7 +898,9 @@ pub fn compute_sweep(input: &SweepInput, budget: &Budget) -> SweepResult {
                 geometry: Geometry::new_unchecked(d.r2, d.z2, d.chi, d.rb),
             },
         };
-        evaluated.fetch_add(1, Ordering::Relaxed);
+        let done = evaluated.fetch_add(1, Ordering::Relaxed) + 1;
+        // Combination counts are far below 2^53: exact in f64.
+        budget.progress(done as f64 / total as f64, None);
         Some(outcome)
     });
     let outcomes: Vec<ComboOutcome> = results
