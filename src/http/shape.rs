@@ -61,11 +61,11 @@ fn strip_bounds(v: &mut Value) {
 }
 
 /// The compiled validator of one request schema (by schema name), built on first use.
-fn validator(schema: &str) -> Option<Arc<jsonschema::Validator>> {
-    static CACHE: OnceLock<Mutex<HashMap<String, Option<Arc<jsonschema::Validator>>>>> =
+fn validator(schema: &str, bounded: bool) -> Option<Arc<jsonschema::Validator>> {
+    static CACHE: OnceLock<Mutex<HashMap<(String, bool), Option<Arc<jsonschema::Validator>>>>> =
         OnceLock::new();
     let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-    if let Some(v) = cache.lock().ok()?.get(schema) {
+    if let Some(v) = cache.lock().ok()?.get(&(schema.to_owned(), bounded)) {
         return v.clone();
     }
     let mut root = Map::new();
@@ -77,27 +77,35 @@ fn validator(schema: &str) -> Option<Arc<jsonschema::Validator>> {
         "$ref".to_owned(),
         json!(format!("#/components/schemas/{schema}")),
     );
-    root.insert("components".to_owned(), shape_components().clone());
+    let components = if bounded {
+        openapi::document()
+            .get("components")
+            .cloned()
+            .unwrap_or_else(|| json!({}))
+    } else {
+        shape_components().clone()
+    };
+    root.insert("components".to_owned(), components);
     let compiled = jsonschema::draft202012::options()
         .build(&Value::Object(root))
         .map_err(|e| tracing::error!(%schema, error = %e, "request schema does not compile"))
         .ok()
         .map(Arc::new);
     if let Ok(mut c) = cache.lock() {
-        c.insert(schema.to_owned(), compiled.clone());
+        c.insert((schema.to_owned(), bounded), compiled.clone());
     }
     compiled
 }
 
 /// Validates a decoded request's JSON against the shape of schema `schema`; a 422 listing every
 /// offending member by JSON pointer when it does not fit.
-pub fn check(schema: &str, body: &[u8]) -> Result<(), ApiError> {
-    let Some(v) = validator(schema) else {
+pub fn check(schema: &str, body: &[u8]) -> Result<Vec<(String, String)>, ApiError> {
+    let Some(v) = validator(schema, false) else {
         // A schema that does not compile is a bug (logged above); the module validator still runs.
-        return Ok(());
+        return Ok(Vec::new());
     };
     let Ok(value) = serde_json::from_slice::<Value>(body) else {
-        return Ok(());
+        return Ok(Vec::new());
     };
     let mut found = Vec::new();
     for e in v.iter_errors(&value).take(20) {
@@ -110,7 +118,39 @@ pub fn check(schema: &str, body: &[u8]) -> Result<(), ApiError> {
             Some(a) => a.with_field(pointer, detail),
         });
     }
-    err.map_or(Ok(()), Err)
+    if let Some(e) = err {
+        return Err(e);
+    }
+    Ok(bound_violations(schema, &value))
+}
+
+/// The documented value bounds `value` breaks, as (pointer, detail). The module validators
+/// report these first, with their own codes; what is left here are bounds of fields a module
+/// ignores in the request's mode (for example a scalar that a sweep replaces), which the
+/// document still bounds: [`bounds_error`] turns them into a 422 once the module has accepted
+/// the request, so that no request the document rejects is answered with a 2xx.
+fn bound_violations(schema: &str, value: &Value) -> Vec<(String, String)> {
+    let Some(v) = validator(schema, true) else {
+        return Vec::new();
+    };
+    let mut found = Vec::new();
+    for e in v.iter_errors(value).take(20) {
+        flatten(&e, &mut found);
+    }
+    found
+}
+
+/// The 422 for documented bounds that the module did not check (see [`bound_violations`]).
+#[must_use]
+pub fn bounds_error(violations: &[(String, String)]) -> Option<ApiError> {
+    let mut err: Option<ApiError> = None;
+    for (pointer, detail) in violations {
+        err = Some(match err {
+            None => ApiError::invalid_field(pointer.clone(), detail.clone()),
+            Some(a) => a.with_field(pointer.clone(), detail.clone()),
+        });
+    }
+    err
 }
 
 /// (pointer, message) of an error; a failed `oneOf`/`anyOf` is explained by the alternative that

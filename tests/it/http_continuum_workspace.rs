@@ -213,3 +213,21 @@ async fn non_convergence_is_a_200_with_status_and_the_time_limit_is_honoured() {
     r.problem(422);
     assert_eq!(r.pointers(), vec!["/time_limit_ms".to_string()]);
 }
+
+/// A workspace sweep ignores `inputs_m` (an FK field), but the document bounds it: a value out
+/// of its documented range is a 422 naming the element, never a 200 (the module accepted the
+/// rest of the request, the service checks the bounds the module did not).
+#[tokio::test]
+async fn ignored_fields_are_still_held_to_their_documented_bounds() {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("api/continuum_workspace/sweep_symmetric.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(p).expect("example")).expect("json");
+    v["inputs_m"] = serde_json::json!([0.0, -1_000_001.0]);
+    let r = crate::common::post_json("/v1/continuum-workspace", &v).await;
+    r.problem(422);
+    assert_eq!(r.pointers(), vec!["/inputs_m/1".to_owned()]);
+    v["inputs_m"] = serde_json::json!([0.0, -0.5]);
+    let r = crate::common::post_json("/v1/continuum-workspace", &v).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+}
