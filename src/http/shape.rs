@@ -60,10 +60,13 @@ fn strip_bounds(v: &mut Value) {
     }
 }
 
-/// The compiled validator of one request schema (by schema name), built on first use.
-fn validator(schema: &str, bounded: bool) -> Option<Arc<jsonschema::Validator>> {
-    static CACHE: OnceLock<Mutex<HashMap<(String, bool), Option<Arc<jsonschema::Validator>>>>> =
-        OnceLock::new();
+/// A compiled request schema (`None` when it does not compile).
+type Compiled = Option<Arc<jsonschema::Validator>>;
+
+/// The compiled validator of one request schema (by schema name; with the document's value
+/// bounds when `bounded`), built on first use.
+fn validator(schema: &str, bounded: bool) -> Compiled {
+    static CACHE: OnceLock<Mutex<HashMap<(String, bool), Compiled>>> = OnceLock::new();
     let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
     if let Some(v) = cache.lock().ok()?.get(&(schema.to_owned(), bounded)) {
         return v.clone();
