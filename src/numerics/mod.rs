@@ -6,6 +6,7 @@ pub mod angles;
 pub mod budget;
 pub mod elliptic;
 pub mod parallel;
+pub mod quadrature;
 
 pub use budget::{Budget, SolverReport, StopReason};
 pub use parallel::{par_map, par_map_while};

@@ -22,6 +22,7 @@ mod http_irefc;
 mod http_mutated_examples;
 mod http_service;
 mod openapi;
+mod paper_bezier_motion;
 mod paper_bus_fuel_economy;
 mod paper_cam_law;
 mod paper_cam_law_fit;
