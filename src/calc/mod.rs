@@ -7,6 +7,7 @@
 //! failure types ([`problem`]), the bounds table ([`bounds`]) and the wire types every endpoint
 //! uses the same way ([`common`]).
 
+pub mod bezier_motion;
 pub mod bounds;
 pub mod bus_fuel_economy;
 pub mod cam_law;
@@ -30,6 +31,7 @@ pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validato
 pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         crate::numerics::budget::schema_bounds(),
+        bezier_motion::wire::schema_bounds(),
         bus_fuel_economy::wire::schema_bounds(),
         cam_law::wire::schema_bounds(),
         cam_law_fit::wire::schema_bounds(),

@@ -5,6 +5,7 @@
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
 //! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
+pub mod bezier_motion;
 pub mod bus_fuel_economy;
 pub mod cam_law;
 pub mod cam_law_fit;
@@ -126,6 +127,7 @@ JSON pointers to the offending fields.",
         (name = "reliability", description = "Reliability and maintenance: component importance under fault propagation"),
         (name = "bus-fuel-economy", description = "Drive-cycle energy of an electric bus with an AC-loss-aware traction motor"),
         (name = "irefc", description = "Cycloid gears with intermediate rolling elements and a free cage: contact stresses, design sweeps, efficiency"),
+        (name = "motion-laws", description = "Servo motion laws: Bezier laws with zero residual vibration of a compliant drive"),
         (name = "continuum-robots", description = "Parallel continuum manipulators: forward kinematics, stability, assembly modes and workspace"),
         (name = "machining-size", description = "Machined dimensions: gradient-boosted trees with XGBoost's semantics, exact SHAP explanations and the paper's data diagnostics"),
         (name = "spatial-linkages", description = "Spatial couplings: closed-form kinematics of the RP1PR coupling between crossed shafts"),
@@ -156,6 +158,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(machining_size::analyze))
         .route(routes!(spatial_coupling::evaluate))
         .route(routes!(vibration_absorber::analyse))
+        .route(routes!(bezier_motion::solve))
         .finish()
 }
 

@@ -143,7 +143,8 @@ fn bound_violations(schema: &str, value: &Value) -> Vec<(String, String)> {
     found
 }
 
-/// The 422 for documented bounds that the module did not check (see [`bound_violations`]).
+/// The 422 for documented bounds that the module did not check: bounds of fields a module may
+/// ignore in the request's mode, found by the document's own bounded schema after the shape check.
 #[must_use]
 pub fn bounds_error(violations: &[(String, String)]) -> Option<ApiError> {
     let mut err: Option<ApiError> = None;

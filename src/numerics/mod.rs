@@ -8,6 +8,7 @@ pub mod elliptic;
 pub mod linalg;
 pub mod parallel;
 pub mod pchip;
+pub mod quadrature;
 
 pub use budget::{Budget, SolverReport, StopReason};
 pub use parallel::{par_map, par_map_while};

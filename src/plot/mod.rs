@@ -7,6 +7,7 @@
 //! Axes carry quantity and unit; colours come from the Okabe–Ito palette, which stays
 //! distinguishable for colour-blind readers, and series also differ by marker or dash.
 
+mod bezier_motion;
 mod bus_fuel_economy;
 mod cam_law;
 mod cam_law_fit;
@@ -48,6 +49,11 @@ struct Picture {
 }
 
 const PICTURES: &[Picture] = &[
+    Picture {
+        route: "/v1/bezier-motion-law",
+        prepare: bezier_motion::prepare,
+        render: bezier_motion::render,
+    },
     Picture {
         route: "/v1/cam-law/evaluate",
         prepare: cam_law::prepare,

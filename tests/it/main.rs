@@ -25,6 +25,7 @@ mod http_service;
 mod http_spatial_coupling;
 mod http_vibration_absorber;
 mod openapi;
+mod paper_bezier_motion;
 mod paper_bus_fuel_economy;
 mod paper_cam_law;
 mod paper_cam_law_fit;

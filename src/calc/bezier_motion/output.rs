@@ -1,0 +1,194 @@
+//! The one place that builds the response of `POST /v1/bezier-motion-law`.
+
+use std::f64::consts::TAU;
+
+use super::compute::{BezierOutput, FactorResult, Residual};
+use super::history::History;
+use super::input::BezierInput;
+use super::optimize::Objective;
+use super::plant::{EndStateMethod, Plant};
+use super::wire::{
+    BezierMotionResponse, EndState, HistoryOut, KinematicsOut, LawOut, MethodOut, ObjectiveIn,
+    OptimizerOut, ReferenceOut, ResidualOut, SensitivityRow, SystemOut,
+};
+use crate::numerics::{Budget, SolverReport, StopReason};
+
+/// Builds the response.
+#[must_use]
+pub fn respond(input: &BezierInput, out: &BezierOutput, budget: &Budget) -> BezierMotionResponse {
+    let plant = &input.plant;
+    let law = &out.law;
+    let phi = input.phi;
+    let steps = out
+        .history
+        .as_ref()
+        .map_or(0, |h| (h.substeps * h.t.len()) as u64);
+    BezierMotionResponse {
+        mode: input.mode,
+        system: system_out(plant, input.t),
+        method: method_out(out),
+        law: LawOut {
+            gamma_rad: out.gamma.clone(),
+            gamma_over_phi: out.gamma.iter().map(|g| g / phi).collect(),
+            s_rad: law.s.clone(),
+            v_rad_s: law.v.clone(),
+            a_rad_s2: law.a.clone(),
+            j_rad_s3: law.j.clone(),
+            degree: law.degree() as u64,
+        },
+        residual: residual_out(plant, &out.residual),
+        reference: out.optimizer.as_ref().map(|o| ReferenceOut {
+            gamma_rad: o.reference_gamma.clone(),
+            residual: residual_out(plant, &o.reference),
+        }),
+        optimizer: out.optimizer.as_ref().map(|o| {
+            let e = out.residual.energy;
+            let e_ref = o.reference.energy;
+            let gmax = out.gamma.iter().fold(0.0_f64, |m, g| m.max(g.abs())) / phi.abs();
+            let finite = |x: f64| x.is_finite().then_some(x);
+            OptimizerOut {
+                objective: match o.objective {
+                    Objective::MinDeviation => ObjectiveIn::MinDeviation,
+                    Objective::MinAccelL2 => ObjectiveIn::MinAccelL2,
+                    Objective::MinJerkL2 => ObjectiveIn::MinJerkL2,
+                },
+                n_constraints: o.n_constraints as u64,
+                rank: o.rank as u64,
+                free_dimensions: input.p.saturating_sub(o.rank) as u64,
+                exact_zero: o.rank == o.n_constraints,
+                energy_ratio_to_reference: (e_ref > 0.0).then(|| e / e_ref).and_then(finite),
+                reduction_db: (e_ref > 0.0)
+                    .then(|| 10.0 * (e_ref / e.max(out.residual.floor)).log10())
+                    .and_then(finite),
+                max_abs_gamma_over_phi: gmax,
+            }
+        }),
+        robust: out
+            .robust
+            .as_ref()
+            .map(|r| r.iter().map(factor_row).collect()),
+        kinematics: out.kinematics.map(|k| KinematicsOut {
+            peak_velocity_rad_s: k.peak_velocity.0,
+            t_peak_velocity_s: k.peak_velocity.1,
+            peak_accel_rad_s2: k.peak_accel.0,
+            t_peak_accel_s: k.peak_accel.1,
+            peak_jerk_rad_s3: k.peak_jerk.0,
+            t_peak_jerk_s: k.peak_jerk.1,
+            min_velocity_rad_s: k.min_velocity.0,
+            t_min_velocity_s: k.min_velocity.1,
+            motion_reversal: k.motion_reversal,
+            hull_velocity_rad_s: k.hull[0],
+            hull_accel_rad_s2: k.hull[1],
+            hull_jerk_rad_s3: k.hull[2],
+        }),
+        sensitivity: out
+            .sensitivity
+            .as_ref()
+            .map(|r| r.iter().map(factor_row).collect()),
+        time_history: out
+            .history
+            .as_ref()
+            .filter(|h| !h.t.is_empty())
+            .map(|h| history_out(h, input.t)),
+        warnings: out.warnings.clone(),
+        report: SolverReport {
+            stop_reason: StopReason::Completed,
+            iterations: out.matrices,
+            evaluations: out.matrices + steps,
+            elapsed_ms: budget.elapsed_ms(),
+        },
+    }
+}
+
+/// Derived system quantities (spec §3.1).
+#[must_use]
+pub fn system_out(plant: &Plant, t: f64) -> SystemOut {
+    let wd = plant.omega_d();
+    let (slow, fast) = plant.pole_magnitudes();
+    SystemOut {
+        j_eq_kgm2: plant.j_eq,
+        omega_n_rad_s: plant.wn,
+        xi: plant.xi,
+        omega_d_rad_s: wd,
+        f_n_hz: plant.wn / TAU,
+        eta: wd
+            .map(|wd| {
+                let r = plant.z / wd;
+                0.5 * plant.j_eq * r * r
+            })
+            .filter(|x| x.is_finite()),
+        periods_in_move: plant.wn * t / TAU,
+        rho_min: t * slow,
+        rho_max: t * fast,
+    }
+}
+
+fn method_out(out: &BezierOutput) -> MethodOut {
+    let (end_state, panels, nodes) = match out.h.method {
+        EndStateMethod::ClosedFormIbp => (EndState::ClosedFormIbp, None, None),
+        EndStateMethod::GaussLegendre { panels, nodes } => (
+            EndState::GaussLegendre,
+            Some(panels as u64),
+            Some(nodes as u64),
+        ),
+    };
+    MethodOut {
+        end_state,
+        ibp_ratio: out.h.ratio,
+        panels,
+        nodes,
+    }
+}
+
+fn residual_out(plant: &Plant, r: &Residual) -> ResidualOut {
+    let finite = |x: f64| x.is_finite().then_some(x);
+    ResidualOut {
+        psi_t_rad: r.x[0],
+        dpsi_t_rad_s: r.x[1],
+        e_t_j: r.energy,
+        q: r.q.and_then(finite),
+        residual_amplitude_rad: r.amplitude.and_then(finite),
+        residual_accel_envelope_rad_s2: r
+            .amplitude
+            .map(|a| plant.wn * (plant.wn * a))
+            .and_then(finite),
+        e_floor_j: r.floor,
+        at_numerical_floor: r.energy <= r.floor,
+    }
+}
+
+fn factor_row(f: &FactorResult) -> SensitivityRow {
+    SensitivityRow {
+        stiffness_factor: f.factor,
+        omega_n_rad_s: f.plant.wn,
+        xi: f.plant.xi,
+        e_t_j: f.residual.energy,
+        residual_amplitude_rad: f.residual.amplitude.filter(|x| x.is_finite()),
+    }
+}
+
+fn history_out(h: &History, t_end: f64) -> HistoryOut {
+    let peak = |v: &[f64], during: bool| {
+        h.t.iter()
+            .zip(v)
+            .filter(|(t, _)| (**t <= t_end) == during)
+            .fold(0.0_f64, |m, (_, x)| m.max(x.abs()))
+    };
+    HistoryOut {
+        t_s: h.t.clone(),
+        phi_rad: h.phi.clone(),
+        dphi_rad_s: h.dphi.clone(),
+        ddphi_rad_s2: h.ddphi.clone(),
+        alpha_rad: h.alpha.clone(),
+        beta_rad: h.beta.clone(),
+        dbeta_rad_s: h.dbeta.clone(),
+        ddbeta_rad_s2: h.ddbeta.clone(),
+        psi_rad: h.psi.clone(),
+        joint_torque_nm: h.torque.clone(),
+        peak_joint_torque_move_nm: peak(&h.torque, true),
+        peak_ddbeta_move_rad_s2: peak(&h.ddbeta, true),
+        peak_ddbeta_after_rad_s2: peak(&h.ddbeta, false),
+        substeps_per_sample: h.substeps as u64,
+        nodes_per_substep: h.nodes as u64,
+    }
+}
