@@ -42,12 +42,14 @@ async fn optional_outputs_only_when_asked() {
     let r = post_json(PATH, &v).await;
     assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
     let b = r.json();
-    for key in ["time_history", "sensitivity", "kinematics"] {
+    for key in ["time_history", "sensitivity"] {
         assert!(
             b.get(key).is_none(),
             "{key} present without being asked for"
         );
     }
+    // Kinematic peaks are cheap and on by default (spec §2: `outputs.kinematic_peaks` true).
+    assert!(b["kinematics"].is_object());
 }
 
 #[tokio::test]
