@@ -4,6 +4,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod props_bezier_motion;
 mod props_bus_fuel_economy;
 mod props_cam_law;
 mod props_cam_law_fit;
