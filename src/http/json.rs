@@ -189,14 +189,20 @@ mod tests {
 
     #[derive(Debug, serde::Deserialize)]
     #[serde(deny_unknown_fields)]
-    #[allow(dead_code)]
+    #[expect(
+        dead_code,
+        reason = "the fields exist to be deserialized and rejected, never read"
+    )]
     struct Inner {
         t_b: f64,
     }
 
     #[derive(Debug, serde::Deserialize)]
     #[serde(deny_unknown_fields)]
-    #[allow(dead_code)]
+    #[expect(
+        dead_code,
+        reason = "the fields exist to be deserialized and rejected, never read"
+    )]
     struct Outer {
         items: Vec<Inner>,
     }

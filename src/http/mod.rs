@@ -55,7 +55,6 @@ pub use state::AppState;
 
 /// Error responses every calculation endpoint can give (all `application/problem+json`).
 #[derive(utoipa::IntoResponses)]
-#[allow(dead_code)]
 pub enum ProblemResponses {
     /// The body is not well-formed JSON.
     #[response(

@@ -126,6 +126,7 @@ fn build() -> (Value, Vec<String>) {
         allow_null_for_optional_request_fields(schemas, &request_roots);
     }
     document_alternative_media_types(&mut doc);
+    unescape_unit_brackets(&mut doc);
     (doc, problems)
 }
 
@@ -507,6 +508,25 @@ fn unsigned_32_bit_range(v: &mut Value) {
             m.values_mut().for_each(unsigned_32_bit_range);
         }
         Value::Array(a) => a.iter_mut().for_each(unsigned_32_bit_range),
+        _ => {}
+    }
+}
+
+/// Doc comments write units in brackets escaped for rustdoc (`time \[s\]`, so rustdoc does not
+/// read `[s]` as a link); the document says them plainly (`time [s]`), as CommonMark renders both.
+fn unescape_unit_brackets(v: &mut Value) {
+    match v {
+        Value::Object(m) => {
+            for (k, x) in m.iter_mut() {
+                match x {
+                    Value::String(s) if k == "description" && s.contains('\\') => {
+                        *s = s.replace("\\[", "[").replace("\\]", "]");
+                    }
+                    _ => unescape_unit_brackets(x),
+                }
+            }
+        }
+        Value::Array(a) => a.iter_mut().for_each(unescape_unit_brackets),
         _ => {}
     }
 }

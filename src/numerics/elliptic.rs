@@ -7,7 +7,6 @@
 
 // The series are kept in Carlson's published form; without a target FMA unit `mul_add` would
 // also be a libm call per term.
-#![allow(clippy::suboptimal_flops)]
 
 /// Duplication stops when every relative deviation from the mean is below this; the truncation
 /// error of `R_F` is then below `ERRTOL^6 / 4` (about 7e-20), far under double precision.

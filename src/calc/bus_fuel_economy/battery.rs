@@ -4,7 +4,6 @@
 // Plain products instead of `mul_add`: without FMA hardware in the target (the default x86-64
 // baseline) `mul_add` is a libm call, ~10x slower in these per-interval loops, and plain
 // arithmetic follows the rounding of the spec's reference implementation.
-#![allow(clippy::suboptimal_flops)]
 
 use super::ac_factor::interp_clamped;
 

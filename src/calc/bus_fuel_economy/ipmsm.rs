@@ -11,7 +11,6 @@
 // Plain products instead of `mul_add`: without FMA hardware in the target (the default x86-64
 // baseline) `mul_add` is a libm call, ~10x slower in these per-interval loops, and plain
 // arithmetic follows the rounding of the spec's reference implementation.
-#![allow(clippy::suboptimal_flops)]
 
 use std::f64::consts::{FRAC_PI_2, PI};
 

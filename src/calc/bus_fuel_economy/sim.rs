@@ -3,7 +3,6 @@
 // Plain products instead of `mul_add`: without FMA hardware in the target (the default x86-64
 // baseline) `mul_add` is a libm call, ~10x slower in these per-interval loops, and plain
 // arithmetic follows the rounding of the spec's reference implementation.
-#![allow(clippy::suboptimal_flops)]
 
 use super::battery::{Battery, EcmState};
 use super::cycles::Interval;
@@ -220,7 +219,7 @@ pub struct SimOutcome {
 ///
 /// # Errors
 /// [`BusFuelEconomyError::Deadline`] when the budget runs out.
-#[allow(clippy::too_many_lines)] // One pass over the intervals; splitting it would scatter the chain.
+// One pass over the intervals; splitting it would scatter the chain.
 pub fn simulate(
     veh: &Vehicle,
     motor: &mut MotorEvaluator<'_>,

@@ -5,7 +5,6 @@
 //! closed forms follow the law's convention (right-continuous inside, left-continuous at `x = 1`).
 
 // Closed-form polynomials read best in their printed (Appendix A) form.
-#![allow(clippy::suboptimal_flops)]
 
 use std::f64::consts::PI;
 

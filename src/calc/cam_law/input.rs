@@ -72,9 +72,7 @@ impl Abscissa {
             Self::Grid { start, end, count } => {
                 let last = count - 1;
                 // count ≤ 200 000, so the usize → f64 conversions are exact.
-                #[allow(clippy::cast_precision_loss)]
                 let step = (end - start) / last as f64;
-                #[allow(clippy::cast_precision_loss)]
                 let mut xs: Vec<f64> = (0..count).map(|k| start + step * k as f64).collect();
                 xs[last] = end;
                 xs

@@ -16,7 +16,6 @@
 // `mul_add` compiles to a libm call on targets without a guaranteed FMA unit, which would more
 // than double the per-sample cost of the hot loops below; the plain forms are accurate enough here
 // (every quantity is evaluated relative to its segment start, errors stay at a few ulp).
-#![allow(clippy::suboptimal_flops)]
 
 use std::f64::consts::{FRAC_2_PI, FRAC_PI_2};
 

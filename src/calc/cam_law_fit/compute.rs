@@ -544,7 +544,6 @@ fn objective_of(law: &SevenSegmentLaw, input: &FitInput, data: &[f64], dtw: &mut
 /// # Errors
 /// [`FitError`] when the fitted law cannot be represented in f64 (not expected after
 /// validation; never a panic).
-#[allow(clippy::too_many_lines)]
 pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, FitError> {
     let started = Instant::now();
     let cap = budget

@@ -222,7 +222,6 @@ fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
 /// [`ProblemClass::InvalidInput`] listing every offending field; [`ProblemClass::TooLarge`]
 /// when the cost estimate exceeds [`MAX_COST`]; [`ProblemClass::Infeasible`] when the boundary
 /// conditions admit no representable law of this duration (the initial law overflows f64).
-#[allow(clippy::too_many_lines)]
 pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let mut v = Validator::new();
     let xs = abscissa(&req, &mut v);
@@ -622,7 +621,6 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let n = xs.len();
 
     // Cost guard (spec §2).
-    #[allow(clippy::cast_precision_loss)]
     let cost = {
         let w = if metric == MetricName::Dtw {
             2.0f64.mul_add(dtw_window.min(n - 1) as f64, 1.0)

@@ -11,11 +11,9 @@ pub fn grid(start: f64, end: f64, count: usize) -> Vec<f64> {
         1 => vec![start],
         _ => {
             // usize → f64 is exact for every accepted count (≤ 200 000 < 2^53).
-            #[allow(clippy::cast_precision_loss)]
             let step = (end - start) / (count - 1) as f64;
             let mut xs: Vec<f64> = (0..count)
                 .map(|k| {
-                    #[allow(clippy::cast_precision_loss)]
                     let kf = k as f64;
                     kf.mul_add(step, start)
                 })

@@ -220,10 +220,6 @@ fn sign_of(w: WireSign) -> Sign {
 /// A power of two within a factor √2 of `x > 0`: dividing by it is exact.
 fn power_of_two_near(x: f64) -> f64 {
     // x is finite, positive and ≤ ~1e101 here, so log2 is in (−1100, 340) and the cast cannot wrap.
-    #[allow(
-        clippy::cast_possible_truncation,
-        reason = "bounded: see the comment above"
-    )]
     let e = x.log2().round() as i32;
     2f64.powi(e)
 }

@@ -53,11 +53,6 @@
     reason = "docs write units as `[length]`, `[deg]`, `[rad]` (the project's field-doc convention, also the \
               OpenAPI descriptions); rustdoc would read them as links"
 )]
-#![allow(
-    clippy::suboptimal_flops,
-    reason = "mul_add is a libm call on the generic x86-64 target (no FMA) and would double the cost of a \
-              position solve; the formulas follow the spec and their rounding is covered by the tests"
-)]
 
 pub mod compute;
 pub mod error;

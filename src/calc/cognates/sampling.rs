@@ -51,10 +51,6 @@ pub fn circuit_param(circuit: &Circuit, u: f64, spacing: Spacing) -> (f64, Sign)
 #[must_use]
 pub fn sample_u(j: usize, n: usize) -> f64 {
     // j < n ≤ 100 000 here: both convert to f64 exactly.
-    #[allow(
-        clippy::cast_precision_loss,
-        reason = "j and n are ≤ 1e5, exact in f64"
-    )]
     let t = j as f64 / n as f64;
     2.0 * PI * t
 }
@@ -101,10 +97,6 @@ impl Sweep {
                 closed,
             } => {
                 // j < n ≤ 100 000: exact in f64.
-                #[allow(
-                    clippy::cast_precision_loss,
-                    reason = "j and n are ≤ 1e5, exact in f64"
-                )]
                 let t = if *closed {
                     j as f64 / n as f64
                 } else {
@@ -183,7 +175,6 @@ pub fn chord_error(mech: &FourBar, n: usize, spacing: Spacing, sub: usize) -> f6
             };
             for s in 1..sub {
                 // s < sub ≤ a few hundred: exact in f64.
-                #[allow(clippy::cast_precision_loss, reason = "small integers")]
                 let u = u0 + (u1 - u0) * (s as f64 / sub as f64);
                 if let Some(q) = curve_point(mech, &circuit, u, spacing) {
                     worst = worst.max(point_segment_distance(q, p0, p1));

@@ -197,10 +197,6 @@ impl<'a> SegmentGrid<'a> {
             }
         }
         let extent = (hi.re - lo.re).max(hi.im - lo.im);
-        #[allow(
-            clippy::cast_precision_loss,
-            reason = "segment counts are ≤ ~1e6, exact in f64"
-        )]
         let n = segs.len().max(1) as f64;
         // About two mean segment lengths per cell (a query then scans a handful of segments), but
         // never more than ~4n cells.
@@ -212,11 +208,6 @@ impl<'a> SegmentGrid<'a> {
         };
         let count = |w: f64| -> usize {
             // w/cell ≤ 2·sqrt(n) ≤ ~2e3: the cast is exact and cannot wrap.
-            #[allow(
-                clippy::cast_possible_truncation,
-                clippy::cast_sign_loss,
-                reason = "bounded, non-negative"
-            )]
             let k = (w / cell).floor() as usize;
             k + 1
         };
@@ -276,14 +267,7 @@ impl<'a> SegmentGrid<'a> {
                 0
             } else {
                 // Clamped to n − 1 before the cast: cannot wrap.
-                #[allow(
-                    clippy::cast_possible_truncation,
-                    clippy::cast_sign_loss,
-                    clippy::cast_precision_loss,
-                    reason = "clamped"
-                )]
-                let i = x.min((n - 1) as f64) as usize;
-                i
+                x.min((n - 1) as f64) as usize
             }
         };
         (
@@ -296,7 +280,6 @@ impl<'a> SegmentGrid<'a> {
     /// `(cx, cy)`; infinite on sides where the block reaches the grid border (no cells beyond).
     fn reach(&self, q: C64, cx: usize, cy: usize, r: usize) -> f64 {
         // Cell indices are ≤ ~2e3: exact in f64.
-        #[allow(clippy::cast_precision_loss, reason = "small indices")]
         let edge = |i: usize| i as f64 * self.cell;
         let left = if cx > r {
             q.re - (self.min.re + edge(cx - r))

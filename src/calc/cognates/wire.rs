@@ -704,10 +704,6 @@ pub struct CurveOut {
     pub n_singular_excluded: usize,
 }
 
-#[allow(
-    clippy::trivially_copy_pass_by_ref,
-    reason = "serde's skip_serializing_if passes a reference"
-)]
 fn is_zero(n: &usize) -> bool {
     *n == 0
 }

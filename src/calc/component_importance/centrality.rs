@@ -139,9 +139,7 @@ pub fn kendall_tau_b(x: &[f64], y: &[f64]) -> Option<f64> {
     }
     let u = |v: u64| -> f64 {
         // Pair counts ≤ 2e6 here: exact in f64.
-        #[allow(clippy::cast_precision_loss)]
-        let f = v as f64;
-        f
+        v as f64
     };
     let con_minus_dis = 2.0f64.mul_add(-u(dis), u(tot) - u(xtie) - u(ytie) + u(ntie));
     Some(con_minus_dis / ((u(tot) - u(xtie)).sqrt() * (u(tot) - u(ytie)).sqrt()))
@@ -186,7 +184,6 @@ fn merge_count(a: &mut [f64], buf: &mut [f64]) -> u64 {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 

@@ -287,7 +287,10 @@ pub fn propagation_sums(
 ///
 /// # Errors
 /// Budget and enumeration failures of the DFS.
-#[allow(clippy::too_many_arguments)]
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the graph, its weights and the enumeration limits of one index computation"
+)]
 pub fn index(
     g: &Digraph,
     he: &[f64],
@@ -338,7 +341,6 @@ pub fn index(
 /// # Errors
 /// [`ComponentImportanceError`] for over-budget enumeration, an exhausted time budget, a hazard
 /// rate beyond f64, or a failed final consistency check.
-#[allow(clippy::too_many_lines)]
 pub fn compute(
     input: &ComponentImportanceInput,
     budget: &Budget,

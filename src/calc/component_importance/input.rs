@@ -136,7 +136,6 @@ fn weight_pair(v: &mut Validator, pointer: &str, w: &[f64]) -> Option<[f64; 2]> 
 impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
     type Error = CalcFailure;
 
-    #[allow(clippy::too_many_lines)]
     fn try_from(req: ComponentImportanceRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let mut warnings = Vec::new();
@@ -494,7 +493,6 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
             )
         })?;
         // max_simple_paths ∈ [1e3, 1e8] (validated): the cast is exact after rounding down.
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
         let max_simple_paths = o.max_simple_paths.floor() as u64;
         Ok(Self {
             ids: req.components.into_iter().map(|c| c.id).collect(),

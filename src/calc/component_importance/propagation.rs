@@ -232,7 +232,6 @@ fn length_f64(l: usize) -> f64 {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 

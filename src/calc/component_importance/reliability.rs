@@ -25,7 +25,6 @@ pub fn hazard_rate(t: f64, eta: f64, beta: f64) -> f64 {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

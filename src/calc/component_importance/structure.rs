@@ -658,13 +658,11 @@ pub fn assemble(
 }
 
 /// `usize` → `f64` for counts (exact below 2^53; counts here are far smaller).
-#[allow(clippy::cast_precision_loss)]
 pub(crate) fn to_f64(x: usize) -> f64 {
     x as f64
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 

@@ -32,7 +32,6 @@ pub fn random_edges(
     };
     let want = (super::structure::to_f64(n) * mean_out_degree.max(0.0)).round();
     // `want` is a small non-negative integer-valued float (≤ 2000 · d).
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let m = (want as usize).min(max);
     let mut perm: Vec<usize> = (0..n).collect();
     perm.shuffle(&mut rng);

@@ -84,7 +84,6 @@ pub fn entropy_weights(fp1: &[f64], fp2: &[f64]) -> Option<[f64; 2]> {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 

@@ -2,7 +2,6 @@
 //! areas, and the area of the union of the cell polygons by rasterisation.
 
 // Raster and shoelace arithmetic in plain form; without a target FMA unit `mul_add` is a libm call.
-#![allow(clippy::suboptimal_flops)]
 
 /// Pixel edge of the union raster as a fraction of `L_ref` (spec 4.8 asks for <= L_ref/250; the
 /// finer pixel keeps the rasterisation error well under the 3 % validation tolerance).

@@ -3,7 +3,6 @@
 //! indeterminate straight-rod states, and the 2-norm condition number.
 
 // Without a target FMA unit `f64::mul_add` is a libm call; plain arithmetic in the inner loops.
-#![allow(clippy::suboptimal_flops)]
 
 use nalgebra::{DMatrix, DVector};
 
@@ -100,7 +99,7 @@ impl Lu {
     }
 
     /// Solve `A x = b` in place (only meaningful when not singular).
-    #[allow(
+    #[expect(
         clippy::needless_range_loop,
         reason = "triangular solves read clearest with indices"
     )]

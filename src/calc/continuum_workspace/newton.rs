@@ -243,7 +243,7 @@ pub const CONTINUATION_STALL_WINDOW: usize = 10;
 /// continuation fails when a step of nominal / 2^8 does not converge.
 const MAX_HALVINGS: u32 = 8;
 
-#[allow(
+#[expect(
     clippy::too_many_arguments,
     reason = "the continuation's full context; grouping it would only rename it"
 )]

@@ -6,10 +6,10 @@
 //! sensitivities are integrated with the same RK4 stages as the state, so `S(1)` is the exact
 //! derivative of the discrete map and Newton converges quadratically.
 
-// Without a target FMA unit `f64::mul_add` is a libm call; in these inner loops it tripled the cost.
-#![allow(clippy::suboptimal_flops)]
-// The fdlibm sine/cosine constants are kept digit for digit as published.
-#![allow(clippy::excessive_precision)]
+#![expect(
+    clippy::excessive_precision,
+    reason = "the fdlibm sine/cosine constants are kept digit for digit as published"
+)]
 
 /// Rod constants that enter the ODE.
 #[derive(Debug, Clone, Copy)]

@@ -8,7 +8,6 @@
 //! generalised problem is reduced to a standard one.
 
 // Without a target FMA unit `f64::mul_add` is a libm call; plain arithmetic in the inner loops.
-#![allow(clippy::suboptimal_flops)]
 
 use nalgebra::DMatrix;
 
@@ -60,7 +59,7 @@ pub enum Tips<'a> {
 /// angles are scaled by `sqrt(h_i)` so that the mass is the identity, and the remaining
 /// constraints are removed by Householder reflections. What is left is a standard symmetric
 /// eigenproblem of size `NM - (2N - 3)`: no Cholesky factor and no generalised solve.
-#[allow(
+#[expect(
     clippy::needless_range_loop,
     reason = "Householder QR on a ragged row block reads clearest with indices"
 )]

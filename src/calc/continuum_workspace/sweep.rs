@@ -15,7 +15,6 @@
 
 // Interpolation and predictor formulas in plain form; without a target FMA unit `mul_add` is a
 // libm call per term.
-#![allow(clippy::suboptimal_flops)]
 
 use std::collections::BTreeMap;
 
@@ -380,7 +379,7 @@ enum Attempt {
 }
 
 /// March from an accepted node to the inputs `to` (spec 4.7 step control) and test the result.
-#[allow(
+#[expect(
     clippy::too_many_arguments,
     reason = "one call site; the arguments are the attempt's context"
 )]

@@ -664,11 +664,9 @@ impl Geometry {
     #[must_use]
     pub fn profile(&self, w: Wheel, n: usize) -> Vec<[f64; 2]> {
         // n ≤ PROFILE_POINTS_MAX (validated), so the usize → f64 conversions are exact.
-        #[allow(clippy::cast_precision_loss)]
         let nf = n as f64;
         (0..n)
             .map(|i| {
-                #[allow(clippy::cast_precision_loss)]
                 let t = TAU * (i as f64) / nf;
                 self.profile_point(w, t).contact
             })
@@ -686,7 +684,6 @@ fn offset(centre: [f64; 2], pitch: [f64; 2], d: f64) -> [f64; 2] {
 
 /// ρt_w as a function of c = cos φ: r2·(1 + χ² − 2χc)^{3/2} / D_w(c).
 // Written as in the spec for traceability; evaluated three times per geometry, not in a hot loop.
-#[allow(clippy::suboptimal_flops)]
 fn rho_t_of_cos(r2: f64, z2: f64, chi: f64, w: Wheel, c: f64) -> f64 {
     let q = (1.0 + chi * chi - 2.0 * chi * c).max(0.0);
     let d = match w {
@@ -703,7 +700,6 @@ fn rho_t_of_cos(r2: f64, z2: f64, chi: f64, w: Wheel, c: f64) -> f64 {
 /// at c* (when it lies in [−1, 1] with D_w(c*) > 0). The spec lists c = −1 and c*; c = 1 also counts when
 /// χ > Z2 (then the cam root is convex). `None` if ρt_w ≤ 0 everywhere.
 // Written as in the spec for traceability (closed forms of c*); not in a hot loop.
-#[allow(clippy::suboptimal_flops)]
 fn min_positive_rho_t(r2: f64, z2: f64, chi: f64, w: Wheel) -> Option<f64> {
     let c_star = match w {
         Wheel::Cam => (2.0 * z2 - 1.0 - (z2 - 2.0) * chi * chi) / ((z2 + 1.0) * chi),

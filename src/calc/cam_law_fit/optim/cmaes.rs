@@ -36,10 +36,8 @@ pub fn fold(v: f64) -> f64 {
 /// Default population size `4 + ⌊3 ln n⌋`.
 #[must_use]
 pub fn default_lambda(n: usize) -> usize {
-    #[allow(clippy::cast_precision_loss)]
     let nf = n.max(1) as f64;
     // Small positive value: the cast cannot wrap.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let extra = (3.0 * nf.ln()).floor() as usize;
     4 + extra
 }
@@ -58,11 +56,6 @@ pub struct CmaParams {
 /// One CMA-ES run from `x0` (free genes) with the given settings. Returns the best point of the
 /// run (folded genes) and why it stopped.
 // Hansen's default constants read best in their published form.
-#[allow(
-    clippy::too_many_lines,
-    clippy::similar_names,
-    clippy::suboptimal_flops
-)]
 pub fn run<M: CurveModel, R: Rng>(
     ctx: &mut Ctx<'_, M>,
     free: &FreeGenes,
@@ -79,11 +72,9 @@ pub fn run<M: CurveModel, R: Rng>(
     if n == 0 {
         return best;
     }
-    #[allow(clippy::cast_precision_loss)]
     let nf = n as f64;
     let lambda = p.lambda.max(2);
     let mu = lambda / 2;
-    #[allow(clippy::cast_precision_loss)]
     let raw: Vec<f64> = (1..=mu)
         .map(|i| ((mu as f64) + 0.5).ln() - (i as f64).ln())
         .collect();
@@ -96,7 +87,6 @@ pub fn run<M: CurveModel, R: Rng>(
     let cmu = (1.0 - c1).min(2.0 * (mueff - 2.0 + 1.0 / mueff) / ((nf + 2.0) * (nf + 2.0) + mueff));
     let damps = 1.0 + 2.0 * (((mueff - 1.0) / (nf + 1.0)).sqrt() - 1.0).max(0.0) + cs;
     let chi_n = nf.sqrt() * (1.0 - 1.0 / (4.0 * nf) + 1.0 / (21.0 * nf * nf));
-    #[allow(clippy::cast_precision_loss)]
     let hist_len = 10 + (30.0 * nf / lambda as f64).ceil() as usize;
 
     let mut mean = DVector::from_column_slice(x0);
@@ -166,7 +156,6 @@ pub fn run<M: CurveModel, R: Rng>(
         let bt_y = b.transpose() * &y_w;
         let inv_sqrt = &b * bt_y.component_div(&d);
         ps = (1.0 - cs) * &ps + (cs * (2.0 - cs) * mueff).sqrt() * inv_sqrt;
-        #[allow(clippy::cast_precision_loss)]
         let gen_f = generation as f64;
         let ps_norm = ps.norm();
         let hsig =

@@ -42,12 +42,10 @@ pub fn run<M: CurveModel>(
     }
     let size = (POPSIZE_PER_GENE * n).max(5);
     // Latin hypercube: one sample per stratum and gene, strata shuffled per gene.
-    #[allow(clippy::cast_precision_loss)]
     let seg = 1.0 / size as f64;
     let mut samples = vec![vec![0.0; n]; size];
     for (i, row) in samples.iter_mut().enumerate() {
         for v in row.iter_mut() {
-            #[allow(clippy::cast_precision_loss)]
             let lo = i as f64 * seg;
             *v = seg.mul_add(rng.random::<f64>(), lo);
         }
@@ -131,7 +129,6 @@ pub fn run<M: CurveModel>(
             return finish(ctx, StopReason::Converged);
         }
         if fit.iter().all(|f| f.is_finite()) {
-            #[allow(clippy::cast_precision_loss)]
             let nf = size as f64;
             let mean = fit.iter().sum::<f64>() / nf;
             let var = fit.iter().map(|f| (f - mean) * (f - mean)).sum::<f64>() / nf;

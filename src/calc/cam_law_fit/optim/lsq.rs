@@ -226,7 +226,6 @@ pub fn run_with<M: CurveModel>(
     let cap = opts.cap;
     let data_scale = ctx.data().iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let n_data = ctx.data().len();
-    #[allow(clippy::cast_precision_loss)]
     let ctx_rms = (ctx.data().iter().map(|v| v * v).sum::<f64>() / n_data.max(1) as f64).sqrt();
     let x0 = DVector::from_iterator(free.len(), free.0.iter().map(|&k| start[k].max(0.0).sqrt()));
     let problem = Problem {

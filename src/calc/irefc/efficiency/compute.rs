@@ -109,7 +109,6 @@ pub struct EfficiencyOutput {
 }
 
 /// Loss of one element in `model` (spec step 5). `r` [N], `l` [m]; returns (vs, ωb, Ω_A, Ω_B, NSA, NSB).
-#[allow(clippy::too_many_arguments)]
 fn element_loss(
     g: &Geometry,
     model: EfficiencyModel,

@@ -274,9 +274,7 @@ pub fn grid_phi(j: usize, n: usize) -> f64 {
         PI
     } else {
         // j < n ≤ 2e6: exact in f64.
-        #[allow(clippy::cast_precision_loss)]
-        let v = j as f64 * PI / n as f64;
-        v
+        j as f64 * PI / n as f64
     }
 }
 
@@ -521,7 +519,6 @@ fn scan(
                 // Phase fraction that puts an element at φ_j = jπ/N: frac(j·Z2/(2N)), exact in integers.
                 let num = ((j0 + i) * z2) % (2 * n);
                 // num < 2N ≤ 4e6: exact in f64.
-                #[allow(clippy::cast_precision_loss)]
                 let p = num as f64 / (2 * n) as f64;
                 let q = g.sum_sin2(p);
                 v_cam[i] /= q;
@@ -550,7 +547,6 @@ fn scan(
 /// overflow nor underflow) and divides once: a/m_cam = a·m_crown/(m_cam·m_crown). Plain `a * b + c`
 /// instead of `mul_add`: without the `fma` target feature `mul_add` is a libm call, which is slower and
 /// stops the loop from vectorising.
-#[allow(clippy::suboptimal_flops)]
 fn scan_kernel(
     g: &Geometry,
     sin: &[f64],

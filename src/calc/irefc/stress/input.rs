@@ -143,7 +143,6 @@ pub enum StressInput {
 pub fn chi_values(from: f64, to: f64, step: f64, max: u64) -> Option<Vec<f64>> {
     let approx = ((to - from + CHI_RANGE_TOL) / step).floor() + 1.0;
     // `max` ≤ 1e5 is exactly representable in f64.
-    #[allow(clippy::cast_precision_loss)]
     let maxf = max as f64;
     if !(approx.is_finite() && approx <= maxf + 1.0) {
         return None;
@@ -151,7 +150,6 @@ pub fn chi_values(from: f64, to: f64, step: f64, max: u64) -> Option<Vec<f64>> {
     let mut v = Vec::new();
     for i in 0..=max {
         // i ≤ 1e5: exact in f64.
-        #[allow(clippy::cast_precision_loss)]
         let c = step.mul_add(i as f64, from);
         if c > to + CHI_RANGE_TOL {
             break;
@@ -214,7 +212,6 @@ impl StressInput {
                 );
             } else {
                 // 18 ≤ n ≤ 2e6 here: the conversion is exact.
-                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
                 {
                     n_intervals = n as usize;
                 }
@@ -443,7 +440,6 @@ impl StressInput {
                     );
                 } else {
                     // combos ≤ 1e5, n_intervals ≤ 2e6: both exact in f64.
-                    #[allow(clippy::cast_precision_loss)]
                     let work = combos as f64 * (n_intervals as f64 + 1.0);
                     if work > SWEEP_WORK_MAX {
                         is.push(
