@@ -26,9 +26,9 @@ use mechcalc::calc::cam_law_fit::compute::{LawModel, Settings, fit};
 use mechcalc::calc::cam_law_fit::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
 use mechcalc::calc::cam_law_fit::optim::ga::GaParams;
 use mechcalc::calc::cam_law_fit::optim::normalized;
-use mechcalc::calc::cam_law_fit::prep::grid;
 use mechcalc::calc::cam_law_fit::wire::Method;
 use mechcalc::numerics::Budget;
+use mechcalc::numerics::grid::linspace;
 
 #[path = "../tests/support/cam_table1.rs"]
 mod cam_table1;
@@ -68,7 +68,7 @@ struct Case {
 }
 
 fn law_case(name: &'static str, c: [f64; 7], q: Quantity, metric: Metric) -> Case {
-    let xs = grid(0.0, 1.0, 300);
+    let xs = linspace(0.0, 1.0, 300);
     let law = SevenSegmentLaw::try_new(&c, &BoundaryConditions::UNIT_RISE).expect("law");
     let mut y = vec![0.0; 300];
     law.eval_quantity_into(&xs, q, &mut y);
@@ -84,7 +84,7 @@ fn law_case(name: &'static str, c: [f64; 7], q: Quantity, metric: Metric) -> Cas
 }
 
 fn poly_case(name: &'static str, law: NamedLaw, q: Quantity, metric: Metric, f_star: f64) -> Case {
-    let xs = grid(0.0, 1.0, 300);
+    let xs = linspace(0.0, 1.0, 300);
     Case {
         name,
         bc: BoundaryConditions::UNIT_RISE,
@@ -287,7 +287,7 @@ struct RunStats {
 }
 
 fn run_case(case: &Case, s: &Settings) -> RunStats {
-    let xs = grid(0.0, 1.0, case.data.len());
+    let xs = linspace(0.0, 1.0, case.data.len());
     let budget = || Budget::unlimited().with_max_evaluations(50_000);
     let model = LawModel {
         xs: &xs,
@@ -423,7 +423,7 @@ fn ga_error_vs_time(seeds: u64) {
         "\n### Paper GA on the Table-1 case: max coefficient error of the best-so-far vs time (median of {seeds} seeds)\n"
     );
     let case = &cases()[0];
-    let xs = grid(0.0, 1.0, 300);
+    let xs = linspace(0.0, 1.0, 300);
     let marks = [0.05, 0.1, 0.2, 0.4, 0.8, 1.6];
     let mut per_mark: Vec<Vec<f64>> = vec![Vec::new(); marks.len()];
     for seed in 0..seeds {
@@ -506,7 +506,7 @@ fn auto_fit(
     snap: f64,
     restarts: u32,
 ) -> (f64, u64) {
-    let xs = grid(bc.t_a, bc.t_b, n);
+    let xs = linspace(bc.t_a, bc.t_b, n);
     let law = SevenSegmentLaw::try_new(c, bc).expect("law");
     let mut y = vec![0.0; n];
     law.eval_quantity_into(&xs, q, &mut y);
@@ -620,7 +620,7 @@ fn knob_tables() {
     );
     println!("| objective | median µs/evaluation | worst µs/evaluation |");
     println!("|---|---|---|");
-    let xs = grid(0.0, 1.0, 300);
+    let xs = linspace(0.0, 1.0, 300);
     let law = SevenSegmentLaw::try_new(&TABLE1_C, &TABLE1_BC).expect("law");
     let mut data = vec![0.0; 300];
     law.eval_quantity_into(&xs, Quantity::A, &mut data);
@@ -672,7 +672,7 @@ fn knob_tables() {
         let mut secs = Vec::new();
         let mut evs = Vec::new();
         for seed in 0..6 {
-            let xs = grid(0.0, 1.0, 300);
+            let xs = linspace(0.0, 1.0, 300);
             let model = LawModel {
                 xs: &xs,
                 bc: case.bc,
@@ -715,7 +715,7 @@ fn knob_tables() {
             let mut s = settings(VARIANTS[0], seed, 0);
             s.ga.population = pop;
             s.ga.generations = gens;
-            let xs = grid(0.0, 1.0, 300);
+            let xs = linspace(0.0, 1.0, 300);
             let model = LawModel {
                 xs: &xs,
                 bc: case.bc,
@@ -781,7 +781,7 @@ fn benches(c: &mut Criterion) {
     }
     g.finish();
     let mut g = c.benchmark_group("cam_law_fit/objective_n300");
-    let xs = grid(0.0, 1.0, 300);
+    let xs = linspace(0.0, 1.0, 300);
     let law = SevenSegmentLaw::try_new(&TABLE1_C, &TABLE1_BC).expect("law");
     let mut data = vec![0.0; 300];
     law.eval_quantity_into(&xs, Quantity::A, &mut data);

@@ -579,7 +579,7 @@ fn modes_table() {
                     let g = pose(got);
                     (g[0] - w[0]).abs() < 1e-6
                         && (g[1] - w[1]).abs() < 1e-6
-                        && fk::wrap_pi(g[2] - w[2]).abs() < 1e-6
+                        && mechcalc::numerics::angles::wrap_pi(g[2] - w[2]).abs() < 1e-6
                 })
             })
             .count();

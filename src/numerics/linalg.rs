@@ -105,38 +105,6 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
         .then_some(v)
 }
 
-/// A root of `f` in `[lo, hi]` where `f(lo)` and `f(hi)` differ in sign (bisection to the last
-/// bit, at most 200 halvings); `None` without a sign change.
-pub fn bisect(mut f: impl FnMut(f64) -> f64, mut lo: f64, mut hi: f64) -> Option<f64> {
-    let (mut flo, fhi) = (f(lo), f(hi));
-    if flo == 0.0 {
-        return Some(lo);
-    }
-    if fhi == 0.0 {
-        return Some(hi);
-    }
-    if flo.signum() == fhi.signum() || !flo.is_finite() || !fhi.is_finite() {
-        return None;
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        let fm = f(mid);
-        if fm == 0.0 {
-            return Some(mid);
-        }
-        if fm.signum() == flo.signum() {
-            lo = mid;
-            flo = fm;
-        } else {
-            hi = mid;
-        }
-    }
-    Some(0.5 * (lo + hi))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,12 +141,5 @@ mod tests {
         assert!(
             (ev[0] + 1e6).abs() < 1e-6 && (ev[1] + 1e3).abs() < 1e-9 && (ev[2] + 1.0).abs() < 1e-12
         );
-    }
-
-    #[test]
-    fn bisect_finds_sqrt2() {
-        let r = bisect(|x| x * x - 2.0, 0.0, 2.0).expect("bracket");
-        assert!((r - 2.0_f64.sqrt()).abs() < 4e-16);
-        assert!(bisect(|x| x * x + 1.0, 0.0, 2.0).is_none());
     }
 }

@@ -4,11 +4,15 @@
 
 pub mod angles;
 pub mod budget;
+pub mod dense;
 pub mod elliptic;
+pub mod grid;
 pub mod linalg;
 pub mod parallel;
 pub mod pchip;
 pub mod quadrature;
+pub mod rng;
+pub mod roots;
 
 pub use budget::{Budget, SolverReport, StopReason};
 pub use parallel::{par_map, par_map_while};

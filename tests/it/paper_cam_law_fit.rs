@@ -13,9 +13,9 @@ use mechcalc::calc::cam_law::catalogue::{NamedLaw, TABLE3};
 use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
 use mechcalc::calc::cam_law::wire::Warning;
 use mechcalc::calc::cam_law_fit::objective::{Dtw, euclidean};
-use mechcalc::calc::cam_law_fit::prep;
 use mechcalc::calc::cam_law_fit::wire::FitCamLawResponse;
 use mechcalc::calc::cam_law_fit::{self, FitCamLawRequest};
+use mechcalc::numerics::grid;
 use mechcalc::numerics::{Budget, StopReason};
 use serde_json::{Value, json};
 
@@ -73,7 +73,7 @@ fn channel_name(q: Quantity) -> &'static str {
 /// uses the evaluator's own value convention at jumps, spec §3.2).
 fn law_samples(c: &[f64; 7], q: Quantity, n: usize) -> Vec<f64> {
     let law = SevenSegmentLaw::try_new(c, &BoundaryConditions::UNIT_RISE).expect("law");
-    let xs = prep::grid(0.0, 1.0, n);
+    let xs = grid::linspace(0.0, 1.0, n);
     let mut y = vec![0.0; n];
     law.eval_quantity_into(&xs, q, &mut y);
     y
@@ -138,7 +138,7 @@ fn p1_to_p6_table6_en_and_dtw_of_the_one_seventh_law() {
     let mut dtw = Dtw::new();
     for (law, linspace, en_ref, dtw_ref, en_paper, dtw_paper) in TABLE6 {
         let xs: Vec<f64> = if linspace {
-            prep::grid(0.0, 1.0, 300)
+            grid::linspace(0.0, 1.0, 300)
         } else {
             (0..300).map(|k| f64::from(k) / 300.0).collect()
         };
@@ -575,7 +575,7 @@ const POLY: [(NamedLaw, Quantity, &str, f64); 18] = [
 ];
 
 fn poly_fit(law: NamedLaw, q: Quantity, metric: &str, seed: u64) -> FitCamLawResponse {
-    let xs = prep::grid(0.0, 1.0, 300);
+    let xs = grid::linspace(0.0, 1.0, 300);
     let y: Vec<f64> = xs.iter().map(|x| law.eval_normalized(*x).get(q)).collect();
     let mut req = id_request(&y, q, metric);
     req["optimizer"] = json!({"method": "auto", "seed": seed, "dtw_global_restarts": 3, "max_evaluations": 200000});

@@ -7,7 +7,7 @@
 use mechcalc::calc::continuum_workspace::closed_form::elastica;
 use mechcalc::calc::continuum_workspace::model::{Model, Params};
 use mechcalc::calc::continuum_workspace::presets::Preset;
-use mechcalc::calc::continuum_workspace::{fk, modes, newton, rod, run, stability};
+use mechcalc::calc::continuum_workspace::{modes, newton, rod, run, stability};
 use mechcalc::numerics::Budget;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -349,7 +349,7 @@ fn wave_agrees_with_per_node_mode_search() {
             let q = model.position(&s.solution.v);
             (q[0] - px).abs() < 1e-6
                 && (q[1] - py).abs() < 1e-6
-                && fk::wrap_pi(model.angle(&s.solution.v) - th).abs() < 1e-6
+                && mechcalc::numerics::angles::wrap_pi(model.angle(&s.solution.v) - th).abs() < 1e-6
         });
         if hit {
             found += 1;

@@ -9,8 +9,9 @@
 use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
 use mechcalc::calc::cam_law_fit::compute::LawModel;
 use mechcalc::calc::cam_law_fit::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
-use mechcalc::calc::cam_law_fit::{self, FitCamLawRequest, prep};
+use mechcalc::calc::cam_law_fit::{self, FitCamLawRequest};
 use mechcalc::numerics::Budget;
+use mechcalc::numerics::grid;
 use proptest::prelude::*;
 use serde_json::json;
 
@@ -68,7 +69,7 @@ fn quantity() -> impl Strategy<Value = Quantity> {
 }
 
 fn samples(c: &[f64; 7], bc: &BoundaryConditions, q: Quantity, n: usize) -> (Vec<f64>, Vec<f64>) {
-    let xs = prep::grid(bc.t_a, bc.t_b, n);
+    let xs = grid::linspace(bc.t_a, bc.t_b, n);
     let law = SevenSegmentLaw::try_new(c, bc).expect("law");
     let mut y = vec![0.0; n];
     law.eval_quantity_into(&xs, q, &mut y);
@@ -165,7 +166,7 @@ proptest! {
         let mut xs = vec![0.0];
         for h in steps { xs.push(xs[xs.len() - 1] + h); }
         let y: Vec<f64> = xs.iter().map(|x| a * x * x + b * x).collect();
-        for (d, x) in prep::gradient(&y, &xs).iter().zip(&xs) {
+        for (d, x) in grid::gradient(&y, &xs).iter().zip(&xs) {
             let exact = 2.0f64.mul_add(a * x, b);
             prop_assert!((d - exact).abs() <= 1e-9 * (1.0 + exact.abs()), "{d} vs {exact}");
         }

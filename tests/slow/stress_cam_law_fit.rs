@@ -8,8 +8,9 @@
 #![allow(clippy::suboptimal_flops)]
 
 use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
-use mechcalc::calc::cam_law_fit::{self, FitCamLawRequest, FitCamLawResponse, prep};
+use mechcalc::calc::cam_law_fit::{self, FitCamLawRequest, FitCamLawResponse};
 use mechcalc::calc::{CalcFailure, ProblemClass};
+use mechcalc::numerics::grid;
 use mechcalc::numerics::{Budget, StopReason};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -86,7 +87,7 @@ fn request(xs: &[f64], name: &str, y: &[f64], bc: &BoundaryConditions) -> Value 
 #[test]
 fn degenerate_generating_and_initial_coefficients() {
     let bc = BoundaryConditions::UNIT_RISE;
-    let xs = prep::grid(0.0, 1.0, 64);
+    let xs = grid::linspace(0.0, 1.0, 64);
     let vectors: [[f64; 7]; 6] = [
         [1e-6, 0.0, 0.0, 1.0, 0.0, 0.0, 1e-6],
         [0.0, 1.0, 0.0, 0.0, 0.0, 1e-9, 0.0],
@@ -127,7 +128,7 @@ fn degenerate_generating_and_initial_coefficients() {
 #[test]
 fn extreme_end_conditions_and_scales() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let xs01 = prep::grid(0.0, 1.0, 40);
+    let xs01 = grid::linspace(0.0, 1.0, 40);
     for &rate in &[0.0, 1.0, -1.0, 1e3, -1e6, 1e11, 1e12] {
         for &(t_a, dt, ds) in &[
             (0.0, 1.0, 1.0),
@@ -165,7 +166,7 @@ fn sample_counts_from_8_to_200000() {
     let bc = BoundaryConditions::UNIT_RISE;
     let c = [0.1, 0.2, 0.1, 0.2, 0.1, 0.2, 0.1];
     for n in [8usize, 9, 50, 2_000, 200_000] {
-        let xs = prep::grid(0.0, 1.0, n);
+        let xs = grid::linspace(0.0, 1.0, n);
         let y = law_data(&c, &bc, Quantity::A, &xs).expect("law");
         let mut v = json!({
             "abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": n}},
@@ -258,10 +259,10 @@ fn non_uniform_abscissae() {
         let _ = run(&v, &Budget::unlimited());
     }
     // Samples a hair outside [t_a, t_b] (inside 1e-9·Δt) are clamped and accepted.
-    let mut xs = prep::grid(2.0, 5.0, 20);
+    let mut xs = grid::linspace(2.0, 5.0, 20);
     xs[0] = 2.0 - 1e-10;
     xs[19] = 5.0 + 1e-10;
-    let y = law_data(&c, &bc, Quantity::A, &prep::grid(2.0, 5.0, 20)).expect("law");
+    let y = law_data(&c, &bc, Quantity::A, &grid::linspace(2.0, 5.0, 20)).expect("law");
     run(&request(&xs, "acceleration", &y, &bc), &Budget::unlimited())
         .expect("clamped samples accepted");
 }
@@ -269,7 +270,7 @@ fn non_uniform_abscissae() {
 #[test]
 fn constant_and_noisy_data_every_method_and_metric() {
     let bc = BoundaryConditions::UNIT_RISE;
-    let xs = prep::grid(0.0, 1.0, 30);
+    let xs = grid::linspace(0.0, 1.0, 30);
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let clean = law_data(
         &[0.125, 0.25, 0.125, 0.0, 0.125, 0.25, 0.125],
@@ -323,7 +324,7 @@ fn constant_and_noisy_data_every_method_and_metric() {
 #[test]
 fn one_evaluation_and_one_millisecond_budgets() {
     let bc = BoundaryConditions::UNIT_RISE;
-    let xs = prep::grid(0.0, 1.0, 2_000);
+    let xs = grid::linspace(0.0, 1.0, 2_000);
     let y = law_data(&[0.1, 0.2, 0.1, 0.2, 0.1, 0.2, 0.1], &bc, Quantity::A, &xs).expect("law");
     for method in METHODS {
         for metric in ["euclidean", "dtw"] {
@@ -359,7 +360,7 @@ fn one_evaluation_and_one_millisecond_budgets() {
 #[test]
 fn fixed_zero_windows_and_options() {
     let bc = BoundaryConditions::UNIT_RISE;
-    let xs = prep::grid(0.0, 1.0, 60);
+    let xs = grid::linspace(0.0, 1.0, 60);
     let y = law_data(
         &[0.125, 0.0, 0.375, 0.0, 0.375, 0.0, 0.125],
         &bc,
@@ -428,7 +429,7 @@ fn early_snap_trap_regression_random_law_with_end_rates() {
         a_a: 66359.01761976283,
         a_b: 12861.087767276851,
     };
-    let xs = prep::grid(bc.t_a, bc.t_b, 200);
+    let xs = grid::linspace(bc.t_a, bc.t_b, 200);
     let y = law_data(&truth, &bc, Quantity::V, &xs).expect("law");
     let mut v = request(&xs, "velocity", &y, &bc);
     v["optimizer"] = json!({});

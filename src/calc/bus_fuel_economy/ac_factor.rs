@@ -10,6 +10,8 @@
 
 use std::f64::consts::PI;
 
+use crate::numerics::grid::interp_clamped;
+
 /// Copper resistivity at 20 °C [Ω·m] (spec §5.5).
 pub const RHO_CU_20: f64 = 1.724e-8;
 /// Temperature coefficient of copper resistance [1/K] (spec §5.5).
@@ -122,24 +124,4 @@ impl AcFactor {
             }
         }
     }
-}
-
-/// Linear interpolation in a strictly increasing table, held constant outside.
-#[must_use]
-pub fn interp_clamped(xs: &[f64], ys: &[f64], x: f64) -> f64 {
-    let n = xs.len().min(ys.len());
-    if n == 0 {
-        return 0.0;
-    }
-    if x <= xs[0] {
-        return ys[0];
-    }
-    if x >= xs[n - 1] {
-        return ys[n - 1];
-    }
-    // xs[0] < x < xs[n-1]: the index is in 1..n.
-    let i = xs[..n].partition_point(|&v| v <= x);
-    let (x0, x1, y0, y1) = (xs[i - 1], xs[i], ys[i - 1], ys[i]);
-    let s = (x - x0) / (x1 - x0);
-    y0 + (y1 - y0) * s
 }

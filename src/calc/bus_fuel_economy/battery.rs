@@ -5,7 +5,7 @@
 // baseline) `mul_add` is a libm call, ~10x slower in these per-interval loops, and plain
 // arithmetic follows the rounding of the spec's reference implementation.
 
-use super::ac_factor::interp_clamped;
+use crate::numerics::grid::interp_clamped;
 
 /// Battery model in SI units.
 #[derive(Debug, Clone)]

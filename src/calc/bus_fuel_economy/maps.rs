@@ -196,7 +196,7 @@ impl Envelope {
                     *t_peak
                 }
             }
-            Self::Table { speed, t_max } => super::ac_factor::interp_clamped(speed, t_max, w),
+            Self::Table { speed, t_max } => crate::numerics::grid::interp_clamped(speed, t_max, w),
         }
     }
 

@@ -17,11 +17,11 @@ use super::optim::cmaes::{self, CmaParams, default_lambda};
 use super::optim::ga::{self, GaParams};
 use super::optim::lsq::{self, MAX_EVALS_PER_START};
 use super::optim::{FreeGenes, de, normalized};
-use super::prep;
 use super::wire::{
     ChannelErrors, Classification, ErrorTable, FitCamLawResponse, FitQuantity, Method, MetricName,
     ObjectiveOut, OptimizerReport,
 };
+use crate::numerics::grid;
 
 /// Zero entries of a Table-3 start are replaced by this before renormalizing (spec §3.5.2 step 1).
 const START_ZERO_FILL: f64 = 0.02;
@@ -675,7 +675,7 @@ pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, F
         }
     });
     let curves = if input.curve_count > 0 {
-        let xs = prep::grid(bc.t_a, bc.t_b, input.curve_count);
+        let xs = grid::linspace(bc.t_a, bc.t_b, input.curve_count);
         let mut c = Curves {
             x: xs.clone(),
             s: None,

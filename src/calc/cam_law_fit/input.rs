@@ -6,10 +6,10 @@ use crate::calc::cam_law::wire::{Units, Warning};
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
 use super::optim::ga::GaParams;
-use super::prep;
 use super::wire::{
     FitCamLawRequest, FitQuantity, MAX_CURVE_COUNT, MAX_SAMPLES, MIN_SAMPLES, Method, MetricName,
 };
+use crate::numerics::grid;
 
 /// Samples may lie this fraction of Δt outside `[t_a, t_b]` (they are clamped), spec §2.
 pub const ABSCISSA_TOL: f64 = 1e-9;
@@ -200,7 +200,7 @@ fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
             }
             // count ≤ 200 000 was just checked: the conversion cannot fail.
             let count = usize::try_from(g.count).ok()?;
-            let xs = prep::grid(g.start, g.end, count);
+            let xs = grid::linspace(g.start, g.end, count);
             if xs.windows(2).any(|w| w[1] <= w[0]) {
                 v.push(
                     "/abscissa/grid",
@@ -682,7 +682,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
             if channels[k].is_none()
                 && let Some(lower) = channels[k - 1].as_ref()
             {
-                channels[k] = Some(prep::gradient(lower, &xs));
+                channels[k] = Some(grid::gradient(lower, &xs));
                 derived[k] = true;
             }
         }

@@ -40,7 +40,6 @@ pub mod error;
 pub mod input;
 pub mod objective;
 pub mod optim;
-pub mod prep;
 pub mod wire;
 
 use std::time::Duration;

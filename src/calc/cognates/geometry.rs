@@ -50,15 +50,7 @@ pub fn cis(theta: f64) -> C64 {
     C64::new(c, s)
 }
 
-/// Wraps an angle to (−π, π].
-#[must_use]
-pub fn wrap_pi(theta: f64) -> f64 {
-    if theta > -PI && theta <= PI {
-        return theta;
-    }
-    let t = (theta + PI).rem_euclid(2.0 * PI) - PI;
-    if t <= -PI { t + 2.0 * PI } else { t }
-}
+pub use crate::numerics::angles::wrap_pi;
 
 /// Assembly branch or coupler side: a sign, `+1` or `−1` (spec §2: `t1`, `t2`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -307,7 +307,7 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 } else {
                     f64::MAX
                 },
-                cond: crate::calc::continuum_workspace::linalg::COND_CAP,
+                cond: crate::numerics::dense::COND_CAP,
                 newton_iterations: f.iterations,
                 total_iterations: total_iterations.max(f.iterations),
                 continuation_steps,

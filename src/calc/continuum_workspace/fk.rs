@@ -3,11 +3,11 @@
 
 use std::f64::consts::PI;
 
-use super::linalg;
 use super::model::{Model, Params};
 use super::newton::{self, ContinuationResult, Counter, Failed, NewtonOptions, Solution};
 use super::stability::{self, RodDisc, Tips};
 use crate::numerics::Budget;
+use crate::numerics::dense;
 
 /// Least-squares residual above which a design has no stress-free home (spec 4.3: 1e-9 L_ref).
 pub const HOME_REL_TOL: f64 = 1e-9;
@@ -271,7 +271,7 @@ pub fn describe(
 /// 2-norm condition number of the scaled Jacobian at a solution.
 #[must_use]
 pub fn condition(model: &Model, sol: &Solution) -> f64 {
-    linalg::cond2(&sol.eval.jac, model.n_unknowns())
+    dense::cond2(&sol.eval.jac, model.n_unknowns())
 }
 
 /// Indices of rods whose chord exceeds `TAUT_CHORD` of their length at `v`.
@@ -287,11 +287,4 @@ pub fn taut_rods(model: &Model, p: &Params, v: &[f64]) -> Vec<usize> {
             chord > TAUT_CHORD * model.design.rods[i].length
         })
         .collect()
-}
-
-/// Wrap an angle to (-pi, pi].
-#[must_use]
-pub fn wrap_pi(t: f64) -> f64 {
-    let w = (t + PI).rem_euclid(2.0 * PI) - PI;
-    if w <= -PI { 2.0f64.mul_add(PI, w) } else { w }
 }

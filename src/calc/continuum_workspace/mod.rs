@@ -58,7 +58,6 @@ pub mod compute;
 pub mod error;
 pub mod fk;
 pub mod input;
-pub mod linalg;
 pub mod model;
 pub mod modes;
 pub mod newton;
@@ -84,6 +83,7 @@ use self::wire::{
     RodRequest, SeedOut, SolverState, StabilityOut, WaveOut, WorkspaceResponse,
 };
 use crate::calc::CalcFailure;
+use crate::numerics::angles::wrap_pi;
 use crate::numerics::{Budget, SolverReport, StopReason};
 
 /// Validate, compute and build the wire response (called on the blocking pool).
@@ -174,7 +174,7 @@ fn platform(pos: [f64; 2], angle: f64) -> PlatformOut {
 
 /// Wrap an angle [rad] to (-180, 180] deg.
 fn wrap_deg(t: f64) -> f64 {
-    let d = fk::wrap_pi(t).to_degrees();
+    let d = wrap_pi(t).to_degrees();
     if d <= -180.0 { d + 360.0 } else { d }
 }
 

@@ -6,6 +6,8 @@
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
+use crate::numerics::angles::wrap_pi;
+
 use super::closed_form::{self, c_of};
 use super::fk::{self, STABLE_MARGIN};
 use super::model::{Model, Params, cross, rot};
@@ -317,7 +319,7 @@ pub fn search(
         match newton::solve(model, params, &v0, opts, budget, counter) {
             Ok(mut sol) => {
                 let th = &mut sol.v[3 * nr + 2];
-                *th = fk::wrap_pi(*th);
+                *th = wrap_pi(*th);
                 let dup = solutions.iter().any(|s| {
                     s.solution
                         .v
@@ -326,7 +328,7 @@ pub fn search(
                         .enumerate()
                         .all(|(k, (a, b))| {
                             let d = if k == 3 * nr + 2 {
-                                fk::wrap_pi(a - b)
+                                wrap_pi(a - b)
                             } else {
                                 a - b
                             };

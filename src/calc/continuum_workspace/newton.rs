@@ -1,8 +1,8 @@
 //! Newton's method on the full FK residual with backtracking (spec 4.2), the tangent predictor and
 //! the home continuation (spec 4.3).
 
-use super::linalg::{self, Lu};
 use super::model::{Eval, Model, Params};
+use crate::numerics::dense::{self, Lu};
 use crate::numerics::{Budget, StopReason};
 
 /// Armijo constant of the backtracking line search (spec 4.2).
@@ -166,7 +166,7 @@ pub fn solve(
             });
         }
         let rhs: Vec<f64> = eval.g.iter().map(|x| -x).collect();
-        let (dv, _) = linalg::solve(&eval.jac, n, &rhs);
+        let (dv, _) = dense::solve(&eval.jac, n, &rhs);
         let mut t = 1.0;
         let mut accepted = None;
         while t >= MIN_STEP {
@@ -215,7 +215,7 @@ pub fn solve(
 pub fn tangent(sol: &Solution, n: usize, dg_ds: &[f64]) -> Vec<f64> {
     let rhs: Vec<f64> = dg_ds.iter().map(|x| -x).collect();
     if sol.lu.is_singular() {
-        linalg::min_norm_solve(&sol.eval.jac, n, &rhs)
+        dense::min_norm_solve(&sol.eval.jac, n, &rhs)
     } else {
         let mut x = rhs;
         sol.lu.solve_in_place(&mut x);

@@ -19,9 +19,9 @@
 use std::collections::BTreeMap;
 
 use super::fk::{self, STABLE_MARGIN};
-use super::linalg;
 use super::model::{Model, Params};
 use super::newton::{self, Counter, NewtonFailure, NewtonOptions, Solution};
+use crate::numerics::dense;
 use crate::numerics::{Budget, StopReason, par_map};
 
 /// Sub-step solves give up when the residual has not halved over this many iterations: from the
@@ -310,7 +310,7 @@ pub fn accept(
     parent_det: Option<i8>,
 ) -> Result<NodeData, NodeStatus> {
     let n = model.n_unknowns();
-    let cond = linalg::cond2(&sol.eval.jac, n);
+    let cond = dense::cond2(&sol.eval.jac, n);
     if cond.is_nan() || cond > s.cond_max {
         return Err(NodeStatus::Singular);
     }

@@ -43,7 +43,6 @@
 //!   gives η ≤ 1 for every μ, f_s ≥ 0; with the paper's μ = 1 mm it predicts η ≈ 0.37, so the paper's
 //!   η = 0.93 depends on its reduced relative speeds.
 
-pub mod brent;
 pub mod efficiency;
 pub mod error;
 pub mod geometry;

@@ -1,8 +1,8 @@
 //! Seeded random streams of the module: one ChaCha8 stream per purpose, so that e.g. adding
 //! k-fold CV does not change the column samples of the main model.
 
+use rand::Rng;
 use rand::seq::SliceRandom;
-use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// The stream of the train/test permutation.
@@ -16,13 +16,7 @@ pub const STREAM_SMOGN: u64 = 4;
 /// The stream of the SHAP-summary row sample.
 pub const STREAM_SHAP_ROWS: u64 = 5;
 
-/// The generator of `purpose` for `seed`.
-#[must_use]
-pub fn stream(seed: u64, purpose: u64) -> ChaCha8Rng {
-    let mut r = ChaCha8Rng::seed_from_u64(seed);
-    r.set_stream(purpose);
-    r
-}
+pub use crate::numerics::rng::{normal, stream};
 
 /// A uniformly random permutation of `0..n`.
 #[must_use]
@@ -40,14 +34,6 @@ pub fn sample_sorted(rng: &mut ChaCha8Rng, n: usize, k: usize) -> Vec<usize> {
     let mut v = rand::seq::index::sample(rng, n, k.min(n)).into_vec();
     v.sort_unstable();
     v
-}
-
-/// A standard normal deviate (Box–Muller; `u1` in (0, 1] so the logarithm is finite).
-#[must_use]
-pub fn normal(rng: &mut ChaCha8Rng) -> f64 {
-    let u1 = 1.0 - rng.random::<f64>();
-    let u2 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// A uniform deviate in [0, 1).

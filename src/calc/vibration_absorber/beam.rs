@@ -1,7 +1,7 @@
 //! Euler–Bernoulli cantilever modes (spec §3.A): roots of the frequency equation, overflow-safe
 //! mode shapes normalised to `∫₀ᴸ φ² dx = L`, and their nodes.
 
-use crate::numerics::linalg::bisect;
+use crate::numerics::roots::bisect;
 
 /// `β_k L`, the k-th root (k ≥ 1) of `1 + cos x cosh x = 0`, solved as `cos x + 1/cosh x = 0`
 /// (the same roots, no overflow) by bisection in `[g − ½, g + ½]`, `g = (2k − 1)π/2`, which holds

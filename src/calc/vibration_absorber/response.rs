@@ -5,7 +5,8 @@
 use nalgebra::{Complex, DMatrix, DVector};
 
 use super::error::VibrationAbsorberError as Error;
-use crate::numerics::linalg::{bisect, eigenvalues, expm};
+use crate::numerics::linalg::{eigenvalues, expm};
+use crate::numerics::roots::bisect;
 use crate::numerics::{Budget, par_map_while};
 
 /// Relative distance `|jω − λ| / max(|λ|max, ω)` below which `jωI − A` is treated as singular.

@@ -10,8 +10,6 @@ pub mod de;
 pub mod ga;
 pub mod lsq;
 
-use rand::Rng;
-
 use super::objective::{Ctx, CurveModel};
 use crate::numerics::StopReason;
 
@@ -77,13 +75,7 @@ pub struct RunEnd {
     pub g: [f64; 7],
 }
 
-/// A standard normal deviate (Box–Muller; two uniforms per call so the draw order is fixed).
-pub fn normal<R: Rng>(rng: &mut R) -> f64 {
-    // 1 − U(0,1) ∈ (0, 1]: the logarithm stays finite.
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-}
+pub use crate::numerics::rng::normal;
 
 /// Evaluate `g`, returning `None` when the budget refuses.
 pub(crate) fn eval<M: CurveModel>(ctx: &mut Ctx<'_, M>, g: &[f64; 7]) -> Option<f64> {

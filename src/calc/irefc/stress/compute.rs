@@ -7,9 +7,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::input::{Design, StressParams, SweepInput};
 use super::wire::{LoadSharing, OutputLink};
-use crate::calc::irefc::brent;
 use crate::calc::irefc::error::IrefcError;
 use crate::calc::irefc::geometry::{AnglePoint, Geometry, Trig, Wheel};
+use crate::numerics::roots;
 use crate::numerics::{Budget, StopReason, par_map_while};
 
 /// Refinement stops when the bracket half-width is below this [rad] (spec step 6).
@@ -641,7 +641,7 @@ fn finish_wheel(
                     continue;
                 }
                 let mut cusp = false;
-                let r = brent::maximize(
+                let r = roots::maximize(
                     |phi| {
                         let s = st.sample_at(phi);
                         if s.margin <= 0.0 {

@@ -1,5 +1,39 @@
-//! Bounded 1-D maximisation (Brent's method: golden section with parabolic steps; R. P. Brent,
-//! "Algorithms for Minimization without Derivatives", 1973, ch. 5, procedure `localmin`).
+//! One-dimensional roots and extrema: bracketed bisection to the last bit ([`bisect`]) and
+//! bounded maximisation by Brent's method ([`maximize`]: golden section with parabolic steps;
+//! R. P. Brent, "Algorithms for Minimization without Derivatives", 1973, ch. 5, procedure
+//! `localmin`).
+
+/// A root of `f` in `[lo, hi]` where `f(lo)` and `f(hi)` differ in sign (bisection to the last
+/// bit, at most 200 halvings); `None` without a sign change.
+pub fn bisect(mut f: impl FnMut(f64) -> f64, mut lo: f64, mut hi: f64) -> Option<f64> {
+    let (mut flo, fhi) = (f(lo), f(hi));
+    if flo == 0.0 {
+        return Some(lo);
+    }
+    if fhi == 0.0 {
+        return Some(hi);
+    }
+    if flo.signum() == fhi.signum() || !flo.is_finite() || !fhi.is_finite() {
+        return None;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        let fm = f(mid);
+        if fm == 0.0 {
+            return Some(mid);
+        }
+        if fm.signum() == flo.signum() {
+            lo = mid;
+            flo = fm;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
 
 /// Result of [`maximize`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,6 +155,13 @@ pub fn maximize(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bisect_finds_sqrt2() {
+        let r = bisect(|x| x * x - 2.0, 0.0, 2.0).expect("bracket");
+        assert!((r - 2.0_f64.sqrt()).abs() < 4e-16);
+        assert!(bisect(|x| x * x + 1.0, 0.0, 2.0).is_none());
+    }
 
     #[test]
     fn finds_parabola_max() {

@@ -1,11 +1,12 @@
-//! Data preparation (spec §3.3): the abscissa grid and the numerical derivative used to derive a
-//! missing channel.
+//! Grids, finite-difference derivatives and table interpolation: the uniform grid and numpy's
+//! second-order `gradient` (the motion-law fit derives a missing channel with them, its spec §3.3),
+//! and clamped linear interpolation in a tabulated curve (battery OCV, motor envelopes, AC factors).
 
 /// The uniform grid `x_k = start + k·(end − start)/(count − 1)`, `k = 0..count−1` (spec §2).
 ///
 /// The last point is pinned to `end` exactly, as numpy's `linspace` does.
 #[must_use]
-pub fn grid(start: f64, end: f64, count: usize) -> Vec<f64> {
+pub fn linspace(start: f64, end: f64, count: usize) -> Vec<f64> {
     match count {
         0 => Vec::new(),
         1 => vec![start],
@@ -82,13 +83,33 @@ pub fn gradient(y: &[f64], x: &[f64]) -> Vec<f64> {
     out
 }
 
+/// Linear interpolation in a strictly increasing table, held constant outside.
+#[must_use]
+pub fn interp_clamped(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+    let n = xs.len().min(ys.len());
+    if n == 0 {
+        return 0.0;
+    }
+    if x <= xs[0] {
+        return ys[0];
+    }
+    if x >= xs[n - 1] {
+        return ys[n - 1];
+    }
+    // xs[0] < x < xs[n-1]: the index is in 1..n.
+    let i = xs[..n].partition_point(|&v| v <= x);
+    let (x0, x1, y0, y1) = (xs[i - 1], xs[i], ys[i - 1], ys[i]);
+    let s = (x - x0) / (x1 - x0);
+    y0 + (y1 - y0) * s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn grid_pins_both_ends() {
-        let xs = grid(0.0, 1.0, 300);
+        let xs = linspace(0.0, 1.0, 300);
         assert_eq!(xs.len(), 300);
         assert!(xs[0].abs() < 1e-300 && (xs[299] - 1.0).abs() < 1e-300);
         assert!(xs.windows(2).all(|w| w[1] > w[0]));
@@ -96,7 +117,7 @@ mod tests {
 
     #[test]
     fn gradient_is_exact_on_quadratics_uniform_and_not() {
-        let xs = grid(0.0, 2.0, 11);
+        let xs = linspace(0.0, 2.0, 11);
         let y: Vec<f64> = xs.iter().map(|x| 3.0 * x * x - x + 2.0).collect();
         for (d, x) in gradient(&y, &xs).iter().zip(&xs) {
             assert!((d - (6.0 * x - 1.0)).abs() < 1e-12, "{d} at {x}");

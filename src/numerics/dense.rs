@@ -1,4 +1,5 @@
-//! Small dense linear algebra on row-major `Vec<f64>` matrices: LU with partial pivoting (with the
+//! Small dense linear algebra on row-major `Vec<f64>` matrices (written for the continuum-workspace
+//! FK Jacobians, general for any square system): LU with partial pivoting (with the
 //! determinant sign the stability companion test needs), minimum-norm solves for the statically
 //! indeterminate straight-rod states, and the 2-norm condition number.
 
