@@ -9,8 +9,12 @@ mod client;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use client::{Server, get, post, rss_kib};
+use client::{Server, cpu_seconds, get, post, rss_kib, thread_count};
 use serde_json::{Value, json};
+
+/// The scenarios run one at a time: each starts its own server and floods it, and two floods at
+/// once on a 2-core machine would measure each other.
+static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
 
 fn scale() -> usize {
     std::env::var("MECHCALC_LOAD_SCALE")
@@ -62,6 +66,7 @@ fn metric(text: &str, name_and_labels: &str) -> f64 {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn idle_and_slowloris_connections_cannot_take_the_service_down() {
+    let _serial = SERIAL.lock().await;
     client::raise_fd_limit();
     let server = Server::start(&[("MECHCALC_HEADER_TIMEOUT_MS", "1500")]).await;
     let n_idle = 2000 * scale();
@@ -115,6 +120,7 @@ async fn idle_and_slowloris_connections_cannot_take_the_service_down() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn cheap_requests_are_served_during_a_flood_of_sweeps() {
+    let _serial = SERIAL.lock().await;
     let server = Server::start(&[("MECHCALC_QUEUE_DEPTH", "64")]).await;
     // Teach the pool what the cheap route costs.
     for _ in 0..5 {
@@ -180,8 +186,61 @@ async fn cheap_requests_are_served_during_a_flood_of_sweeps() {
     server.stop().await;
 }
 
+/// The compute pool bounds the CPU: with one compute thread, a flood of parallel sweeps (each of
+/// which would use every core it were given) keeps the process at about one core, and the
+/// process does not grow a thread per job.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_flood_of_sweeps_stays_within_the_configured_compute_threads() {
+    let _serial = SERIAL.lock().await;
+    let server = Server::start(&[
+        ("MECHCALC_COMPUTE_THREADS", "1"),
+        ("MECHCALC_COMPUTE_SLOTS", "4"),
+        ("MECHCALC_QUEUE_DEPTH", "64"),
+    ])
+    .await;
+    let pid = server.pid();
+    let threads_idle = thread_count(pid);
+    let heavy_tasks: Vec<_> = (0..(6 * scale()))
+        .map(|_| {
+            let addr = server.addr;
+            tokio::spawn(async move { post(addr, "/v1/continuum-workspace", &heavy(2500)).await })
+        })
+        .collect();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let (cpu0, t0) = (cpu_seconds(pid), Instant::now());
+    let mut threads_busy = 0;
+    for _ in 0..15 {
+        tokio::time::sleep(Duration::from_millis(100)).await;
+        threads_busy = threads_busy.max(thread_count(pid));
+    }
+    let cores = (cpu_seconds(pid) - cpu0) / t0.elapsed().as_secs_f64();
+    eprintln!(
+        "one compute thread, 6 sweeps: {cores:.2} cores, threads {threads_idle} idle / {threads_busy} busy"
+    );
+    // One compute thread plus the async layer's decoding and bookkeeping; an unbounded sweep
+    // on this 2-core machine would show close to 2.
+    assert!(
+        cores < 1.35,
+        "the process used {cores:.2} cores with one compute thread"
+    );
+    assert!(
+        threads_busy <= threads_idle + 4,
+        "threads grew from {threads_idle} to {threads_busy} under the flood"
+    );
+    for t in heavy_tasks {
+        let r = t.await.expect("join").expect("answers");
+        assert!(
+            r.status == 200 || r.status == 503,
+            "heavy answered {}",
+            r.status
+        );
+    }
+    server.stop().await;
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_disconnected_client_frees_its_slot() {
+    let _serial = SERIAL.lock().await;
     let server = Server::start(&[]).await;
     let slots = get(server.addr, "/healthz").await.expect("ok").json()["compute_slots_free"]
         .as_u64()
@@ -230,6 +289,7 @@ async fn a_disconnected_client_frees_its_slot() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn slow_readers_are_dropped_and_memory_returns() {
+    let _serial = SERIAL.lock().await;
     let server = Server::start(&[("MECHCALC_WRITE_TIMEOUT_MS", "1000")]).await;
     let big = json!({"law": "modified_sine", "constraints": {"t_a": 0.0, "t_b": 1.0, "s_a": 0.0, "s_b": 1.0},
         "abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": 200_000}}, "quantities": ["s", "v", "a", "j"]});
@@ -263,6 +323,7 @@ async fn slow_readers_are_dropped_and_memory_returns() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn sigterm_during_work_exits_within_the_deadline() {
+    let _serial = SERIAL.lock().await;
     let server = Server::start(&[("MECHCALC_SHUTDOWN_GRACE_MS", "1000")]).await;
     let addr = server.addr;
     let work =
