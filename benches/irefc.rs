@@ -14,9 +14,11 @@
 #![allow(missing_docs)]
 
 use std::hint::black_box;
-use std::time::Instant;
 
 use criterion::{Criterion, criterion_group};
+
+#[path = "support/mod.rs"]
+mod support;
 use mechcalc::calc::irefc::efficiency::compute;
 use mechcalc::calc::irefc::efficiency::input::EfficiencyInput;
 use mechcalc::calc::irefc::stress::wire::{StressSingleResponse, StressSweepResponse};
@@ -81,8 +83,17 @@ fn sweep_req(step: f64, refine: bool) -> IrefcStressRequest {
     .expect("valid request")
 }
 
+/// The sweep with the default budget (every core of the machine).
 fn sweep(req: IrefcStressRequest) -> StressSweepResponse {
-    match run_stress(req, &Budget::unlimited()).expect("valid sweep") {
+    sweep_with(req, &Budget::unlimited())
+}
+
+fn sweep_on(req: IrefcStressRequest, threads: usize) -> StressSweepResponse {
+    sweep_with(req, &Budget::unlimited().with_threads(threads))
+}
+
+fn sweep_with(req: IrefcStressRequest, budget: &Budget) -> StressSweepResponse {
+    match run_stress(req, budget).expect("valid sweep") {
         IrefcStressResponse::Sweep(r) => r,
         IrefcStressResponse::Single(_) => unreachable!("sweep request"),
     }
@@ -100,18 +111,10 @@ fn eff(req: IrefcEfficiencyRequest) -> IrefcEfficiencyResponse {
     run_efficiency(req, &Budget::unlimited()).expect("feasible")
 }
 
-/// Median and worst of `reps` wall times of `f` [µs].
-fn time_us<T>(reps: usize, mut f: impl FnMut() -> T) -> (f64, f64) {
-    black_box(f());
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let s = Instant::now();
-            black_box(f());
-            s.elapsed().as_secs_f64() * 1e6
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    (t[t.len() / 2], t[t.len() - 1])
+/// Median and worst of `reps` wall times of `f` [µs] (the shared timing helper).
+fn time_us<T>(reps: usize, f: impl FnMut() -> T) -> (f64, f64) {
+    let (t, _) = support::time_runs(reps, f);
+    (t.median_us(), t.worst_us())
 }
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -227,6 +230,32 @@ fn sweep_table() {
     );
 }
 
+/// The sweep on 1 and 2 threads of the compute pool's budget: wall time, process CPU time, and
+/// whether the records are identical.
+fn threads_table() {
+    println!(
+        "\n### irefc stress: the 6541-combination sweep on 1 and 2 threads (default setting)\n"
+    );
+    let n = (reps() / 4).max(5);
+    let one = sweep_on(sweep_req(1.0, true), 1);
+    println!(
+        "| threads | median ms | worst ms | process CPU ms per run | records identical to 1 thread |"
+    );
+    println!("|---|---|---|---|---|");
+    for threads in [1, 2] {
+        let cpu0 = support::process_cpu_ms();
+        let (t, last) = support::time_runs(n, || sweep_on(sweep_req(1.0, true), threads));
+        let cpu = (support::process_cpu_ms() - cpu0) / (n + 1) as f64;
+        let same =
+            serde_json::to_value(&last.records).ok() == serde_json::to_value(&one.records).ok();
+        println!(
+            "| {threads} | {:.1} | {:.1} | {cpu:.1} | {same} |",
+            t.median_ms(),
+            t.worst_ms()
+        );
+    }
+}
+
 fn efficiency_table() {
     let n = reps();
     println!(
@@ -287,6 +316,7 @@ fn tables() {
     }
     stress_table();
     sweep_table();
+    threads_table();
     efficiency_table();
     println!();
 }
