@@ -208,14 +208,7 @@ pub async fn post_and_never_read(addr: SocketAddr, path: &'static str, body: Val
 
 /// Resident memory of a process [KiB].
 pub fn rss_kib(pid: u32) -> u64 {
-    std::fs::read_to_string(format!("/proc/{pid}/status"))
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find_map(|l| l.strip_prefix("VmRSS:"))
-                .and_then(|v| v.split_whitespace().next()?.parse().ok())
-        })
-        .unwrap_or(0)
+    status_field(pid, "VmRSS:")
 }
 
 /// CPU time a process has used so far (user + system) [s], from `/proc/<pid>/stat` (clock ticks
@@ -233,12 +226,17 @@ pub fn cpu_seconds(pid: u32) -> f64 {
 
 /// Threads of a process, from `/proc/<pid>/status`.
 pub fn thread_count(pid: u32) -> u64 {
+    status_field(pid, "Threads:")
+}
+
+/// The first number of a `/proc/<pid>/status` line (0 when absent).
+fn status_field(pid: u32, key: &str) -> u64 {
     std::fs::read_to_string(format!("/proc/{pid}/status"))
         .ok()
         .and_then(|s| {
             s.lines()
-                .find_map(|l| l.strip_prefix("Threads:"))
-                .and_then(|v| v.trim().parse().ok())
+                .find_map(|l| l.strip_prefix(key))
+                .and_then(|v| v.split_whitespace().next()?.parse().ok())
         })
         .unwrap_or(0)
 }
