@@ -622,6 +622,9 @@ fn simpson01(f: impl Fn(f64) -> f64, n: usize) -> f64 {
     (f(0.0) + f(1.0) + inner) * h / 3.0
 }
 
+/// The actuator force per unit stroke `U/r = C(s)` through the coil and the PD law.
+type Coil = Box<dyn Fn(Complex<f64>) -> Complex<f64>>;
+
 /// The paper's receptance `W(x_o)/P` for n = 1 (Eq. (17)–(19), with the actuator force closed
 /// through the coil and the PD law). Eq. (18)–(19) are written for force, absorber and output all
 /// at the tip; here `φ(l)²` is split into `φ(x_o)φ(x_p)`, `φ(x_a)²`, `φ(x_o)φ(x_a)` as the same
@@ -636,7 +639,7 @@ struct PaperN1 {
     ba: f64,
     /// `U = C(s)·r`: the actuator force per unit stroke through coil and PD law (`None`: no
     /// absorber at all).
-    coil: Option<Box<dyn Fn(Complex<f64>) -> Complex<f64>>>,
+    coil: Option<Coil>,
 }
 
 impl PaperN1 {
@@ -682,7 +685,7 @@ fn n1_coupled_frf_equals_the_paper_per_mode_eq_17_to_19() {
         let phi = [xo, xp, xa].map(|x| paper_shape(beta, x).0);
         let c11 = 2.0 * zeta * (k11 * m11).sqrt();
         for mode in ["none", "passive", "passive_shorted", "active"] {
-            let coil: Option<Box<dyn Fn(Complex<f64>) -> Complex<f64>>> = match mode {
+            let coil: Option<Coil> = match mode {
                 "none" => None,
                 "passive" => Some(Box::new(|_| Complex::new(0.0, 0.0))),
                 // (L_c s + R) i = −K_b ṙ: U = −K_c K_b s / (L_c s + R) · r.
