@@ -42,6 +42,7 @@ const CROSS_FIELD: &[(&str, &str, &str)] = &[
     ("/v1/vibration-absorber", "/absorber/position_m", "x_a ≤ beam.length_m"),
     ("/v1/vibration-absorber", "/excitation/position_m", "x_p ≤ beam.length_m"),
     ("/v1/vibration-absorber", "/excitation/resonance_of_mode", "k ≤ beam.n_modes"),
+    ("/v1/vibration-absorber", "/excitation/harmonics/0/resonance_of_mode", "k ≤ beam.n_modes"),
     ("/v1/vibration-absorber", "/absorber/passive_tuning_mode", "k ≤ beam.n_modes"),
     ("/v1/vibration-absorber", "/control/tuning_mode", "k ≤ beam.n_modes"),
     ("/v1/vibration-absorber", "/outputs/frequency_response/f_max_hz", "f_max_hz > f_min_hz"),

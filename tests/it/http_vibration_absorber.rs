@@ -237,3 +237,93 @@ async fn undamped_resonance_on_the_grid_is_null_with_a_warning() {
             .any(|w| w["code"] == "UNDAMPED_RESONANCE")
     );
 }
+
+/// Several harmonics (spec §3.D.4): the list form answers with one frequency per component; it
+/// excludes the single-harmonic members, needs `type = harmonic` and checks every component.
+#[tokio::test]
+async fn harmonics_list_is_validated_per_component() {
+    let ok = json!({"excitation": {"harmonics": [
+            {"amplitude_n": 1.0, "resonance_of_mode": 1},
+            {"amplitude_n": 0.5, "frequency_hz": 10.0, "phase_rad": 0.3}]},
+        "outputs": {"time_response": {"t_end_s": 0.5, "dt_s": 0.001}}});
+    let r = post_json(PATH, &ok).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let t = &r.json()["time_response"];
+    assert!(t.get("excitation_frequency_hz").is_none());
+    let f = t["excitation_frequencies_hz"]
+        .as_array()
+        .expect("per component");
+    assert_eq!(f.len(), 2);
+    assert_eq!(f[1], 10.0);
+
+    let one = json!([{"amplitude_n": 1.0, "frequency_hz": 5.0}]);
+    let cases: [(&str, Option<&str>, Value); 9] = [
+        (
+            "/excitation/amplitude_n",
+            Some("HARMONICS_CONFLICT"),
+            json!({"amplitude_n": 2.0, "harmonics": one}),
+        ),
+        (
+            "/excitation/frequency_hz",
+            Some("HARMONICS_CONFLICT"),
+            json!({"frequency_hz": 5.0, "harmonics": one}),
+        ),
+        (
+            "/excitation/resonance_of_mode",
+            Some("HARMONICS_CONFLICT"),
+            json!({"resonance_of_mode": 1, "harmonics": one}),
+        ),
+        (
+            "/excitation/phase_rad",
+            Some("HARMONICS_CONFLICT"),
+            json!({"phase_rad": 0.1, "harmonics": one}),
+        ),
+        (
+            "/excitation/harmonics",
+            None,
+            json!({"type": "step", "harmonics": one}),
+        ),
+        ("/excitation/harmonics", None, json!({"harmonics": []})),
+        (
+            "/excitation/harmonics/1/resonance_of_mode",
+            None,
+            json!({"harmonics": [{"amplitude_n": 1.0, "frequency_hz": 5.0},
+                                 {"amplitude_n": 1.0, "frequency_hz": 5.0, "resonance_of_mode": 1}]}),
+        ),
+        (
+            "/excitation/harmonics/0/frequency_hz",
+            None,
+            json!({"harmonics": [{"amplitude_n": 1.0, "phase_rad": 0.0}]}),
+        ),
+        (
+            "/excitation/harmonics/1/resonance_of_mode",
+            Some("MODE_OUT_OF_RANGE"),
+            json!({"harmonics": [{"amplitude_n": 1.0, "frequency_hz": 5.0},
+                                 {"amplitude_n": 1.0, "resonance_of_mode": 4}]}),
+        ),
+    ];
+    for (pointer, code, excitation) in cases {
+        let r = post_json(PATH, &json!({"excitation": excitation})).await;
+        assert_eq!(
+            r.status,
+            422,
+            "{pointer}: {}",
+            String::from_utf8_lossy(&r.bytes)
+        );
+        assert!(
+            r.pointers().contains(&pointer.to_owned()),
+            "{pointer}: got {:?}",
+            r.pointers()
+        );
+        if let Some(code) = code {
+            assert_eq!(r.json()["code"], code, "{pointer}");
+        }
+    }
+    // 17 components: one more than the exosystem cap.
+    let many: Vec<Value> = (0..17)
+        .map(|j| json!({"amplitude_n": 1.0, "frequency_hz": 1.0 + f64::from(j)}))
+        .collect();
+    let r = post_json(PATH, &json!({"excitation": {"harmonics": many}})).await;
+    assert_eq!(r.status, 422);
+    assert!(r.pointers().contains(&"/excitation/harmonics".to_owned()));
+}

@@ -257,6 +257,55 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(cases(16))]
+
+    /// Several harmonics (one exosystem block each) superpose: the list answer is the sum of the
+    /// single-harmonic answers, on every channel, to round-off.
+    #[test]
+    fn several_harmonics_superpose(
+        d in design(),
+        comps in proptest::collection::vec((-5.0_f64..5.0, 0.5_f64..120.0, -3.2_f64..3.2), 2..=4),
+    ) {
+        let mut d = d;
+        d["outputs"] = json!({"time_response": {"t_end_s": 0.4, "dt_s": 0.0007, "points_m": [0.7], "return_series": true}});
+        let channels = |a: &Value| -> Vec<Vec<f64>> {
+            let t = &a["time_response"];
+            let mut out = vec![t["points"][0]["w_m"].clone()];
+            for k in ["stroke_m", "force_n", "current_a", "voltage_v"] {
+                if let Some(v) = t.get(k) {
+                    out.push(v.clone());
+                }
+            }
+            out.iter().map(|v| v.as_array().expect("series").iter().filter_map(Value::as_f64).collect()).collect()
+        };
+        let xp = d["excitation"]["position_m"].clone();
+        let mut multi = d.clone();
+        multi["excitation"] = json!({"position_m": xp, "harmonics": comps.iter()
+            .map(|(p, f, ph)| json!({"amplitude_n": p, "frequency_hz": f, "phase_rad": ph}))
+            .collect::<Vec<_>>()});
+        let got = channels(&answer(multi));
+        let mut sum: Vec<Vec<f64>> = got.iter().map(|c| vec![0.0; c.len()]).collect();
+        let mut scale = vec![0.0_f64; got.len()];
+        for (p, f, ph) in &comps {
+            let mut single = d.clone();
+            single["excitation"] = json!({"position_m": xp, "type": "harmonic",
+                "amplitude_n": p, "frequency_hz": f, "phase_rad": ph});
+            for (j, c) in channels(&answer(single)).into_iter().enumerate() {
+                scale[j] = scale[j].max(c.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+                for (acc, x) in sum[j].iter_mut().zip(c) {
+                    *acc += x;
+                }
+            }
+        }
+        for (j, (g, w)) in got.iter().zip(&sum).enumerate() {
+            for (a, b) in g.iter().zip(w) {
+                prop_assert!((a - b).abs() <= 1e-10 * scale[j], "channel {j}: {a:e} vs {b:e} (scale {:e})", scale[j]);
+            }
+        }
+    }
+}
+
 /// Composite Simpson on [0, 1].
 fn simpson(f: impl Fn(f64) -> f64, n: usize) -> f64 {
     let h = 1.0 / n as f64;

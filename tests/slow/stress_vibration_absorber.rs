@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use crate::support::finite::first_null_or_non_finite;
 use mechcalc::calc::vibration_absorber::compute::build_model;
-use mechcalc::calc::vibration_absorber::input::{Forcing, VibrationAbsorberInput};
+use mechcalc::calc::vibration_absorber::input::{Forcing, FreqRef, VibrationAbsorberInput};
 use mechcalc::calc::vibration_absorber::{VibrationAbsorberRequest, run};
 use mechcalc::calc::{CalcFailure, ProblemClass};
 use mechcalc::numerics::Budget;
@@ -53,28 +53,32 @@ fn codes(a: &Value) -> Vec<String> {
         .collect()
 }
 
-/// Direct `expm(A_aug t) s(0)` at `t` for a harmonic request: the reference of spec §8.
+/// Direct `expm(A_aug t) s(0)` at `t` for a harmonic request (one 2×2 exosystem block per
+/// component): the reference of spec §8.
 fn direct_tip(v: &Value, t: f64) -> f64 {
     let input = VibrationAbsorberInput::try_from(request(v)).expect("valid");
     let (m, freqs, _) = build_model(&input);
-    let Forcing::Harmonic { freq, phase } = input.forcing else {
+    let Forcing::Harmonic { components, .. } = &input.forcing else {
         panic!("harmonic only")
-    };
-    let f = match freq {
-        mechcalc::calc::vibration_absorber::input::FreqRef::Hz(f) => f,
-        mechcalc::calc::vibration_absorber::input::FreqRef::Mode(k) => freqs[k - 1],
     };
     let (a, b) = (m.a_matrix(), m.b_vector());
     let n = a.nrows();
-    let mut aug = DMatrix::zeros(n + 2, n + 2);
+    let na = n + 2 * components.len();
+    let mut aug = DMatrix::zeros(na, na);
     aug.view_mut((0, 0), (n, n)).copy_from(&a);
-    aug.view_mut((0, n), (n, 1))
-        .copy_from(&(b * input.amplitude));
-    aug[(n, n + 1)] = 2.0 * PI * f;
-    aug[(n + 1, n)] = -2.0 * PI * f;
-    let mut s0 = DVector::zeros(n + 2);
-    s0[n] = phase.sin();
-    s0[n + 1] = phase.cos();
+    let mut s0 = DVector::zeros(na);
+    for (j, c) in components.iter().enumerate() {
+        let f = match c.freq {
+            FreqRef::Hz(f) => f,
+            FreqRef::Mode(k) => freqs[k - 1],
+        };
+        let e = n + 2 * j;
+        aug.view_mut((0, e), (n, 1)).copy_from(&(&b * c.amplitude));
+        aug[(e, e + 1)] = 2.0 * PI * f;
+        aug[(e + 1, e)] = -2.0 * PI * f;
+        s0[e] = c.phase.sin();
+        s0[e + 1] = c.phase.cos();
+    }
     let s = expm(&(aug * t)).expect("finite") * s0;
     let c = m.row_deflection(1.0);
     c.dot(&s.rows(0, n).into_owned())
@@ -137,6 +141,8 @@ fn stiff_systems_step_exactly_at_large_steps() {
         "excitation": {"type": "harmonic", "resonance_of_mode": 2},
         "outputs": {"time_response": {"t_end_s": 2.0, "dt_s": 0.001, "return_series": true}}});
     let a = finite_answer(&v);
+    // 1e-9: the benchmark measures 1.4e-10 stepping drift at n = 30 over 10 s (spec §8 expects
+    // ≤ 1e-10; not met at n = 30, see the module docs), with a margin for machine round-off.
     let want = direct_tip(&v, 2.0);
     let scale = a["time_response"]["points"][0]["max_abs_m"]
         .as_f64()
@@ -184,6 +190,35 @@ fn long_horizons_are_re_anchored() {
     let a = finite_answer(&v);
     assert_eq!(a["time_response"]["n_samples"], 500_001);
     let want = direct_tip(&v, 500.0);
+    let scale = a["time_response"]["points"][0]["max_abs_m"]
+        .as_f64()
+        .expect("max");
+    assert!(
+        (last_tip(&a) - want).abs() <= 1e-9 * scale,
+        "{} vs {want}",
+        last_tip(&a)
+    );
+}
+
+#[test]
+fn sixteen_harmonics_on_fifty_undamped_modes_stay_exact() {
+    // The largest augmented system (103 + 32 states): every component at a bare-beam resonance
+    // (secular growth in sixteen modes at once), stepped 1e4 times at h = 0.1 ms, against a
+    // direct exponential at t_end.
+    let comps: Vec<Value> = (1..=16)
+        .map(|k| json!({"amplitude_n": 1.0 / f64::from(k), "resonance_of_mode": k, "phase_rad": 0.1 * f64::from(k)}))
+        .collect();
+    let v = json!({"beam": {"n_modes": 50}, "control": {"mode": "active", "tuning_mode": 2},
+        "excitation": {"harmonics": comps},
+        "outputs": {"time_response": {"t_end_s": 1.0, "dt_s": 1e-4, "return_series": true, "decimate": 100}}});
+    let a = finite_answer(&v);
+    assert_eq!(
+        a["time_response"]["excitation_frequencies_hz"]
+            .as_array()
+            .map(Vec::len),
+        Some(16)
+    );
+    let want = direct_tip(&v, 1.0);
     let scale = a["time_response"]["points"][0]["max_abs_m"]
         .as_f64()
         .expect("max");

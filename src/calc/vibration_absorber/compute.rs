@@ -63,8 +63,10 @@ pub struct VibrationAbsorberOutput {
 /// Time response reductions with their channel layout.
 #[derive(Debug, Clone)]
 pub struct TimeOutput {
-    /// Excitation frequency [Hz] (harmonic).
-    pub excitation_hz: Option<f64>,
+    /// Frequency of each harmonic component [Hz] (empty unless harmonic).
+    pub excitation_hz: Vec<f64>,
+    /// Whether the components were listed (`excitation.harmonics`).
+    pub listed: bool,
     /// Samples.
     pub n_samples: usize,
     /// Output abscissae [m].
@@ -207,14 +209,18 @@ pub fn compute(
         None => None,
     };
 
-    let excitation_hz = match input.forcing {
-        Forcing::Harmonic { freq, .. } => Some(hz(freq, &freqs)),
-        _ => None,
+    let excitation_hz: Vec<f64> = match &input.forcing {
+        Forcing::Harmonic { components, .. } => {
+            components.iter().map(|c| hz(c.freq, &freqs)).collect()
+        }
+        _ => Vec::new(),
     };
-    tuning_warning(gains.as_ref(), excitation_hz, &mut warnings);
+    for fe in &excitation_hz {
+        tuning_warning(gains.as_ref(), *fe, &mut warnings);
+    }
     let time = match &o.time {
         Some(t) => {
-            let out = time_response(&model, &a, &b, input, t, excitation_hz, budget)?;
+            let out = time_response(&model, &a, &b, input, t, &excitation_hz, budget)?;
             evaluations += out.series.expms;
             iterations += t.steps as u64;
             Some(out)
@@ -367,8 +373,8 @@ fn stability_warning(model: &Model, zeta: f64, eigen: Option<&Eigen>, warnings: 
 }
 
 /// Excitation near but not at the tuning frequency: beating, not cancellation (spec §4 item 10).
-fn tuning_warning(gains: Option<&Gains>, excitation_hz: Option<f64>, warnings: &mut Vec<Warning>) {
-    if let (Some(g), Some(fe)) = (gains, excitation_hz)
+fn tuning_warning(gains: Option<&Gains>, fe: f64, warnings: &mut Vec<Warning>) {
+    if let Some(g) = gains
         && let Some(fc) = g.tuning_hz
     {
         let rel = (fe - fc).abs() / fc;
@@ -435,35 +441,39 @@ fn ava_frequency_response(
 }
 
 /// The exact time response (spec §3.D.4): augmented autonomous system, one matrix exponential,
-/// `Φᵏ` stepping.
+/// `Φᵏ` stepping. A harmonic force adds one 2×2 exosystem block `[[0, Ω_j], [−Ω_j, 0]]` per
+/// component (state `[sin(Ω_j t + φ_j), cos(Ω_j t + φ_j)]`, driving `A` through `P_j B`), a step
+/// one constant state, an impulse only the initial state `P0 B`.
 fn time_response(
     model: &Model,
     a: &DMatrix<f64>,
     b: &DVector<f64>,
     input: &VibrationAbsorberInput,
     t: &TimeRequest,
-    excitation_hz: Option<f64>,
+    excitation_hz: &[f64],
     budget: &Budget,
 ) -> Result<TimeOutput, Error> {
     let n = a.nrows();
     let p0 = input.amplitude;
-    let extra_states = match input.forcing {
-        Forcing::Harmonic { .. } => 2,
-        Forcing::Step => 1,
-        Forcing::Impulse | Forcing::None => 0,
+    let (extra_states, listed) = match &input.forcing {
+        Forcing::Harmonic { components, listed } => (2 * components.len(), *listed),
+        Forcing::Step => (1, false),
+        Forcing::Impulse | Forcing::None => (0, false),
     };
     let na = n + extra_states;
     let mut aug = DMatrix::zeros(na, na);
     aug.view_mut((0, 0), (n, n)).copy_from(a);
     let mut s0 = DVector::zeros(na);
-    match input.forcing {
-        Forcing::Harmonic { phase, .. } => {
-            let w = 2.0 * PI * excitation_hz.unwrap_or(0.0);
-            aug.view_mut((0, n), (n, 1)).copy_from(&(b * p0));
-            aug[(n, n + 1)] = w;
-            aug[(n + 1, n)] = -w;
-            s0[n] = phase.sin();
-            s0[n + 1] = phase.cos();
+    match &input.forcing {
+        Forcing::Harmonic { components, .. } => {
+            for (j, (c, f)) in components.iter().zip(excitation_hz).enumerate() {
+                let (s, w) = (n + 2 * j, 2.0 * PI * f);
+                aug.view_mut((0, s), (n, 1)).copy_from(&(b * c.amplitude));
+                aug[(s, s + 1)] = w;
+                aug[(s + 1, s)] = -w;
+                s0[s] = c.phase.sin();
+                s0[s + 1] = c.phase.cos();
+            }
         }
         Forcing::Step => {
             aug.view_mut((0, n), (n, 1)).copy_from(&(b * p0));
@@ -495,7 +505,13 @@ fn time_response(
             rows.push(pad(c));
         }
     }
-    let window = excitation_hz.filter(|f| *f > 0.0).map_or(1.0, |f| 1.0 / f);
+    // "Last period": the longest component period (each component completes a period in it).
+    let window = excitation_hz
+        .iter()
+        .copied()
+        .filter(|f| *f > 0.0)
+        .reduce(f64::min)
+        .map_or(1.0, |f| 1.0 / f);
     let t_end = t.steps as f64 * t.dt;
     let last_from = ((t_end - window) / t.dt).ceil().max(0.0) as usize;
     let stepper = Stepper {
@@ -509,7 +525,8 @@ fn time_response(
     };
     let series = stepper.run(budget)?;
     Ok(TimeOutput {
-        excitation_hz,
+        excitation_hz: excitation_hz.to_vec(),
+        listed,
         n_samples: t.steps + 1,
         points: t.points.clone(),
         series,

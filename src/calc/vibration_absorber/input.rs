@@ -7,8 +7,8 @@ use crate::calc::common::{TimeLimited, time_limit};
 use crate::calc::{CalcFailure, Validator};
 
 use super::wire::{
-    self, ControlMode, ExcitationType, FrequencyResponseIn, GridIn, TimeResponseIn,
-    VibrationAbsorberRequest,
+    self, ControlMode, ExcitationIn, ExcitationType, FrequencyResponseIn, GridIn, HarmonicIn,
+    TimeResponseIn, VibrationAbsorberRequest,
 };
 
 /// Code of a `{mode: k}` reference beyond `beam.n_modes`.
@@ -19,6 +19,8 @@ pub const ZERO_FORCE_CONSTANT: &str = "ZERO_FORCE_CONSTANT";
 pub const POSITION_OUT_OF_BEAM: &str = "POSITION_OUT_OF_BEAM";
 /// Code of a time grid with more than 2e6 samples.
 pub const TOO_MANY_SAMPLES: &str = "TOO_MANY_SAMPLES";
+/// Code of `excitation.harmonics` given together with a single-harmonic member.
+pub const HARMONICS_CONFLICT: &str = "HARMONICS_CONFLICT";
 
 /// Configuration (which states the model has).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,15 +105,26 @@ pub enum GainSource {
     },
 }
 
-/// Time law of the force.
+/// One harmonic component `P sin(Ωt + φ)` of the force.
 #[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Harmonic {
+    /// `P` [N].
+    pub amplitude: f64,
+    /// Ω/2π.
+    pub freq: FreqRef,
+    /// φ [rad].
+    pub phase: f64,
+}
+
+/// Time law of the force.
+#[derive(Debug, Clone, PartialEq)]
 pub enum Forcing {
-    /// `P0 sin(Ωt + φ0)`.
+    /// `Σ_j P_j sin(Ω_j t + φ_j)`: one component for the single-harmonic form.
     Harmonic {
-        /// Ω/2π.
-        freq: FreqRef,
-        /// φ0 [rad].
-        phase: f64,
+        /// The components (at least one).
+        components: Vec<Harmonic>,
+        /// Whether the request listed them (`excitation.harmonics`) rather than giving one.
+        listed: bool,
     },
     /// Impulse `P0` [N·s] at t = 0.
     Impulse,
@@ -208,7 +221,8 @@ pub struct VibrationAbsorberInput {
     pub forcing: Forcing,
     /// `x_p` [m].
     pub force_position: f64,
-    /// `P0` [N] or [N·s].
+    /// `P0` [N] or [N·s] of an impulse or a step (the single harmonic's amplitude too; the
+    /// components carry their own).
     pub amplitude: f64,
     /// Analyses.
     pub outputs: Outputs,
@@ -384,6 +398,144 @@ fn time(v: &mut Validator, t: &TimeResponseIn, length: f64) -> TimeRequest {
         series: t.return_series,
         decimate: decimate.max(1) as usize,
     }
+}
+
+/// A frequency given as `frequency_hz` or `resonance_of_mode` (at most one; `default` when
+/// neither is given, `None` = required).
+fn freq_ref(
+    v: &mut Validator,
+    base: &str,
+    (hz, mode): (Option<f64>, Option<u32>),
+    n_modes: usize,
+    default: Option<FreqRef>,
+) -> FreqRef {
+    let both = hz.is_some() && mode.is_some();
+    v.ensure(!both, format!("{base}/resonance_of_mode"), || {
+        "give at most one of frequency_hz and resonance_of_mode".to_owned()
+    });
+    match (hz, mode, default) {
+        (Some(f), _, _) => FreqRef::Hz(opt(
+            v,
+            &format!("{base}/frequency_hz"),
+            Some(f),
+            1.0,
+            wire::FREQUENCY,
+        )),
+        (None, Some(k), _) => FreqRef::Mode(mode_ref(
+            v,
+            &format!("{base}/resonance_of_mode"),
+            "resonance_of_mode",
+            k,
+            n_modes,
+        )),
+        (None, None, Some(d)) => d,
+        (None, None, None) => {
+            v.push(
+                format!("{base}/frequency_hz"),
+                "give frequency_hz or resonance_of_mode",
+            );
+            FreqRef::Hz(1.0)
+        }
+    }
+}
+
+/// The components of `excitation.harmonics` (spec §3.D.4 "several harmonics").
+fn harmonics(v: &mut Validator, list: &[HarmonicIn], n_modes: usize) -> Vec<Harmonic> {
+    let base = "/excitation/harmonics";
+    v.ensure(
+        !list.is_empty() && list.len() <= wire::MAX_HARMONICS,
+        base,
+        || {
+            format!(
+                "must list 1…{} components, got {}",
+                wire::MAX_HARMONICS,
+                list.len()
+            )
+        },
+    );
+    list.iter()
+        .enumerate()
+        .map(|(j, h)| {
+            let at = format!("{base}/{j}");
+            v.range(
+                &format!("{at}/amplitude_n"),
+                "amplitude_n",
+                h.amplitude_n,
+                wire::AMPLITUDE,
+            );
+            Harmonic {
+                amplitude: h.amplitude_n,
+                freq: freq_ref(v, &at, (h.frequency_hz, h.resonance_of_mode), n_modes, None),
+                phase: opt(v, &format!("{at}/phase_rad"), h.phase_rad, 0.0, wire::PHASE),
+            }
+        })
+        .collect()
+}
+
+/// The force law and its amplitude `P0` (impulse, step, single harmonic).
+fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, f64) {
+    let amplitude = opt(
+        v,
+        "/excitation/amplitude_n",
+        e.amplitude_n,
+        1.0,
+        wire::AMPLITUDE,
+    );
+    if let Some(list) = &e.harmonics {
+        let single = [
+            ("amplitude_n", e.amplitude_n.is_some()),
+            ("frequency_hz", e.frequency_hz.is_some()),
+            ("resonance_of_mode", e.resonance_of_mode.is_some()),
+            ("phase_rad", e.phase_rad.is_some()),
+        ];
+        for (name, given) in single {
+            v.ensure_code(
+                !given,
+                HARMONICS_CONFLICT,
+                format!("/excitation/{name}"),
+                || {
+                    format!(
+                        "give either excitation.harmonics or the single harmonic's {name}, not both"
+                    )
+                },
+            );
+        }
+        v.ensure(
+            e.kind == ExcitationType::Harmonic,
+            "/excitation/harmonics",
+            || "harmonics needs excitation.type = harmonic".to_owned(),
+        );
+        let components = harmonics(v, list, n_modes);
+        return (
+            Forcing::Harmonic {
+                components,
+                listed: true,
+            },
+            amplitude,
+        );
+    }
+    let freq = freq_ref(
+        v,
+        "/excitation",
+        (e.frequency_hz, e.resonance_of_mode),
+        n_modes,
+        Some(FreqRef::Mode(2.min(n_modes))),
+    );
+    let phase = opt(v, "/excitation/phase_rad", e.phase_rad, 0.0, wire::PHASE);
+    let forcing = match e.kind {
+        ExcitationType::Harmonic => Forcing::Harmonic {
+            components: vec![Harmonic {
+                amplitude,
+                freq,
+                phase,
+            }],
+            listed: false,
+        },
+        ExcitationType::Impulse => Forcing::Impulse,
+        ExcitationType::Step => Forcing::Step,
+        ExcitationType::None => Forcing::None,
+    };
+    (forcing, amplitude)
 }
 
 impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
@@ -599,48 +751,7 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
 
         let e = &req.excitation;
         let force_position = position(&mut v, "/excitation/position_m", e.position_m, length);
-        let amplitude = opt(
-            &mut v,
-            "/excitation/amplitude_n",
-            e.amplitude_n,
-            1.0,
-            wire::AMPLITUDE,
-        );
-        v.ensure(
-            e.frequency_hz.is_none() || e.resonance_of_mode.is_none(),
-            "/excitation/resonance_of_mode",
-            || "give at most one of frequency_hz and resonance_of_mode".to_owned(),
-        );
-        let freq = match (e.frequency_hz, e.resonance_of_mode) {
-            (Some(f), _) => FreqRef::Hz(opt(
-                &mut v,
-                "/excitation/frequency_hz",
-                Some(f),
-                1.0,
-                wire::FREQUENCY,
-            )),
-            (None, Some(k)) => FreqRef::Mode(mode_ref(
-                &mut v,
-                "/excitation/resonance_of_mode",
-                "resonance_of_mode",
-                k,
-                n_modes,
-            )),
-            (None, None) => FreqRef::Mode(2.min(n_modes)),
-        };
-        let phase = opt(
-            &mut v,
-            "/excitation/phase_rad",
-            e.phase_rad,
-            0.0,
-            wire::PHASE,
-        );
-        let forcing = match e.kind {
-            ExcitationType::Harmonic => Forcing::Harmonic { freq, phase },
-            ExcitationType::Impulse => Forcing::Impulse,
-            ExcitationType::Step => Forcing::Step,
-            ExcitationType::None => Forcing::None,
-        };
+        let (forcing, amplitude) = excitation(&mut v, e, n_modes);
 
         let o = &req.outputs;
         let outputs = Outputs {

@@ -61,9 +61,18 @@ fn closed_loop_out(e: &Eigen, size: usize) -> ClosedLoopOut {
 fn time_out(t: &TimeOutput) -> TimeOut {
     let s = &t.series;
     let row = |i: Option<usize>, v: &Vec<f64>| i.map(|i| v[i]);
+    // Series of the stroke, force, current, voltage channels (when asked and present).
+    let channel = |c: usize| {
+        s.series
+            .as_ref()
+            .and_then(|ser| t.extra[c].map(|i| ser[i].clone()))
+    };
     TimeOut {
         method: "expm-exosystem".to_owned(),
-        excitation_frequency_hz: t.excitation_hz,
+        excitation_frequency_hz: (!t.listed)
+            .then(|| t.excitation_hz.first().copied())
+            .flatten(),
+        excitation_frequencies_hz: t.listed.then(|| t.excitation_hz.clone()),
         n_samples: t.n_samples,
         points: t
             .points
@@ -82,14 +91,10 @@ fn time_out(t: &TimeOutput) -> TimeOut {
         current_max_a: row(t.extra[2], &s.max_abs),
         voltage_max_v: row(t.extra[3], &s.max_abs),
         t_s: s.t.clone(),
-        stroke_m: s
-            .series
-            .as_ref()
-            .and_then(|ser| t.extra[0].map(|i| ser[i].clone())),
-        force_n: s
-            .series
-            .as_ref()
-            .and_then(|ser| t.extra[1].map(|i| ser[i].clone())),
+        stroke_m: channel(0),
+        force_n: channel(1),
+        current_a: channel(2),
+        voltage_v: channel(3),
     }
 }
 

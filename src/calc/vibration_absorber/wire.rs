@@ -61,6 +61,9 @@ pub const MAX_SAMPLES: f64 = 2e6;
 pub const SHAPE_POINTS: Range = Range::int(2, 10_001);
 /// Largest number of output abscissae per analysis.
 pub const MAX_POINTS: usize = 64;
+/// Largest number of components of `excitation.harmonics` (each adds two exosystem states, so
+/// the augmented system stays ≤ 103 + 32 = 135 states).
+pub const MAX_HARMONICS: usize = 16;
 
 /// Request of `POST /v1/vibration-absorber`: beam, absorber, actuator, control law, excitation and
 /// the analyses wanted. Every member is optional (spec §2 defaults).
@@ -261,8 +264,10 @@ pub enum ExcitationType {
     None,
 }
 
-/// The force on the beam. Harmonic frequency: `frequency_hz`, or `resonance_of_mode` (the model's
-/// bare-beam `f_k`; default mode 2).
+/// The force on the beam, applied at `position_m`. One harmonic: `amplitude_n`, `frequency_hz` or
+/// `resonance_of_mode` (the model's bare-beam `f_k`; default mode 2) and `phase_rad`. Several
+/// harmonics (spec §3.D.4): list them in `harmonics` instead (then `amplitude_n`, `frequency_hz`,
+/// `resonance_of_mode` and `phase_rad` must be absent); `p(t) = Σ_j P_j sin(Ω_j t + φ_j)`.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
 #[schema(as = vibration_absorber::ExcitationIn)]
 #[serde(deny_unknown_fields)]
@@ -289,6 +294,35 @@ pub struct ExcitationIn {
     /// Phase `φ0` [rad], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.0)]
+    pub phase_rad: Option<f64>,
+    /// Several harmonic components at `position_m`, 1…16, each simulated exactly with its own 2×2
+    /// exosystem block (type `harmonic` only; exclusive with the single-harmonic members
+    /// `amplitude_n`, `frequency_hz`, `resonance_of_mode`, `phase_rad`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub harmonics: Option<Vec<HarmonicIn>>,
+}
+
+/// One component `P_j sin(Ω_j t + φ_j)` of a multi-harmonic force. Give exactly one of
+/// `frequency_hz` and `resonance_of_mode`.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = vibration_absorber::HarmonicIn)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicIn {
+    /// Amplitude `P_j` [N].
+    #[schema(example = 1.0)]
+    pub amplitude_n: f64,
+    /// Frequency `Ω_j/2π` [Hz] (exclusive with `resonance_of_mode`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub frequency_hz: Option<f64>,
+    /// At the bare-beam resonance of mode `k` (≤ `beam.n_modes`; exclusive with `frequency_hz`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub resonance_of_mode: Option<u32>,
+    /// Phase `φ_j` [rad], default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
     pub phase_rad: Option<f64>,
 }
 
@@ -406,7 +440,8 @@ pub struct TimeResponseIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = json!([1.0]))]
     pub points_m: Option<Vec<f64>>,
-    /// Return the sampled series (the biggest payload).
+    /// Return the sampled series (the biggest payload): `t_s`, `w_m` per abscissa, and with an
+    /// absorber `stroke_m`, with a coil `force_n` and `current_a`, with `active` `voltage_v`.
     #[serde(default)]
     pub return_series: bool,
     /// Keep every k-th sample in the series (default 1).
@@ -652,8 +687,9 @@ pub struct TimePointOut {
     pub x_m: f64,
     /// max |w| over all samples [m].
     pub max_abs_m: f64,
-    /// max |w| over the samples with `t ≥ t_end − T` [m], `T` the excitation period (harmonic)
-    /// or 1 s (other excitations), whole horizon if shorter.
+    /// max |w| over the samples with `t ≥ t_end − T` [m], `T` the excitation period (harmonic;
+    /// with several harmonics the longest component period) or 1 s (other excitations), whole
+    /// horizon if shorter.
     pub max_abs_last_period_m: f64,
     /// RMS of w over all samples [m].
     pub rms_m: f64,
@@ -670,10 +706,15 @@ pub struct TimeOut {
     /// `expm-exosystem`: one matrix exponential of the augmented autonomous system, then
     /// `s_{k+1} = Φ s_k` (re-anchored every 1e4 steps beyond 1e5 samples).
     pub method: String,
-    /// Excitation frequency [Hz] (harmonic only).
+    /// Excitation frequency [Hz] (single harmonic only).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub excitation_frequency_hz: Option<f64>,
+    /// Frequency of each component of `excitation.harmonics` [Hz], in request order (several
+    /// harmonics only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub excitation_frequencies_hz: Option<Vec<f64>>,
     /// Number of samples (t = 0, dt, …, K·dt).
     pub n_samples: usize,
     /// Per output abscissa.
@@ -702,10 +743,18 @@ pub struct TimeOut {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub stroke_m: Option<Vec<f64>>,
-    /// Actuator force samples [N] (`return_series`, with a coil).
+    /// Actuator force samples `u = K_c i` [N] (`return_series`, with a coil).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub force_n: Option<Vec<f64>>,
+    /// Coil current samples `i` [A] (`return_series`, with a coil).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub current_a: Option<Vec<f64>>,
+    /// Control voltage samples `e_c = −(K_p r + K_d ṙ)` [V] (`return_series`, `active`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub voltage_v: Option<Vec<f64>>,
 }
 
 crate::schema_bounds! {
@@ -737,6 +786,12 @@ crate::schema_bounds! {
     ControlIn { tuning_hz: FREQUENCY, tuning_mode: MODE_INDEX, kp_v_m: GAIN, kd_v_s_m: GAIN },
     ExcitationIn {
         position_m: LENGTH,
+        amplitude_n: AMPLITUDE,
+        frequency_hz: FREQUENCY,
+        resonance_of_mode: MODE_INDEX,
+        phase_rad: PHASE,
+    },
+    HarmonicIn {
         amplitude_n: AMPLITUDE,
         frequency_hz: FREQUENCY,
         resonance_of_mode: MODE_INDEX,
