@@ -47,6 +47,7 @@ pub mod brent;
 pub mod efficiency;
 pub mod error;
 pub mod geometry;
+pub mod input;
 pub mod stress;
 pub mod wire;
 
