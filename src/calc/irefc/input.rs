@@ -1,6 +1,6 @@
 //! Validation shared by both IREFC endpoints: the four initial parameters (r2, Z2, χ, rb) and the
 //! materials, checked against the bounds of [`super::wire`] with the crate's one
-//! [`Validator`](crate::calc::Validator).
+//! [`Validator`].
 //!
 //! Every range problem has the spec code `BAD_RANGE`; the failure's class follows its code
 //! ([`class_of`]: `GRID_TOO_FINE` and `SWEEP_TOO_LARGE` are too-large), and when problems with
