@@ -33,6 +33,7 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         crate::numerics::budget::schema_bounds(),
         bezier_motion::wire::schema_bounds(),
         bus_fuel_economy::wire::schema_bounds(),
+        bus_fuel_economy::wire::variant_bounds(),
         cam_law::wire::schema_bounds(),
         cam_law_fit::wire::schema_bounds(),
         cognates::wire::schema_bounds(),

@@ -106,21 +106,62 @@ pub const INVALID_INPUT: &str = "INVALID_INPUT";
 /// assert_eq!(err.errors.len(), 2);
 /// assert_eq!(err.errors[1].detail, "n must be an integer in [8, 200000], got 3");
 /// ```
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Validator {
     issues: Vec<(&'static str, FieldIssue)>,
+    /// The code of the plain checks (`push`, `ensure`, `finite`, `all_in`, `range`, `uint`).
+    code: &'static str,
+    /// The failure's class from its code; `None`: always [`ProblemClass::InvalidInput`].
+    class_of: Option<fn(&str) -> ProblemClass>,
+}
+
+impl Default for Validator {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 impl Validator {
-    /// An empty validator.
+    /// An empty validator: plain checks record `INVALID_INPUT`, the failure is `InvalidInput`.
     #[must_use]
-    pub fn new() -> Self {
-        Self::default()
+    pub const fn new() -> Self {
+        Self {
+            issues: Vec::new(),
+            code: INVALID_INPUT,
+            class_of: None,
+        }
     }
 
-    /// Record a problem at `pointer` with the code `INVALID_INPUT`.
+    /// An empty validator for a module whose spec gives validation problems its own codes:
+    /// the plain checks (`push`, `ensure`, `finite`, `all_in`, `range`, `uint`) record `code`
+    /// (e.g. IREFC's `BAD_RANGE`), the failure's class follows its code (`class_of`, e.g. a size
+    /// limit is [`ProblemClass::TooLarge`]), and when problems with different codes are listed
+    /// together each detail starts with its own code (`"MISSING_FIELD: r2_mm is required"`), so
+    /// a client still sees every problem's code.
+    ///
+    /// ```
+    /// use mechcalc::calc::{ProblemClass, Range, Validator};
+    /// let class = |c: &str| if c == "TOO_FINE" { ProblemClass::TooLarge } else { ProblemClass::InvalidInput };
+    /// let mut v = Validator::coded("BAD_RANGE", class);
+    /// v.range("/step", "step", 0.0, Range::FINITE.gt(0.0));
+    /// v.push_code("TOO_FINE", "/n", "n is too fine");
+    /// let err = v.finish().unwrap_err();
+    /// assert_eq!((err.code, err.class), ("BAD_RANGE", ProblemClass::InvalidInput));
+    /// assert_eq!(err.errors[0].detail, "BAD_RANGE: step must be > 0, got 0");
+    /// ```
+    #[must_use]
+    pub const fn coded(code: &'static str, class_of: fn(&str) -> ProblemClass) -> Self {
+        Self {
+            issues: Vec::new(),
+            code,
+            class_of: Some(class_of),
+        }
+    }
+
+    /// Record a problem at `pointer` with the validator's code (`INVALID_INPUT` unless
+    /// [`Validator::coded`] named another).
     pub fn push(&mut self, pointer: impl Into<String>, detail: impl Into<String>) {
-        self.push_code(INVALID_INPUT, pointer, detail);
+        self.push_code(self.code, pointer, detail);
     }
 
     /// Record a problem at `pointer` with a module-specific code.
@@ -210,10 +251,11 @@ impl Validator {
         }
     }
 
-    /// Require `value` in `range` (finite, and whole for an integer range), code `INVALID_INPUT`.
+    /// Require `value` in `range` (finite, and whole for an integer range), with the validator's
+    /// code (`INVALID_INPUT` unless [`Validator::coded`] named another).
     /// `name` (may be empty) starts the message: `"a must be > 0, got -1"`.
     pub fn range(&mut self, pointer: &str, name: &str, value: f64, range: Range) -> bool {
-        self.range_code(INVALID_INPUT, pointer, name, value, range)
+        self.range_code(self.code, pointer, name, value, range)
     }
 
     /// Like [`Validator::range`], with a module-specific code.
@@ -270,9 +312,21 @@ impl Validator {
         self.issues.extend(other.issues);
     }
 
-    /// `Ok(())` when no problem was recorded, else one [`ProblemClass::InvalidInput`] failure
-    /// listing all of them. Its code is the code shared by all problems, else the first
-    /// problem's code.
+    /// Fail now with every problem recorded so far (exactly as [`Validator::finish`] would), else
+    /// go on collecting: for checks that need the fields checked so far to be valid.
+    pub fn checkpoint(&mut self) -> Result<(), CalcFailure> {
+        let so_far = Self {
+            issues: std::mem::take(&mut self.issues),
+            code: self.code,
+            class_of: self.class_of,
+        };
+        so_far.finish()
+    }
+
+    /// `Ok(())` when no problem was recorded, else one failure listing all of them. Its code is
+    /// the code shared by all problems, else the first problem's code; its class is
+    /// [`ProblemClass::InvalidInput`] (or, for a [`Validator::coded`] validator, the class of
+    /// that code).
     pub fn finish(self) -> Result<(), CalcFailure> {
         let Some(&(code, _)) = self.issues.first() else {
             return Ok(());
@@ -283,11 +337,23 @@ impl Validator {
         } else {
             format!("{n} fields failed validation")
         };
+        let tag = self.class_of.is_some() && self.issues.iter().any(|(c, _)| *c != code);
         Err(CalcFailure {
-            class: ProblemClass::InvalidInput,
+            class: self
+                .class_of
+                .map_or(ProblemClass::InvalidInput, |f| f(code)),
             code,
             detail,
-            errors: self.issues.into_iter().map(|(_, i)| i).collect(),
+            errors: self
+                .issues
+                .into_iter()
+                .map(|(c, mut issue)| {
+                    if tag {
+                        issue.detail = format!("{c}: {}", issue.detail);
+                    }
+                    issue
+                })
+                .collect(),
         })
     }
 }

@@ -7,11 +7,12 @@ use super::ipmsm::{Ipmsm, IpmsmParams, psi_from_back_emf, rpm_to_rad_s};
 use super::maps::{Envelope, Grid2, efficiency_to_loss};
 use super::motor::{MotorInput, MotorKind};
 use super::sim::Vehicle;
+use super::wire as w;
 use super::wire::{
     AcFactorSpec, BatteryModel, BatterySpec, BusFuelEconomyRequest, CycleSpec, EnvelopeTable,
     GridSpec, IpmsmMotor, Mode, MotorEval, MotorSpec, OutputKind, PowerConvention, VehicleSpec,
 };
-use crate::calc::{CalcFailure, ProblemClass, Validator};
+use crate::calc::{CalcFailure, ProblemClass, Range, Validator};
 
 /// Most motors per request (spec §3.5).
 pub const MAX_MOTORS: usize = 8;
@@ -28,15 +29,15 @@ pub const MAX_TIME_STEP_S: f64 = 60.0;
 pub const MIN_TIME_STEP_S: f64 = 1e-3;
 /// Smallest efficiency of the gear, inverter, battery and a constant motor [-]: a service limit
 /// (the spec allows (0, 1]) that keeps P/η finite; real drivetrains are far above it.
-pub const MIN_EFFICIENCY: f64 = 0.01;
+pub const MIN_EFFICIENCY: f64 = w::EFFICIENCY.lo;
 /// Smallest value of an efficiency map [-]: keeps the converted loss |P|(1/η − 1) finite.
-pub const MIN_MAP_EFFICIENCY: f64 = 1e-6;
+pub const MIN_MAP_EFFICIENCY: f64 = w::MAP_EFFICIENCY.lo;
 /// Smallest gear ratio [-]: a service limit (spec (0, 50]) that keeps T_w/(η_T i_g) finite.
-pub const MIN_GEAR_RATIO: f64 = 0.01;
+pub const MIN_GEAR_RATIO: f64 = w::GEAR_RATIO.lo;
 /// Largest trace speed [m/s] (720 km/h): a service limit that keeps v² and the road load finite.
-pub const MAX_SPEED_MPS: f64 = 200.0;
+pub const MAX_SPEED_MPS: f64 = w::SPEED_MPS.hi;
 /// Largest |time| of a custom trace [s] (about 30 years): keeps Δt well resolved.
-pub const MAX_TIME_S: f64 = 1e9;
+pub const MAX_TIME_S: f64 = w::TIME_S.hi;
 /// Relative slack of the cycle-speed vs n_max check (rounding of the rpm conversion).
 const SPEED_CHECK_SLACK: f64 = 1e-12;
 /// Longest id / cycle name.
@@ -97,27 +98,9 @@ pub struct BusFuelEconomyInput {
     pub options: Options,
 }
 
-/// `lo < x ≤ hi`.
-fn open_closed(v: &mut Validator, ptr: &str, x: f64, lo: f64, hi: f64) -> bool {
-    if !v.finite(ptr, x) {
-        return false;
-    }
-    let ok = x > lo && x <= hi;
-    if !ok {
-        v.push(ptr, format!("must be in ({lo}, {hi}], got {x}"));
-    }
-    ok
-}
-
-/// Strictly increasing, finite, ≥ `min_len` points, first ≥ `first_min`, all ≤ `max`.
-fn axis(
-    v: &mut Validator,
-    ptr: &str,
-    xs: &[f64],
-    min_len: usize,
-    first_min: f64,
-    max: f64,
-) -> bool {
+/// Strictly increasing, finite, ≥ `min_len` points, each in `range` (the first checked against
+/// its lower end, then the order, then every point).
+fn axis(v: &mut Validator, ptr: &str, xs: &[f64], min_len: usize, range: Range) -> bool {
     if xs.len() < min_len {
         v.push(
             ptr,
@@ -128,10 +111,10 @@ fn axis(
     if !v.all_finite(ptr, xs) {
         return false;
     }
-    if xs[0] < first_min {
+    if xs[0] < range.lo {
         v.push(
             format!("{ptr}/0"),
-            format!("must be ≥ {first_min}, got {}", xs[0]),
+            format!("must be ≥ {}, got {}", range.lo, xs[0]),
         );
         return false;
     }
@@ -146,23 +129,16 @@ fn axis(
         );
         return false;
     }
-    if let Some(i) = xs.iter().position(|x| x.abs() > max) {
-        v.push(
-            format!("{ptr}/{i}"),
-            format!("magnitude must be ≤ {max}, got {}", xs[i]),
-        );
-        return false;
-    }
-    true
+    v.all_in(ptr, "", xs, range)
 }
 
-/// A table `[rows][cols]` of finite values in [lo, hi] (or (lo, hi] when `open_lo`).
+/// A table `[rows][cols]` of values in `range`.
 fn table(
     v: &mut Validator,
     ptr: &str,
     t: &[Vec<f64>],
     (rows, cols): (usize, usize),
-    (lo, hi, open_lo): (f64, f64, bool),
+    range: Range,
 ) -> bool {
     if t.len() != rows {
         v.push(
@@ -183,18 +159,7 @@ fn table(
             );
             return false;
         }
-        if !v.all_finite(&p, row) {
-            return false;
-        }
-        let bad = row
-            .iter()
-            .position(|&x| x > hi || x < lo || (open_lo && x <= lo));
-        if let Some(j) = bad {
-            let lb = if open_lo { "(" } else { "[" };
-            v.push(
-                format!("{p}/{j}"),
-                format!("must be in {lb}{lo}, {hi}], got {}", row[j]),
-            );
+        if !v.all_in(&p, "", row, range) {
             return false;
         }
     }
@@ -212,40 +177,33 @@ fn name_ok(v: &mut Validator, ptr: &str, name: &str, what: &str) {
 }
 
 fn vehicle(v: &mut Validator, s: &VehicleSpec) -> Vehicle {
-    open_closed(v, "/vehicle/curb_mass_kg", s.curb_mass_kg, 0.0, 1e5);
-    if s.passengers > 500 {
-        v.push(
-            "/vehicle/passengers",
-            format!("must be in [0, 500], got {}", s.passengers),
-        );
+    let fields = [
+        ("curb_mass_kg", s.curb_mass_kg, w::CURB_MASS_KG),
+        ("passengers", f64::from(s.passengers), w::PASSENGERS),
+        (
+            "mass_per_passenger_kg",
+            s.mass_per_passenger_kg,
+            w::MASS_PER_PASSENGER_KG,
+        ),
+        ("frontal_area_m2", s.frontal_area_m2, w::FRONTAL_AREA_M2),
+        ("drag_coeff", s.drag_coeff, w::DRAG_COEFF),
+        ("rolling_coeff", s.rolling_coeff, w::ROLLING_COEFF),
+        ("air_density", s.air_density, w::AIR_DENSITY),
+        ("gravity", s.gravity, w::GRAVITY),
+        ("wheel_radius_m", s.wheel_radius_m, w::WHEEL_RADIUS_M),
+        ("gear_ratio", s.gear_ratio, w::GEAR_RATIO),
+        ("gear_efficiency", s.gear_efficiency, w::EFFICIENCY),
+        (
+            "rotational_inertia_factor",
+            s.rotational_inertia_factor,
+            w::FRACTION,
+        ),
+        ("grade", s.grade, w::GRADE),
+        ("aux_power_w", s.aux_power_w, w::AUX_POWER_W),
+    ];
+    for (name, x, range) in fields {
+        v.range(&format!("/vehicle/{name}"), "", x, range);
     }
-    v.in_range(
-        "/vehicle/mass_per_passenger_kg",
-        s.mass_per_passenger_kg,
-        0.0,
-        200.0,
-    );
-    open_closed(v, "/vehicle/frontal_area_m2", s.frontal_area_m2, 0.0, 30.0);
-    open_closed(v, "/vehicle/drag_coeff", s.drag_coeff, 0.0, 3.0);
-    v.in_range("/vehicle/rolling_coeff", s.rolling_coeff, 0.0, 0.1);
-    open_closed(v, "/vehicle/air_density", s.air_density, 0.0, 2.0);
-    open_closed(v, "/vehicle/gravity", s.gravity, 9.0, 10.5);
-    open_closed(v, "/vehicle/wheel_radius_m", s.wheel_radius_m, 0.1, 2.0);
-    v.in_range("/vehicle/gear_ratio", s.gear_ratio, MIN_GEAR_RATIO, 50.0);
-    v.in_range(
-        "/vehicle/gear_efficiency",
-        s.gear_efficiency,
-        MIN_EFFICIENCY,
-        1.0,
-    );
-    v.in_range(
-        "/vehicle/rotational_inertia_factor",
-        s.rotational_inertia_factor,
-        0.0,
-        1.0,
-    );
-    v.in_range("/vehicle/grade", s.grade, -0.3, 0.3);
-    v.in_range("/vehicle/aux_power_w", s.aux_power_w, 0.0, 1e5);
     let mass = f64::from(s.passengers).mul_add(s.mass_per_passenger_kg, s.curb_mass_kg);
     Vehicle {
         mass,
@@ -284,7 +242,7 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
                 }
             }
             let eta = b.efficiency.unwrap_or(1.0);
-            v.in_range("/battery/efficiency", eta, MIN_EFFICIENCY, 1.0);
+            v.range("/battery/efficiency", "", eta, w::EFFICIENCY);
             Battery::Constant { eta }
         }
         BatteryModel::Ecm2rc => {
@@ -294,8 +252,8 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
                     "is a constant-model field; not allowed with model \"ecm_2rc\"".to_owned(),
                 );
             }
-            // Required field in (lo, hi] (`lo_open`) or [lo, hi]; NaN placeholder when missing.
-            let mut need = |name: &str, x: Option<f64>, lo: f64, hi: f64, lo_open: bool| -> f64 {
+            // Required field in its range; NaN placeholder when missing.
+            let mut need = |name: &str, x: Option<f64>, range: Range| -> f64 {
                 let ptr = format!("/battery/{name}");
                 match x {
                     None => {
@@ -303,28 +261,24 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
                         f64::NAN
                     }
                     Some(x) => {
-                        if lo_open {
-                            open_closed(v, &ptr, x, lo, hi);
-                        } else {
-                            v.in_range(&ptr, x, lo, hi);
-                        }
+                        v.range(&ptr, "", x, range);
                         x
                     }
                 }
             };
-            let soc0 = need("soc_initial", b.soc_initial, 0.0, 1.0, true);
-            let r0 = need("r0_ohm", b.r0_ohm, 0.0, 100.0, true);
-            let r1 = need("r1_ohm", b.r1_ohm, 0.0, 100.0, false);
-            let c1 = need("c1_f", b.c1_f, 0.0, 1e9, true);
-            let r2 = need("r2_ohm", b.r2_ohm, 0.0, 100.0, false);
-            let c2 = need("c2_f", b.c2_f, 0.0, 1e9, true);
+            let soc0 = need("soc_initial", b.soc_initial, w::SOC_INITIAL);
+            let r0 = need("r0_ohm", b.r0_ohm, w::R0_OHM);
+            let r1 = need("r1_ohm", b.r1_ohm, w::RC_OHM);
+            let c1 = need("c1_f", b.c1_f, w::RC_F);
+            let r2 = need("r2_ohm", b.r2_ohm, w::RC_OHM);
+            let c2 = need("c2_f", b.c2_f, w::RC_F);
             let vn = b.nominal_voltage.unwrap_or(360.0);
             let cap = b.capacity_kwh.unwrap_or(256.0);
-            open_closed(v, "/battery/nominal_voltage", vn, 0.0, 5000.0);
-            open_closed(v, "/battery/capacity_kwh", cap, 0.0, 1e4);
+            v.range("/battery/nominal_voltage", "", vn, w::NOMINAL_VOLTAGE);
+            v.range("/battery/capacity_kwh", "", cap, w::CAPACITY_KWH);
             let (soc_t, ocv_t) = match (&b.ocv_soc, &b.ocv_v) {
                 (Some(s), Some(o)) => {
-                    let ok_s = axis(v, "/battery/ocv_soc", s, 2, 0.0, 1.0);
+                    let ok_s = axis(v, "/battery/ocv_soc", s, 2, w::FRACTION);
                     if ok_s && s.last().is_some_and(|&x| x > 1.0) {
                         v.push(
                             "/battery/ocv_soc",
@@ -336,13 +290,8 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
                             "/battery/ocv_v",
                             format!("must have {} values like ocv_soc, got {}", s.len(), o.len()),
                         );
-                    } else if v.all_finite("/battery/ocv_v", o)
-                        && let Some(i) = o.iter().position(|&x| x <= 0.0 || x > 1e5)
-                    {
-                        v.push(
-                            format!("/battery/ocv_v/{i}"),
-                            format!("must be in (0, 100000] V, got {}", o[i]),
-                        );
+                    } else {
+                        v.all_in("/battery/ocv_v", "", o, w::OCV_V);
                     }
                     (s.clone(), o.clone())
                 }
@@ -429,7 +378,7 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
             if !ok {
                 return None;
             }
-            if let Some(i) = cc.time_s.iter().position(|t| t.abs() > MAX_TIME_S) {
+            if let Some(i) = cc.time_s.iter().position(|&t| !w::TIME_S.contains(t)) {
                 v.push(
                     format!("{tp}/{i}"),
                     format!("|time| must be ≤ {MAX_TIME_S} s, got {}", cc.time_s[i]),
@@ -461,10 +410,7 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
                 ok = false;
             }
             let mps: Vec<f64> = speeds.iter().map(|s| s * factor).collect();
-            if let Some(i) = mps
-                .iter()
-                .position(|&s| !(0.0..=MAX_SPEED_MPS).contains(&s))
-            {
+            if let Some(i) = mps.iter().position(|&s| !w::SPEED_MPS.contains(s)) {
                 v.push(
                     format!("{sp_ptr}/{i}"),
                     format!(
@@ -484,7 +430,7 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
                     ok = false;
                 } else if !v.all_finite(&gp, g) {
                     ok = false;
-                } else if let Some(i) = g.iter().position(|x| !(-0.3..=0.3).contains(x)) {
+                } else if let Some(i) = g.iter().position(|&x| !w::GRADE.contains(x)) {
                     v.push(
                         format!("{gp}/{i}"),
                         format!("grade must be in [-0.3, 0.3], got {}", g[i]),
@@ -512,7 +458,7 @@ fn envelope(
     table: Option<&EnvelopeTable>,
 ) -> (Envelope, f64) {
     let n_max = n_max.unwrap_or(DEFAULT_N_MAX);
-    open_closed(v, &format!("{base}/n_max_rpm"), n_max, 0.0, 1e5);
+    v.range(&format!("{base}/n_max_rpm"), "", n_max, w::N_MAX_RPM);
     let env = match table {
         Some(t) => {
             if t_peak.is_some() || p_peak.is_some() {
@@ -522,7 +468,13 @@ fn envelope(
                 );
             }
             let p = format!("{base}/envelope");
-            let ok = axis(v, &format!("{p}/speed_rpm"), &t.speed_rpm, 2, 0.0, 1e5);
+            let ok = axis(
+                v,
+                &format!("{p}/speed_rpm"),
+                &t.speed_rpm,
+                2,
+                w::SPEED_AXIS_RPM,
+            );
             if t.t_max_nm.len() != t.speed_rpm.len() {
                 v.push(
                     format!("{p}/t_max_nm"),
@@ -532,13 +484,8 @@ fn envelope(
                         t.t_max_nm.len()
                     ),
                 );
-            } else if v.all_finite(&format!("{p}/t_max_nm"), &t.t_max_nm)
-                && let Some(i) = t.t_max_nm.iter().position(|&x| x <= 0.0 || x > 1e6)
-            {
-                v.push(
-                    format!("{p}/t_max_nm/{i}"),
-                    format!("must be in (0, 1000000] N·m, got {}", t.t_max_nm[i]),
-                );
+            } else {
+                v.all_in(&format!("{p}/t_max_nm"), "", &t.t_max_nm, w::TORQUE_NM);
             }
             let _ = ok;
             Envelope::Table {
@@ -549,8 +496,8 @@ fn envelope(
         None => {
             let tp = t_peak.unwrap_or(DEFAULT_T_PEAK);
             let pp = p_peak.unwrap_or(DEFAULT_P_PEAK);
-            open_closed(v, &format!("{base}/t_peak_nm"), tp, 0.0, 1e6);
-            open_closed(v, &format!("{base}/p_peak_w"), pp, 0.0, 1e9);
+            v.range(&format!("{base}/t_peak_nm"), "", tp, w::TORQUE_NM);
+            v.range(&format!("{base}/p_peak_w"), "", pp, w::POWER_W);
             Envelope::TorquePower {
                 t_peak: tp,
                 p_peak: pp,
@@ -562,32 +509,31 @@ fn envelope(
 
 fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
     let p = format!("{base}/");
-    if !(1..=32).contains(&m.pole_pairs) {
-        v.push(
-            format!("{p}pole_pairs"),
-            format!("must be in [1, 32], got {}", m.pole_pairs),
-        );
-    }
-    let pp = f64::from(m.pole_pairs.clamp(1, 32));
+    v.uint(
+        &format!("{p}pole_pairs"),
+        "",
+        u64::from(m.pole_pairs),
+        w::POLE_PAIRS,
+    );
+    let pp = f64::from(m.pole_pairs).clamp(w::POLE_PAIRS.lo, w::POLE_PAIRS.hi);
     let psi = match (m.psi_m_wb, &m.back_emf) {
         (Some(psi), None) => {
-            open_closed(v, &format!("{p}psi_m_wb"), psi, 0.0, 100.0);
+            v.range(&format!("{p}psi_m_wb"), "", psi, w::PSI_M_WB);
             psi
         }
         (None, Some(b)) => {
-            let a = open_closed(
-                v,
+            let a = v.range(
                 &format!("{p}back_emf/v_peak_phase"),
+                "",
                 b.v_peak_phase,
-                0.0,
-                1e5,
+                w::BACK_EMF,
             );
-            let c = open_closed(v, &format!("{p}back_emf/at_rpm"), b.at_rpm, 0.0, 1e5);
+            let c = v.range(&format!("{p}back_emf/at_rpm"), "", b.at_rpm, w::BACK_EMF);
             let psi = psi_from_back_emf(b.v_peak_phase, b.at_rpm, pp);
-            if a && c && !(psi > 0.0 && psi <= 100.0) {
+            if a && c && !w::PSI_M_WB.contains(psi) {
                 v.push(
                     format!("{p}back_emf"),
-                    format!("implies ψ_m = {psi} Wb, outside (0, 100]"),
+                    format!("implies ψ_m = {psi} Wb, outside {}", w::PSI_M_WB),
                 );
             }
             psi
@@ -604,41 +550,40 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
             f64::NAN
         }
     };
-    let ld_ok = open_closed(v, &format!("{p}ld_h"), m.ld_h, 0.0, 1.0);
-    let lq_ok = open_closed(v, &format!("{p}lq_h"), m.lq_h, 0.0, 1.0);
+    let ld_ok = v.range(&format!("{p}ld_h"), "", m.ld_h, w::INDUCTANCE_H);
+    let lq_ok = v.range(&format!("{p}lq_h"), "", m.lq_h, w::INDUCTANCE_H);
     if ld_ok && lq_ok && m.lq_h < m.ld_h {
         v.push(
             format!("{p}lq_h"),
             format!("must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}", m.ld_h, m.lq_h),
         );
     }
-    open_closed(
-        v,
-        &format!("{p}r_phase_20c_ohm"),
-        m.r_phase_20c_ohm,
-        0.0,
-        100.0,
-    );
     let temp = m.winding_temp_c.unwrap_or(100.0);
-    v.in_range(&format!("{p}winding_temp_c"), temp, -40.0, 250.0);
-    open_closed(v, &format!("{p}i_max_arms"), m.i_max_arms, 0.0, 1e5);
-    open_closed(v, &format!("{p}v_dc"), m.v_dc, 0.0, 1e5);
     let util = m.voltage_utilization.unwrap_or(1.0);
-    open_closed(v, &format!("{p}voltage_utilization"), util, 0.0, 1.155);
-    open_closed(v, &format!("{p}n_max_rpm"), m.n_max_rpm, 0.0, 1e5);
+    let fields = [
+        ("r_phase_20c_ohm", m.r_phase_20c_ohm, w::R_PHASE_OHM),
+        ("winding_temp_c", temp, w::WINDING_TEMP_C),
+        ("i_max_arms", m.i_max_arms, w::ELECTRIC_LIMIT),
+        ("v_dc", m.v_dc, w::ELECTRIC_LIMIT),
+        ("voltage_utilization", util, w::VOLTAGE_UTILIZATION),
+        ("n_max_rpm", m.n_max_rpm, w::N_MAX_RPM),
+    ];
+    for (name, x, range) in fields {
+        v.range(&format!("{p}{name}"), "", x, range);
+    }
     let t_cap = m.t_cap_nm.unwrap_or(f64::INFINITY);
     if m.t_cap_nm.is_some() {
-        open_closed(v, &format!("{p}t_cap_nm"), t_cap, 0.0, 1e6);
+        v.range(&format!("{p}t_cap_nm"), "", t_cap, w::TORQUE_NM);
     }
     let p_cap = m.p_cap_w.unwrap_or(f64::INFINITY);
     if m.p_cap_w.is_some() {
-        open_closed(v, &format!("{p}p_cap_w"), p_cap, 0.0, 1e9);
+        v.range(&format!("{p}p_cap_w"), "", p_cap, w::POWER_W);
     }
     let ac = match &m.ac_factor {
         None | Some(AcFactorSpec::NoAc(_)) => AcFactor::None,
         Some(AcFactorSpec::Table(t)) => {
             let ap = format!("{p}ac_factor");
-            axis(v, &format!("{ap}/freq_hz"), &t.freq_hz, 1, 0.0, 1e7);
+            axis(v, &format!("{ap}/freq_hz"), &t.freq_hz, 1, w::FREQ_HZ);
             if t.k_ac.len() != t.freq_hz.len() {
                 v.push(
                     format!("{ap}/k_ac"),
@@ -648,13 +593,8 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
                         t.k_ac.len()
                     ),
                 );
-            } else if v.all_finite(&format!("{ap}/k_ac"), &t.k_ac)
-                && let Some(i) = t.k_ac.iter().position(|&k| !(1.0..=1000.0).contains(&k))
-            {
-                v.push(
-                    format!("{ap}/k_ac/{i}"),
-                    format!("k_AC must be in [1, 1000], got {}", t.k_ac[i]),
-                );
+            } else {
+                v.all_in(&format!("{ap}/k_ac"), "k_AC", &t.k_ac, w::K_AC);
             }
             AcFactor::Table {
                 freq_hz: t.freq_hz.clone(),
@@ -663,28 +603,20 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
         }
         Some(AcFactorSpec::Dowell(d)) => {
             let ap = format!("{p}ac_factor");
-            open_closed(
-                v,
-                &format!("{ap}/conductor_height_m"),
-                d.conductor_height_m,
-                0.0,
-                0.1,
-            );
-            if !(1..=100).contains(&d.layers) {
-                v.push(
-                    format!("{ap}/layers"),
-                    format!("must be in [1, 100], got {}", d.layers),
-                );
+            let fields = [
+                (
+                    "conductor_height_m",
+                    d.conductor_height_m,
+                    w::CONDUCTOR_HEIGHT_M,
+                ),
+                ("layers", f64::from(d.layers), w::LAYERS),
+                ("porosity", d.porosity, w::POROSITY),
+                ("stack_length_m", d.stack_length_m, w::STACK_LENGTH_M),
+                ("end_length_m", d.end_length_m, w::END_LENGTH_M),
+            ];
+            for (name, x, range) in fields {
+                v.range(&format!("{ap}/{name}"), "", x, range);
             }
-            open_closed(v, &format!("{ap}/porosity"), d.porosity, 0.0, 1.0);
-            open_closed(
-                v,
-                &format!("{ap}/stack_length_m"),
-                d.stack_length_m,
-                0.0,
-                10.0,
-            );
-            v.in_range(&format!("{ap}/end_length_m"), d.end_length_m, 0.0, 10.0);
             AcFactor::Dowell(Dowell {
                 conductor_height_m: d.conductor_height_m,
                 layers: f64::from(d.layers),
@@ -695,14 +627,18 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
         }
     };
     let iron = m.iron.clone().unwrap_or_default();
-    v.in_range(&format!("{p}iron/k_h"), iron.k_h, 0.0, 1e6);
-    v.in_range(&format!("{p}iron/k_e"), iron.k_e, 0.0, 1e6);
     let mech = m.mech.clone().unwrap_or_default();
-    v.in_range(&format!("{p}mech/c_fric_nm"), mech.c_fric_nm, 0.0, 1e6);
-    v.in_range(&format!("{p}mech/c_wind"), mech.c_wind, 0.0, 1e6);
+    for (name, x) in [
+        ("iron/k_h", iron.k_h),
+        ("iron/k_e", iron.k_e),
+        ("mech/c_fric_nm", mech.c_fric_nm),
+        ("mech/c_wind", mech.c_wind),
+    ] {
+        v.range(&format!("{p}{name}"), "", x, w::LOSS_COEFF);
+    }
     let scale = m.stack_scale.unwrap_or(1.0);
     if m.stack_scale.is_some() {
-        open_closed(v, &format!("{p}stack_scale"), scale, 0.0, 10.0);
+        v.range(&format!("{p}stack_scale"), "", scale, w::STACK_SCALE);
         if !matches!(ac, AcFactor::Dowell(_)) {
             v.push(
                 format!("{p}stack_scale"),
@@ -751,11 +687,11 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     // The second element (admissible speed in rad/s) is recomputed below from the rpm values.
     let (kind, _) = match spec {
         MotorSpec::Constant(m) => {
-            v.in_range(
+            v.range(
                 &format!("{base}/efficiency"),
+                "",
                 m.efficiency,
-                MIN_EFFICIENCY,
-                1.0,
+                w::EFFICIENCY,
             );
             let (env, w) = envelope(
                 v,
@@ -782,8 +718,20 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 m.n_max_rpm,
                 m.envelope.as_ref(),
             );
-            let ok_s = axis(v, &format!("{base}/speed_rpm"), &m.speed_rpm, 2, 0.0, 1e5);
-            let ok_t = axis(v, &format!("{base}/torque_nm"), &m.torque_nm, 2, 0.0, 1e6);
+            let ok_s = axis(
+                v,
+                &format!("{base}/speed_rpm"),
+                &m.speed_rpm,
+                2,
+                w::SPEED_AXIS_RPM,
+            );
+            let ok_t = axis(
+                v,
+                &format!("{base}/torque_nm"),
+                &m.torque_nm,
+                2,
+                w::TORQUE_AXIS_NM,
+            );
             let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
             let mut ok = ok_s && ok_t;
             if ok {
@@ -792,7 +740,7 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                     &format!("{base}/efficiency"),
                     &m.efficiency,
                     (ns, nt),
-                    (MIN_MAP_EFFICIENCY, 1.0, false),
+                    w::MAP_EFFICIENCY,
                 );
                 if let Some(g) = &m.efficiency_gen {
                     ok &= table(
@@ -800,7 +748,7 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                         &format!("{base}/efficiency_gen"),
                         g,
                         (ns, nt),
-                        (MIN_MAP_EFFICIENCY, 1.0, false),
+                        w::MAP_EFFICIENCY,
                     );
                 }
             }
@@ -842,14 +790,19 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 m.n_max_rpm,
                 m.envelope.as_ref(),
             );
-            let ok_s = axis(v, &format!("{base}/speed_rpm"), &m.speed_rpm, 2, 0.0, 1e5);
+            let ok_s = axis(
+                v,
+                &format!("{base}/speed_rpm"),
+                &m.speed_rpm,
+                2,
+                w::SPEED_AXIS_RPM,
+            );
             let ok_t = axis(
                 v,
                 &format!("{base}/torque_nm"),
                 &m.torque_nm,
                 2,
-                f64::NEG_INFINITY,
-                1e6,
+                w::SIGNED_TORQUE_AXIS_NM,
             );
             if ok_t && !m.torque_nm.iter().any(|&t| t.abs() <= 0.0) {
                 v.push(
@@ -858,15 +811,8 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 );
             }
             let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
-            let ok = ok_s
-                && ok_t
-                && table(
-                    v,
-                    &format!("{base}/loss_w"),
-                    &m.loss_w,
-                    (ns, nt),
-                    (0.0, 1e9, false),
-                );
+            let ok =
+                ok_s && ok_t && table(v, &format!("{base}/loss_w"), &m.loss_w, (ns, nt), w::LOSS_W);
             let loss = Grid2 {
                 speed: m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
                 torque: m.torque_nm.clone(),
@@ -917,8 +863,18 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
 }
 
 fn grid(v: &mut Validator, ptr: &str, g: &GridSpec) -> (f64, f64) {
-    v.in_range(&format!("{ptr}/speed_step_rpm"), g.speed_step_rpm, 1.0, 1e4);
-    v.in_range(&format!("{ptr}/torque_step_nm"), g.torque_step_nm, 0.1, 1e4);
+    v.range(
+        &format!("{ptr}/speed_step_rpm"),
+        "",
+        g.speed_step_rpm,
+        w::SPEED_STEP_RPM,
+    );
+    v.range(
+        &format!("{ptr}/torque_step_nm"),
+        "",
+        g.torque_step_nm,
+        w::TORQUE_STEP_NM,
+    );
     (g.speed_step_rpm, g.torque_step_nm)
 }
 
@@ -949,11 +905,11 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let veh = vehicle(&mut v, &req.vehicle);
-        v.in_range(
+        v.range(
             "/inverter/efficiency",
+            "",
             req.inverter.efficiency,
-            MIN_EFFICIENCY,
-            1.0,
+            w::EFFICIENCY,
         );
         let bat = battery(&mut v, &req.battery);
 
@@ -1011,24 +967,19 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
 
         // Options.
         let o = &req.options;
-        if !(1..=32).contains(&o.substeps) {
-            v.push(
-                "/options/substeps",
-                format!("must be in [1, 32], got {}", o.substeps),
-            );
-        }
+        v.uint("/options/substeps", "", u64::from(o.substeps), w::SUBSTEPS);
         let gr = grid(&mut v, "/options/loss_map_grid", &o.loss_map_grid);
-        v.in_range(
+        v.range(
             "/options/op_histogram/speed_bin_rpm",
+            "",
             o.op_histogram.speed_bin_rpm,
-            1.0,
-            1e5,
+            w::SPEED_BIN_RPM,
         );
-        v.in_range(
+        v.range(
             "/options/op_histogram/torque_bin_nm",
+            "",
             o.op_histogram.torque_bin_nm,
-            0.1,
-            1e5,
+            w::TORQUE_BIN_NM,
         );
         let n_cyc = req.cycles.len().max(1);
         let weights = match &o.desirability_weights {
@@ -1045,13 +996,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
                         ),
                     );
                     vec![1.0 / n_cyc as f64; n_cyc]
-                } else if !v.all_finite(p, w) {
-                    vec![1.0 / n_cyc as f64; n_cyc]
-                } else if let Some(i) = w.iter().position(|&x| !(0.0..=1e6).contains(&x)) {
-                    v.push(
-                        format!("{p}/{i}"),
-                        format!("must be in [0, 1000000], got {}", w[i]),
-                    );
+                } else if !v.all_in(p, "", w, w::DESIRABILITY_WEIGHT) {
                     vec![1.0 / n_cyc as f64; n_cyc]
                 } else {
                     let s: f64 = w.iter().sum();

@@ -943,88 +943,239 @@ pub struct LossComponentMaps {
     pub mode: Vec<Vec<Option<String>>>,
 }
 
+/// Curb mass [kg].
+pub const CURB_MASS_KG: Range = Range::FINITE.gt(0.0).max(1e5);
+/// Passengers [–].
+pub const PASSENGERS: Range = Range::int(0, 500);
+/// Mass per passenger [kg].
+pub const MASS_PER_PASSENGER_KG: Range = Range::closed(0.0, 200.0);
+/// Frontal area [m²].
+pub const FRONTAL_AREA_M2: Range = Range::FINITE.gt(0.0).max(30.0);
+/// Drag coefficient [–].
+pub const DRAG_COEFF: Range = Range::FINITE.gt(0.0).max(3.0);
+/// Rolling-resistance coefficient [–].
+pub const ROLLING_COEFF: Range = Range::closed(0.0, 0.1);
+/// Air density [kg/m³].
+pub const AIR_DENSITY: Range = Range::FINITE.gt(0.0).max(2.0);
+/// Gravity [m/s²].
+pub const GRAVITY: Range = Range::FINITE.gt(9.0).max(10.5);
+/// Wheel radius [m].
+pub const WHEEL_RADIUS_M: Range = Range::FINITE.gt(0.1).max(2.0);
+/// Final-drive gear ratio [–].
+pub const GEAR_RATIO: Range = Range::closed(0.01, 50.0);
+/// A constant efficiency (gear, inverter, battery, constant motor) [–]: at least 1 %.
+pub const EFFICIENCY: Range = Range::closed(0.01, 1.0);
+/// A fraction in [0, 1] (rotational inertia factor) [–].
+pub const FRACTION: Range = Range::closed(0.0, 1.0);
+/// Road grade (rise over run) [–].
+pub const GRADE: Range = Range::closed(-0.3, 0.3);
+/// Auxiliary power [W].
+pub const AUX_POWER_W: Range = Range::closed(0.0, 1e5);
+/// Battery nominal voltage [V].
+pub const NOMINAL_VOLTAGE: Range = Range::FINITE.gt(0.0).max(5000.0);
+/// Battery capacity [kWh].
+pub const CAPACITY_KWH: Range = Range::FINITE.gt(0.0).max(1e4);
+/// Initial state of charge [–]: (0, 1] (spec §2).
+pub const SOC_INITIAL: Range = Range::FINITE.gt(0.0).max(1.0);
+/// Series resistance R0 [Ω]: > 0 (spec §2).
+pub const R0_OHM: Range = Range::FINITE.gt(0.0).max(100.0);
+/// RC-branch resistance R1, R2 [Ω]: ≥ 0 (spec §2).
+pub const RC_OHM: Range = Range::closed(0.0, 100.0);
+/// RC-branch capacitance C1, C2 [F]: > 0 (spec §2).
+pub const RC_F: Range = Range::FINITE.gt(0.0).max(1e9);
+/// Torque [N·m] (peak, cap, envelope values): positive.
+pub const TORQUE_NM: Range = Range::FINITE.gt(0.0).max(1e6);
+/// Power [W] (peak, cap): positive.
+pub const POWER_W: Range = Range::FINITE.gt(0.0).max(1e9);
+/// Motor top speed [rpm].
+pub const N_MAX_RPM: Range = Range::FINITE.gt(0.0).max(1e5);
+/// Pole pairs [–].
+pub const POLE_PAIRS: Range = Range::int(1, 32);
+/// Permanent-magnet flux linkage ψ_m [Wb].
+pub const PSI_M_WB: Range = Range::FINITE.gt(0.0).max(100.0);
+/// Back-EMF peak phase voltage [V] and its speed [rpm].
+pub const BACK_EMF: Range = Range::FINITE.gt(0.0).max(1e5);
+/// d- and q-axis inductance [H].
+pub const INDUCTANCE_H: Range = Range::FINITE.gt(0.0).max(1.0);
+/// Phase resistance at 20 °C [Ω].
+pub const R_PHASE_OHM: Range = Range::FINITE.gt(0.0).max(100.0);
+/// Winding temperature [°C] (spec §2).
+pub const WINDING_TEMP_C: Range = Range::closed(-40.0, 250.0);
+/// Current limit [A rms] and DC-link voltage [V].
+pub const ELECTRIC_LIMIT: Range = Range::FINITE.gt(0.0).max(1e5);
+/// Voltage utilisation [–] (≤ 2/√3 with space-vector modulation).
+pub const VOLTAGE_UTILIZATION: Range = Range::FINITE.gt(0.0).max(1.155);
+/// Stack scale [–].
+pub const STACK_SCALE: Range = Range::FINITE.gt(0.0).max(10.0);
+/// Dowell conductor height [m].
+pub const CONDUCTOR_HEIGHT_M: Range = Range::FINITE.gt(0.0).max(0.1);
+/// Dowell conductor layers [–].
+pub const LAYERS: Range = Range::int(1, 100);
+/// Dowell porosity [–].
+pub const POROSITY: Range = Range::FINITE.gt(0.0).max(1.0);
+/// Stack length [m].
+pub const STACK_LENGTH_M: Range = Range::FINITE.gt(0.0).max(10.0);
+/// End-winding length [m].
+pub const END_LENGTH_M: Range = Range::closed(0.0, 10.0);
+/// Iron and mechanical loss coefficients (k_h, k_e, c_fric, c_wind): ≥ 0 (spec §2).
+pub const LOSS_COEFF: Range = Range::closed(0.0, 1e6);
+/// AC resistance factor k_AC [–].
+pub const K_AC: Range = Range::closed(1.0, 1000.0);
+/// Loss-map grid speed step [rpm].
+pub const SPEED_STEP_RPM: Range = Range::closed(1.0, 1e4);
+/// Loss-map grid torque step [N·m].
+pub const TORQUE_STEP_NM: Range = Range::closed(0.1, 1e4);
+/// Operating-point histogram speed bin [rpm].
+pub const SPEED_BIN_RPM: Range = Range::closed(1.0, 1e5);
+/// Operating-point histogram torque bin [N·m].
+pub const TORQUE_BIN_NM: Range = Range::closed(0.1, 1e5);
+/// Sub-steps per cycle interval [–].
+pub const SUBSTEPS: Range = Range::int(1, 32);
+/// Desirability weight of a cycle [–] (normalised to sum 1; not all 0).
+pub const DESIRABILITY_WEIGHT: Range = Range::closed(0.0, 1e6);
+/// Open-circuit voltage table values [V].
+pub const OCV_V: Range = Range::FINITE.gt(0.0).max(1e5);
+/// A motor speed axis [rpm] (strictly increasing).
+pub const SPEED_AXIS_RPM: Range = Range::closed(0.0, 1e5);
+/// A motoring torque axis [N·m] (strictly increasing).
+pub const TORQUE_AXIS_NM: Range = Range::closed(0.0, 1e6);
+/// A signed torque axis of a loss map [N·m] (strictly increasing, containing 0).
+pub const SIGNED_TORQUE_AXIS_NM: Range = Range::closed(-1e6, 1e6);
+/// A frequency axis of a k_AC table [Hz] (strictly increasing).
+pub const FREQ_HZ: Range = Range::closed(0.0, 1e7);
+/// An efficiency-map value [–]: the floor keeps the converted loss |P|(1/η − 1) finite.
+pub const MAP_EFFICIENCY: Range = Range::closed(1e-6, 1.0);
+/// A loss-map value [W].
+pub const LOSS_W: Range = Range::closed(0.0, 1e9);
+/// Custom-cycle time [s] (about ±30 years: keeps Δt well resolved; strictly increasing, steps
+/// of 1 ms to 60 s).
+pub const TIME_S: Range = Range::closed(-1e9, 1e9);
+/// Custom-cycle speed [m/s]: a service limit (720 km/h) that keeps v² and the road load finite.
+pub const SPEED_MPS: Range = Range::closed(0.0, 200.0);
+/// Custom-cycle speed [km/h] (the same limit as [`SPEED_MPS`]).
+pub const SPEED_KMH: Range = Range::closed(0.0, 720.0);
+
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
 crate::schema_bounds! {
     VehicleSpec {
-        curb_mass_kg: Range::FINITE.gt(0.0).max(100000.0),
-        passengers: Range::INTEGER.min(0.0).max(500.0),
-        mass_per_passenger_kg: Range::FINITE.min(0.0).max(200.0),
-        frontal_area_m2: Range::FINITE.gt(0.0).max(30.0),
-        drag_coeff: Range::FINITE.gt(0.0).max(3.0),
-        rolling_coeff: Range::FINITE.min(0.0).max(0.1),
-        air_density: Range::FINITE.gt(0.0).max(2.0),
-        gravity: Range::FINITE.gt(9.0).max(10.5),
-        wheel_radius_m: Range::FINITE.gt(0.1).max(2.0),
-        gear_ratio: Range::FINITE.min(0.01).max(50.0),
-        gear_efficiency: Range::FINITE.min(0.01).max(1.0),
-        rotational_inertia_factor: Range::FINITE.min(0.0).max(1.0),
-        grade: Range::FINITE.min(-0.3).max(0.3),
-        aux_power_w: Range::FINITE.min(0.0).max(100000.0),
+        curb_mass_kg: CURB_MASS_KG,
+        passengers: PASSENGERS,
+        mass_per_passenger_kg: MASS_PER_PASSENGER_KG,
+        frontal_area_m2: FRONTAL_AREA_M2,
+        drag_coeff: DRAG_COEFF,
+        rolling_coeff: ROLLING_COEFF,
+        air_density: AIR_DENSITY,
+        gravity: GRAVITY,
+        wheel_radius_m: WHEEL_RADIUS_M,
+        gear_ratio: GEAR_RATIO,
+        gear_efficiency: EFFICIENCY,
+        rotational_inertia_factor: FRACTION,
+        grade: GRADE,
+        aux_power_w: AUX_POWER_W,
     },
     InverterSpec {
-        efficiency: Range::FINITE.min(0.01).max(1.0),
+        efficiency: EFFICIENCY,
     },
     BatterySpec {
-        efficiency: Range::FINITE.min(0.01).max(1.0),
-        nominal_voltage: Range::FINITE.gt(0.0).max(5000.0),
-        capacity_kwh: Range::FINITE.gt(0.0).max(10000.0),
-        soc_initial: Range::FINITE.min(0.0).max(1.0),
-        r0_ohm: Range::FINITE.min(0.0).max(100.0),
-        r1_ohm: Range::FINITE.min(0.0).max(100.0),
-        c1_f: Range::FINITE.min(0.0),
-        r2_ohm: Range::FINITE.min(0.0).max(100.0),
-        c2_f: Range::FINITE.min(0.0),
+        efficiency: EFFICIENCY,
+        nominal_voltage: NOMINAL_VOLTAGE,
+        capacity_kwh: CAPACITY_KWH,
+        soc_initial: SOC_INITIAL,
+        r0_ohm: R0_OHM,
+        r1_ohm: RC_OHM,
+        c1_f: RC_F,
+        r2_ohm: RC_OHM,
+        c2_f: RC_F,
+        ocv_soc @items: FRACTION,
+        ocv_v @items: OCV_V,
+    },
+    CustomCycle {
+        time_s @items: TIME_S,
+        speed_kmh @items: SPEED_KMH,
+        speed_mps @items: SPEED_MPS,
+        grade @items: GRADE,
+    },
+    EnvelopeTable {
+        speed_rpm @items: SPEED_AXIS_RPM,
+        t_max_nm @items: TORQUE_NM,
+    },
+    EfficiencyMapMotor {
+        speed_rpm @items: SPEED_AXIS_RPM,
+        torque_nm @items: TORQUE_AXIS_NM,
+    },
+    LossMapMotor {
+        speed_rpm @items: SPEED_AXIS_RPM,
+        torque_nm @items: SIGNED_TORQUE_AXIS_NM,
+    },
+    AcFactorTable {
+        freq_hz @items: FREQ_HZ,
+        k_ac @items: K_AC,
     },
     ConstantMotor {
-        efficiency: Range::FINITE.min(0.01).max(1.0),
-        t_peak_nm: Range::FINITE.gt(0.0).max(1e6),
-        p_peak_w: Range::FINITE.gt(0.0).max(1e9),
-        n_max_rpm: Range::FINITE.gt(0.0).max(100000.0),
+        efficiency: EFFICIENCY,
+        t_peak_nm: TORQUE_NM,
+        p_peak_w: POWER_W,
+        n_max_rpm: N_MAX_RPM,
     },
     BackEmf {
-        v_peak_phase: Range::FINITE.gt(0.0),
-        at_rpm: Range::FINITE.gt(0.0),
+        v_peak_phase: BACK_EMF,
+        at_rpm: BACK_EMF,
     },
     DowellSpec {
-        conductor_height_m: Range::FINITE.gt(0.0).max(0.1),
-        layers: Range::INTEGER.min(1.0).max(100.0),
-        porosity: Range::FINITE.gt(0.0).max(1.0),
-        stack_length_m: Range::FINITE.gt(0.0).max(10.0),
-        end_length_m: Range::FINITE.min(0.0).max(10.0),
+        conductor_height_m: CONDUCTOR_HEIGHT_M,
+        layers: LAYERS,
+        porosity: POROSITY,
+        stack_length_m: STACK_LENGTH_M,
+        end_length_m: END_LENGTH_M,
     },
     IronSpec {
-        k_h: Range::FINITE.min(0.0),
-        k_e: Range::FINITE.min(0.0),
+        k_h: LOSS_COEFF,
+        k_e: LOSS_COEFF,
     },
     MechSpec {
-        c_fric_nm: Range::FINITE.min(0.0),
-        c_wind: Range::FINITE.min(0.0),
+        c_fric_nm: LOSS_COEFF,
+        c_wind: LOSS_COEFF,
     },
     IpmsmMotor {
-        pole_pairs: Range::INTEGER.min(1.0).max(32.0),
-        psi_m_wb: Range::FINITE.gt(0.0).max(100.0),
-        ld_h: Range::FINITE.gt(0.0).max(1.0),
-        lq_h: Range::FINITE.gt(0.0).max(1.0),
-        r_phase_20c_ohm: Range::FINITE.gt(0.0).max(100.0),
-        winding_temp_c: Range::FINITE.min(-40.0).max(250.0),
-        i_max_arms: Range::FINITE.gt(0.0).max(100000.0),
-        v_dc: Range::FINITE.gt(0.0).max(100000.0),
-        voltage_utilization: Range::FINITE.gt(0.0).max(1.155),
-        n_max_rpm: Range::FINITE.gt(0.0).max(100000.0),
-        t_cap_nm: Range::FINITE.gt(0.0).max(1e6),
-        p_cap_w: Range::FINITE.gt(0.0).max(1e9),
-        stack_scale: Range::FINITE.gt(0.0).max(10.0),
+        pole_pairs: POLE_PAIRS,
+        psi_m_wb: PSI_M_WB,
+        ld_h: INDUCTANCE_H,
+        lq_h: INDUCTANCE_H,
+        r_phase_20c_ohm: R_PHASE_OHM,
+        winding_temp_c: WINDING_TEMP_C,
+        i_max_arms: ELECTRIC_LIMIT,
+        v_dc: ELECTRIC_LIMIT,
+        voltage_utilization: VOLTAGE_UTILIZATION,
+        n_max_rpm: N_MAX_RPM,
+        t_cap_nm: TORQUE_NM,
+        p_cap_w: POWER_W,
+        stack_scale: STACK_SCALE,
     },
     GridSpec {
-        speed_step_rpm: Range::FINITE.min(1.0).max(10000.0),
-        torque_step_nm: Range::FINITE.min(0.1).max(10000.0),
+        speed_step_rpm: SPEED_STEP_RPM,
+        torque_step_nm: TORQUE_STEP_NM,
     },
     HistogramSpec {
-        speed_bin_rpm: Range::FINITE.min(1.0).max(100000.0),
-        torque_bin_nm: Range::FINITE.min(0.1).max(100000.0),
+        speed_bin_rpm: SPEED_BIN_RPM,
+        torque_bin_nm: TORQUE_BIN_NM,
     },
     OptionsSpec {
-        substeps: Range::INTEGER.min(1.0).max(32.0),
+        substeps: SUBSTEPS,
+        desirability_weights @items: DESIRABILITY_WEIGHT,
     },
+}
+
+/// Bounds of the values of the two-dimensional map tables (items of items, rendered inline).
+#[must_use]
+pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
+    use crate::calc::SchemaBound;
+    vec![
+        SchemaBound::at::<EfficiencyMapMotor>("/properties/efficiency/items/items", MAP_EFFICIENCY),
+        SchemaBound::at::<EfficiencyMapMotor>(
+            "/properties/efficiency_gen/items/items",
+            MAP_EFFICIENCY,
+        ),
+        SchemaBound::at::<LossMapMotor>("/properties/loss_w/items/items", LOSS_W),
+    ]
 }

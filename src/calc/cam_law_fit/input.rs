@@ -3,9 +3,11 @@
 
 use crate::calc::cam_law::law::{BoundaryConditions, K1, LawError, Quantity, SevenSegmentLaw};
 use crate::calc::cam_law::wire::{Units, Warning};
+use crate::calc::common::TIME_LIMIT_MS;
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
 use super::optim::ga::GaParams;
+use super::wire;
 use super::wire::{
     FitCamLawRequest, FitQuantity, MAX_CURVE_COUNT, MAX_SAMPLES, MIN_SAMPLES, Method, MetricName,
 };
@@ -18,20 +20,15 @@ pub const ABSCISSA_TOL: f64 = 1e-9;
 pub const MAX_COST: f64 = 2e10;
 /// Default evaluation cap (spec §2).
 pub const DEFAULT_MAX_EVALUATIONS: u64 = 50_000;
-/// Largest accepted evaluation cap (spec §2).
-pub const MAX_EVALUATIONS: u64 = 10_000_000;
 /// Default time limit [ms] (spec §2).
 pub const DEFAULT_TIME_LIMIT_MS: u64 = 10_000;
-/// Largest accepted time limit [ms] (spec §2).
-pub const MAX_TIME_LIMIT_MS: u64 = 600_000;
+/// Largest accepted time limit [ms] (spec §2; the end of the shared `time_limit_ms` bound, a whole
+/// number: the conversion is exact).
+pub const MAX_TIME_LIMIT_MS: u64 = crate::calc::common::TIME_LIMIT_MS.hi as u64;
 /// Default zero-snap threshold (spec §3.5.2 step 4).
 pub const DEFAULT_SNAP_TOL: f64 = 2e-3;
-/// Largest accepted zero-snap threshold (spec §2).
-pub const MAX_SNAP_TOL: f64 = 0.05;
 /// Default IPOP restarts for DTW in `auto` (spec §2).
 pub const DEFAULT_DTW_RESTARTS: u32 = 3;
-/// Largest accepted IPOP restart count (spec §2).
-pub const MAX_DTW_RESTARTS: u32 = 9;
 
 /// A validated fit request (SI is not imposed: units are the caller's, spec §2).
 #[derive(Debug, Clone)]
@@ -126,14 +123,6 @@ fn check_magnitudes(v: &mut Validator, pointer: &str, values: &[f64]) {
     v.all_in(pointer, "value", values, super::wire::DATA_VALUE);
 }
 
-fn uint_in(v: &mut Validator, pointer: &str, value: u64, lo: u64, hi: u64) -> bool {
-    let ok = (lo..=hi).contains(&value);
-    v.ensure(ok, pointer, || {
-        format!("must be in [{lo}, {hi}], got {value}")
-    });
-    ok
-}
-
 /// Validate the abscissa; returns the sample abscissae when valid.
 fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
     match (&req.abscissa.values, &req.abscissa.grid) {
@@ -181,13 +170,7 @@ fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
         (None, Some(g)) => {
             let ok_start = v.finite("/abscissa/grid/start", g.start);
             let ok_end = v.finite("/abscissa/grid/end", g.end);
-            let ok_count = uint_in(
-                v,
-                "/abscissa/grid/count",
-                g.count,
-                MIN_SAMPLES as u64,
-                MAX_SAMPLES as u64,
-            );
+            let ok_count = v.uint("/abscissa/grid/count", "", g.count, wire::GRID_COUNT);
             if ok_start && ok_end && g.end <= g.start {
                 v.push(
                     "/abscissa/grid/end",
@@ -388,8 +371,11 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let mut dtw_window = 1usize;
     if let Some(w) = req.objective.dtw_window {
         let max = n.unwrap_or(MAX_SAMPLES);
+        // The window is at most N ≤ 2e5, the number of samples (a cross-field rule); every i64
+        // converts to a whole f64, far outside the range when huge.
+        let range = wire::DTW_WINDOW.max(max as f64);
         match usize::try_from(w) {
-            Ok(wu) if wu <= max => dtw_window = wu,
+            Ok(wu) if range.contains(w as f64) => dtw_window = wu,
             _ => v.push(
                 "/objective/dtw_window",
                 format!("must be in [0, N = {max}] samples, got {w}"),
@@ -407,46 +393,44 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         );
     }
     let max_evaluations = o.max_evaluations.unwrap_or(DEFAULT_MAX_EVALUATIONS);
-    uint_in(
-        &mut v,
+    v.uint(
         "/optimizer/max_evaluations",
+        "",
         max_evaluations,
-        1,
-        MAX_EVALUATIONS,
+        wire::MAX_EVALUATIONS,
     );
     if let Some(t) = o.time_limit_ms {
-        uint_in(&mut v, "/optimizer/time_limit_ms", t, 1, MAX_TIME_LIMIT_MS);
+        v.uint("/optimizer/time_limit_ms", "", t, TIME_LIMIT_MS);
     }
     let dtw_global_restarts = o.dtw_global_restarts.unwrap_or(DEFAULT_DTW_RESTARTS);
-    uint_in(
-        &mut v,
+    v.uint(
         "/optimizer/dtw_global_restarts",
+        "",
         u64::from(dtw_global_restarts),
-        0,
-        u64::from(MAX_DTW_RESTARTS),
+        wire::DTW_RESTARTS,
     );
     let snap_tol = o.snap_tol.unwrap_or(DEFAULT_SNAP_TOL);
-    v.in_range("/optimizer/snap_tol", snap_tol, 0.0, MAX_SNAP_TOL);
+    v.range("/optimizer/snap_tol", "", snap_tol, wire::SNAP_TOL);
     let mut ga = GaParams::default();
     if let Some(g) = o.ga {
         let pg = "/optimizer/ga";
         if let Some(p) = g.population
-            && uint_in(&mut v, &format!("{pg}/population"), p, 4, 10_000)
+            && v.uint(&format!("{pg}/population"), "", p, wire::POPULATION)
         {
             ga.population = usize::try_from(p).unwrap_or(100);
         }
         if let Some(p) = g.generations
-            && uint_in(&mut v, &format!("{pg}/generations"), p, 1, 100_000)
+            && v.uint(&format!("{pg}/generations"), "", p, wire::GENERATIONS)
         {
             ga.generations = p;
         }
         if let Some(p) = g.range_every
-            && uint_in(&mut v, &format!("{pg}/range_every"), p, 1, 100_000)
+            && v.uint(&format!("{pg}/range_every"), "", p, wire::GENERATIONS)
         {
             ga.range_every = p;
         }
         if let Some(p) = g.stall_generations
-            && uint_in(&mut v, &format!("{pg}/stall_generations"), p, 1, 100_000)
+            && v.uint(&format!("{pg}/stall_generations"), "", p, wire::GENERATIONS)
         {
             ga.stall_generations = p;
         }
@@ -464,7 +448,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         ];
         for (name, value, slot) in probs {
             if let Some(x) = value
-                && v.in_range(&format!("{pg}/{name}"), x, 0.0, 1.0)
+                && v.range(&format!("{pg}/{name}"), "", x, wire::PROBABILITY)
             {
                 *slot = x;
             }
@@ -573,13 +557,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     // Outputs.
     let (curve_count, curve_quantities) = match &req.outputs.curves {
         Some(cv) => {
-            uint_in(
-                &mut v,
-                "/outputs/curves/count",
-                cv.count,
-                0,
-                MAX_CURVE_COUNT,
-            );
+            v.uint("/outputs/curves/count", "", cv.count, wire::CURVE_COUNT);
             let mut qs: Vec<Quantity> = Vec::new();
             for q in cv
                 .quantities

@@ -464,6 +464,25 @@ pub struct OptimizerReport {
 /// (rescale the unit beyond it); the same bound as the evaluator's boundary values.
 pub const DATA_VALUE: Range = crate::calc::cam_law::wire::BOUNDARY_VALUE;
 
+/// Samples of a generated abscissa grid [–] (spec §2: 7 unknowns need at least 8).
+pub const GRID_COUNT: Range = Range::int(MIN_SAMPLES as i64, MAX_SAMPLES as i64);
+/// DTW window [samples]; at most N, the number of samples (a cross-field rule).
+pub const DTW_WINDOW: Range = Range::int(0, MAX_SAMPLES as i64);
+/// Objective evaluations of the optimizer [–].
+pub const MAX_EVALUATIONS: Range = Range::int(1, 10_000_000);
+/// IPOP-CMA-ES restarts of `auto` with the DTW metric [–].
+pub const DTW_RESTARTS: Range = Range::int(0, 9);
+/// Zero-snap threshold on normalized coefficients [–].
+pub const SNAP_TOL: Range = Range::closed(0.0, 0.05);
+/// GA population [–].
+pub const POPULATION: Range = Range::int(4, 10_000);
+/// GA generation counts (generations, range_every, stall_generations) [–].
+pub const GENERATIONS: Range = Range::int(1, 100_000);
+/// A GA probability or range fraction [–].
+pub const PROBABILITY: Range = Range::closed(0.0, 1.0);
+/// Points of the dense output curves [–] (0: none).
+pub const CURVE_COUNT: Range = Range::int(0, MAX_CURVE_COUNT as i64);
+
 crate::schema_bounds! {
     Channels {
         displacement @items: DATA_VALUE,
@@ -471,7 +490,7 @@ crate::schema_bounds! {
         acceleration @items: DATA_VALUE,
     },
     FitGrid {
-        count: Range::INTEGER.min(8.0).max(200000.0),
+        count: GRID_COUNT,
     },
     FitConstraints {
         t_a: DATA_VALUE,
@@ -484,27 +503,27 @@ crate::schema_bounds! {
         a_b: DATA_VALUE,
     },
     ObjectiveIn {
-        dtw_window: Range::INTEGER.min(0.0).max(200000.0),
+        dtw_window: DTW_WINDOW,
     },
     OptimizerIn {
-        max_evaluations: Range::INTEGER.min(1.0).max(10000000.0),
-        time_limit_ms: Range::INTEGER.min(1.0).max(600000.0),
-        dtw_global_restarts: Range::INTEGER.min(0.0).max(9.0),
-        snap_tol: Range::FINITE.min(0.0).max(0.05),
+        max_evaluations: MAX_EVALUATIONS,
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
+        dtw_global_restarts: DTW_RESTARTS,
+        snap_tol: SNAP_TOL,
     },
     GaIn {
-        population: Range::INTEGER.min(4.0).max(10000.0),
-        generations: Range::INTEGER.min(1.0).max(100000.0),
-        p_crossover: Range::FINITE.min(0.0).max(1.0),
-        p_inversion: Range::FINITE.min(0.0).max(1.0),
-        p_range_mutation: Range::FINITE.min(0.0).max(1.0),
-        range0: Range::FINITE.min(0.0).max(1.0),
-        range_factor: Range::FINITE.min(0.0).max(1.0),
-        range_every: Range::INTEGER.min(1.0).max(100000.0),
-        p_mutation: Range::FINITE.min(0.0).max(1.0),
-        stall_generations: Range::INTEGER.min(1.0).max(100000.0),
+        population: POPULATION,
+        generations: GENERATIONS,
+        p_crossover: PROBABILITY,
+        p_inversion: PROBABILITY,
+        p_range_mutation: PROBABILITY,
+        range0: PROBABILITY,
+        range_factor: PROBABILITY,
+        range_every: GENERATIONS,
+        p_mutation: PROBABILITY,
+        stall_generations: GENERATIONS,
     },
     CurvesIn {
-        count: Range::INTEGER.min(0.0).max(100000.0),
+        count: CURVE_COUNT,
     },
 }

@@ -6,6 +6,16 @@ use thiserror::Error;
 
 use crate::calc::{CalcFailure, ProblemClass};
 
+/// A length is not positive (or a coordinate/angle not finite), or is zero next to the largest
+/// length (spec §3).
+pub const NON_POSITIVE_LENGTH: &str = "NON_POSITIVE_LENGTH";
+/// The ground pivots coincide: |B − A| ≤ 1e-12·L (spec §3).
+pub const COINCIDENT_PIVOTS: &str = "COINCIDENT_PIVOTS";
+/// The coupler triangle (b, d, e) violates the triangle inequality (spec §3).
+pub const COUPLER_TRIANGLE_INVALID: &str = "COUPLER_TRIANGLE_INVALID";
+/// The coupler point P sits on a coupler joint: |k| or |1 − k| ≤ 1e-9 (spec §3).
+pub const COUPLER_POINT_AT_JOINT: &str = "COUPLER_POINT_AT_JOINT";
+
 /// Error of [`super::compute::compute`].
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum CognatesError {

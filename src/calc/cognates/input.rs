@@ -9,16 +9,19 @@
 //! power of two close to the largest length L (an exact scaling), so every tolerance is absolute and
 //! no square can overflow or underflow whatever the caller's unit.
 
-use crate::calc::{CalcFailure, FieldIssue, ProblemClass};
+use crate::calc::{CalcFailure, INVALID_INPUT, Range, Validator};
 
+use super::error::{
+    COINCIDENT_PIVOTS, COUPLER_POINT_AT_JOINT, COUPLER_TRIANGLE_INVALID, NON_POSITIVE_LENGTH,
+};
 use super::geometry::{C64, FourBar, Sign, cis, cross};
 use super::wire::{
-    AngleReference, CognatesRequest, CouplerPoint, CurveMode, Spacing, VerifyKind, WireSign,
+    AngleReference, CognatesRequest, CouplerPoint, CurveMode, GroundSpec, JointsSpec, Spacing,
+    VerifyKind, WireSign,
 };
 
 pub use super::wire::MAX_MAGNITUDE;
 use super::wire::{COORDINATE, GRASHOF_RTOL, LENGTH, NON_NEGATIVE_LENGTH, POINTS_PER_CIRCUIT};
-use crate::calc::Range;
 /// A ground length at or below this fraction of L is "coincident pivots" (spec §3: 1e-12).
 pub const COINCIDENT_REL: f64 = 1e-12;
 /// A link length below this fraction of L is numerically zero next to L (same bound as the pivots):
@@ -30,8 +33,6 @@ pub const TRIANGLE_SLACK_REL: f64 = 1e-12;
 pub const AT_JOINT_TOL: f64 = 1e-9;
 /// P within this fraction of max(b, d, e) of the line DE is collinear (spec §7 warning).
 pub const COLLINEAR_REL: f64 = 1e-12;
-/// Smallest and largest `points_per_circuit` (spec §3; the bound is [`POINTS_PER_CIRCUIT`]).
-pub const POINTS_PER_CIRCUIT_RANGE: (u64, u64) = (16, 100_000);
 
 /// Snapshot request in the normalised frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,103 +101,42 @@ pub struct CognatesInput {
     pub options: Options,
 }
 
-/// Collects field issues with their spec codes.
-#[derive(Default)]
-struct Issues {
-    list: Vec<(&'static str, FieldIssue)>,
+/// Check `x` against `range` (a length or coordinate bound of wire.rs): below the range, or not
+/// finite, is the spec's `NON_POSITIVE_LENGTH`; above the magnitude cap (or below a negative lower
+/// end) `INVALID_INPUT`.
+fn bounded(v: &mut Validator, pointer: &str, name: &str, x: f64, range: Range) -> bool {
+    let beyond_cap = x.is_finite() && (x > range.hi || (x < range.lo && range.lo < 0.0));
+    let code = if beyond_cap {
+        INVALID_INPUT
+    } else {
+        NON_POSITIVE_LENGTH
+    };
+    v.range_code(code, pointer, name, x, range)
 }
 
-impl Issues {
-    fn push(&mut self, code: &'static str, pointer: impl Into<String>, detail: impl Into<String>) {
-        self.list.push((
-            code,
-            FieldIssue {
-                pointer: pointer.into(),
-                detail: detail.into(),
-            },
-        ));
-    }
+/// A check of one named value at a pointer (`v, pointer, name, value`); true when it passes.
+type Check = fn(&mut Validator, &str, &str, f64) -> bool;
 
-    fn is_clean(&self) -> bool {
-        self.list.is_empty()
-    }
+/// A distance that may be zero ([`NON_NEGATIVE_LENGTH`]).
+fn non_negative(v: &mut Validator, pointer: &str, name: &str, x: f64) -> bool {
+    bounded(v, pointer, name, x, NON_NEGATIVE_LENGTH)
+}
 
-    /// A value of `range` (a length or coordinate bound of wire.rs); out of range below or
-    /// non-finite is the spec's `NON_POSITIVE_LENGTH`, above the magnitude cap `INVALID_INPUT`.
-    fn bounded(&mut self, pointer: &str, name: &str, x: f64, range: Range, what: &str) -> bool {
-        if range.contains(x) {
-            true
-        } else if x.is_finite() && (x > range.hi || (x < range.lo && range.lo < 0.0)) {
-            self.push(
-                "INVALID_INPUT",
-                pointer,
-                format!("{name} must be {range}, got {x:e}"),
-            );
-            false
-        } else {
-            self.push(
-                "NON_POSITIVE_LENGTH",
-                pointer,
-                format!("{name} must be a finite {what}, got {x}"),
-            );
-            false
-        }
-    }
+/// A coordinate or signed length ([`COORDINATE`]).
+fn coordinate(v: &mut Validator, pointer: &str, name: &str, x: f64) -> bool {
+    bounded(v, pointer, name, x, COORDINATE)
+}
 
-    /// A positive, finite, bounded length.
-    fn length(&mut self, pointer: &str, name: &str, x: f64) -> bool {
-        self.bounded(pointer, name, x, LENGTH, "length > 0")
-    }
+/// A point `[x, y]` of coordinates at `pointer` (`/0`, `/1`).
+fn point(v: &mut Validator, pointer: &str, name: &str, p: [f64; 2]) -> bool {
+    let x = coordinate(v, &format!("{pointer}/0"), &format!("{name}.x"), p[0]);
+    let y = coordinate(v, &format!("{pointer}/1"), &format!("{name}.y"), p[1]);
+    x && y
+}
 
-    /// A non-negative, finite, bounded length.
-    fn non_negative(&mut self, pointer: &str, name: &str, x: f64) -> bool {
-        self.bounded(pointer, name, x, NON_NEGATIVE_LENGTH, "length ≥ 0")
-    }
-
-    /// A finite, bounded coordinate or signed length.
-    fn coord(&mut self, pointer: &str, name: &str, x: f64) -> bool {
-        self.bounded(pointer, name, x, COORDINATE, "number")
-    }
-
-    fn point(&mut self, pointer: &str, name: &str, p: [f64; 2]) -> bool {
-        let x = self.coord(&format!("{pointer}/0"), &format!("{name}.x"), p[0]);
-        let y = self.coord(&format!("{pointer}/1"), &format!("{name}.y"), p[1]);
-        x && y
-    }
-
-    fn angle(&mut self, pointer: &str, name: &str, x: f64) -> bool {
-        if x.is_finite() {
-            true
-        } else {
-            self.push(
-                "NON_POSITIVE_LENGTH",
-                pointer,
-                format!("{name} must be a finite angle, got {x}"),
-            );
-            false
-        }
-    }
-
-    /// `Ok` when clean; else one failure with every issue so far, coded by the first.
-    fn finish(&mut self) -> Result<(), CalcFailure> {
-        let list = std::mem::take(&mut self.list);
-        let Some((code, first)) = list.first() else {
-            return Ok(());
-        };
-        let code = *code;
-        let n = list.len();
-        let detail = if n == 1 {
-            format!("{} {}", first.pointer, first.detail)
-        } else {
-            format!("{n} fields failed validation")
-        };
-        Err(CalcFailure {
-            class: ProblemClass::InvalidInput,
-            code,
-            detail,
-            errors: list.into_iter().map(|(_, i)| i).collect(),
-        })
-    }
+/// A finite angle in degrees (any value: it is reduced modulo 360°).
+fn angle(v: &mut Validator, pointer: &str, name: &str, x: f64) -> bool {
+    v.range_code(NON_POSITIVE_LENGTH, pointer, name, x, Range::FINITE)
 }
 
 fn c64(p: [f64; 2]) -> C64 {
@@ -233,31 +173,22 @@ struct CouplerData {
 }
 
 /// Options validation (shared by both modes).
-fn validate_options(req: &CognatesRequest, issues: &mut Issues) -> Options {
+fn validate_options(req: &CognatesRequest, v: &mut Validator) -> Options {
     let o = &req.options;
-    let (lo, hi) = POINTS_PER_CIRCUIT_RANGE;
-    // Counts up to 2^53 convert exactly; larger ones are far outside the range either way.
-    let n = o.points_per_circuit as f64;
-    if !POINTS_PER_CIRCUIT.contains(n) {
-        issues.push(
-            "INVALID_INPUT",
-            "/options/points_per_circuit",
-            format!(
-                "points_per_circuit must be {POINTS_PER_CIRCUIT}, got {}",
-                o.points_per_circuit
-            ),
-        );
-    }
-    if !GRASHOF_RTOL.contains(o.grashof_rtol) {
-        issues.push(
-            "INVALID_INPUT",
-            "/options/grashof_rtol",
-            format!(
-                "grashof_rtol must be {GRASHOF_RTOL}, got {}",
-                o.grashof_rtol
-            ),
-        );
-    }
+    // The ends of POINTS_PER_CIRCUIT are whole numbers far below 2^53: the conversions are exact.
+    let (lo, hi) = (POINTS_PER_CIRCUIT.lo as u64, POINTS_PER_CIRCUIT.hi as u64);
+    v.uint(
+        "/options/points_per_circuit",
+        "points_per_circuit",
+        o.points_per_circuit,
+        POINTS_PER_CIRCUIT,
+    );
+    v.range(
+        "/options/grashof_rtol",
+        "grashof_rtol",
+        o.grashof_rtol,
+        GRASHOF_RTOL,
+    );
     Options {
         curves: o.curves,
         points_per_circuit: usize::try_from(o.points_per_circuit.clamp(lo, hi)).unwrap_or(360),
@@ -276,25 +207,19 @@ impl TryFrom<CognatesRequest> for CognatesInput {
     type Error = CalcFailure;
 
     fn try_from(req: CognatesRequest) -> Result<Self, Self::Error> {
-        let mut issues = Issues::default();
-        let options = validate_options(&req, &mut issues);
-        if req.joints.is_some() {
-            joints_mode(&req, options, issues)
+        let mut v = Validator::new();
+        let options = validate_options(&req, &mut v);
+        if let Some(j) = req.joints {
+            joints_mode(&req, &j, options, v)
         } else {
-            dimension_mode(&req, options, issues)
+            dimension_mode(&req, options, v)
         }
     }
 }
 
-fn joints_mode(
-    req: &CognatesRequest,
-    options: Options,
-    mut issues: Issues,
-) -> Result<CognatesInput, CalcFailure> {
-    let Some(j) = req.joints else {
-        unreachable!("joints_mode is called with joints present")
-    };
-    let conflicts = [
+/// The fields that must be absent with `joints` (read from the drawn configuration).
+fn conflicts_with_joints(req: &CognatesRequest) -> [(&'static str, bool); 7] {
+    [
         ("/ground", req.ground.is_some()),
         ("/crank", req.crank.is_some()),
         ("/coupler", req.coupler.is_some()),
@@ -302,24 +227,27 @@ fn joints_mode(
         ("/coupler_point", req.coupler_point.is_some()),
         ("/input_angle_deg", req.input_angle_deg.is_some()),
         ("/branch", req.branch.is_some()),
-    ];
-    for (ptr, present) in conflicts {
+    ]
+}
+
+fn joints_mode(
+    req: &CognatesRequest,
+    j: &JointsSpec,
+    options: Options,
+    mut v: Validator,
+) -> Result<CognatesInput, CalcFailure> {
+    for (ptr, present) in conflicts_with_joints(req) {
         if present {
-            issues.push(
-                "INVALID_INPUT",
+            v.push(
                 ptr,
                 "must be omitted with `joints` (read from the drawn configuration)",
             );
         }
     }
-    let ok = [("A", j.a), ("B", j.b), ("D", j.d), ("E", j.e), ("P", j.p)]
-        .into_iter()
-        .fold(true, |acc, (n, p)| {
-            issues.point(&format!("/joints/{n}"), n, p) && acc
-        });
-    if !ok || !issues.is_clean() {
-        issues.finish()?;
+    for (n, p) in [("A", j.a), ("B", j.b), ("D", j.d), ("E", j.e), ("P", j.p)] {
+        point(&mut v, &format!("/joints/{n}"), n, p);
     }
+    v.checkpoint()?;
     let (a, b, d, e, p) = (c64(j.a), c64(j.b), c64(j.d), c64(j.e), c64(j.p));
     let l = (b - a).norm();
     let crank = (d - a).norm();
@@ -332,36 +260,30 @@ fn joints_mode(
         .max((p - d).norm())
         .max((p - e).norm());
     if !(big_l.is_finite() && big_l > 0.0) {
-        issues.push("NON_POSITIVE_LENGTH", "/joints", "all joints coincide");
-        issues.finish()?;
+        v.push_code(NON_POSITIVE_LENGTH, "/joints", "all joints coincide");
+        v.checkpoint()?;
     }
     if l <= COINCIDENT_REL * big_l {
-        issues.push(
-            "COINCIDENT_PIVOTS",
+        v.push_code(
+            COINCIDENT_PIVOTS,
             "/joints/B",
             format!("B coincides with A: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"),
         );
     }
-    for (ptr, name, len) in [
-        ("/joints/D", "crank |D − A|", crank),
-        ("/joints/E", "coupler |E − D|", coupler),
-        ("/joints/E", "rocker |E − B|", rocker),
-    ] {
-        if len <= LENGTH_FLOOR_REL * big_l {
-            issues.push(
-                "NON_POSITIVE_LENGTH",
-                ptr,
-                format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"),
-            );
-        }
-    }
-    if !issues.is_clean() {
-        issues.finish()?;
-    }
+    length_floor(
+        &mut v,
+        big_l,
+        [
+            ("/joints/D", "crank |D − A|", crank),
+            ("/joints/E", "coupler |E − D|", coupler),
+            ("/joints/E", "rocker |E − B|", rocker),
+        ],
+        |len, floor| len <= floor,
+    );
+    v.checkpoint()?;
     let k = (p - d) / (e - d);
-    let one = C64::new(1.0, 0.0);
-    check_at_joint(&mut issues, "/joints/P", k, one);
-    issues.finish()?;
+    check_at_joint(&mut v, "/joints/P", k);
+    v.finish()?;
     let scale = power_of_two_near(big_l);
     let n = |z: C64| (z - a) / scale;
     let mech = FourBar {
@@ -392,10 +314,33 @@ fn joints_mode(
     })
 }
 
-fn check_at_joint(issues: &mut Issues, ptr: &str, k: C64, one: C64) {
+/// `NON_POSITIVE_LENGTH` for each link `(pointer, name, length)` that is zero next to the largest
+/// length L (`too_short(length, 1e-12·L)`).
+fn length_floor(
+    v: &mut Validator,
+    big_l: f64,
+    links: [(&str, &str, f64); 3],
+    too_short: fn(f64, f64) -> bool,
+) {
+    let floor = LENGTH_FLOOR_REL * big_l;
+    for (ptr, name, len) in links {
+        if too_short(len, floor) {
+            v.push_code(
+                NON_POSITIVE_LENGTH,
+                ptr,
+                format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"),
+            );
+        }
+    }
+}
+
+/// `COUPLER_POINT_AT_JOINT` when P (coupler ratio `k`) sits on the crank joint D or the rocker
+/// joint E.
+fn check_at_joint(v: &mut Validator, ptr: &str, k: C64) {
+    let one = C64::new(1.0, 0.0);
     if k.norm() <= AT_JOINT_TOL {
-        issues.push(
-            "COUPLER_POINT_AT_JOINT",
+        v.push_code(
+            COUPLER_POINT_AT_JOINT,
             ptr,
             format!(
                 "P coincides with the crank joint D: |k| = {:e} ≤ 1e-9",
@@ -403,8 +348,8 @@ fn check_at_joint(issues: &mut Issues, ptr: &str, k: C64, one: C64) {
             ),
         );
     } else if (one - k).norm() <= AT_JOINT_TOL {
-        issues.push(
-            "COUPLER_POINT_AT_JOINT",
+        v.push_code(
+            COUPLER_POINT_AT_JOINT,
             ptr,
             format!(
                 "P coincides with the rocker joint E: |1 − k| = {:e} ≤ 1e-9",
@@ -414,120 +359,94 @@ fn check_at_joint(issues: &mut Issues, ptr: &str, k: C64, one: C64) {
     }
 }
 
-fn dimension_mode(
-    req: &CognatesRequest,
-    options: Options,
-    mut issues: Issues,
-) -> Result<CognatesInput, CalcFailure> {
-    // --- field checks ---
-    let mut ground_ok = false;
-    let mut a_raw = [0.0, 0.0];
-    let mut b_raw = [0.0, 0.0];
-    match &req.ground {
-        None => issues.push(
-            "INVALID_INPUT",
-            "/ground",
-            "ground is required (or give `joints`)",
-        ),
-        Some(g) => {
-            a_raw = g.a.unwrap_or([0.0, 0.0]);
-            let a_ok = issues.point("/ground/A", "A", a_raw);
-            match (g.b, g.length) {
-                (Some(_), Some(_)) => issues.push(
-                    "INVALID_INPUT",
-                    "/ground/length",
-                    "give either B or length, not both",
-                ),
-                (None, None) => {
-                    issues.push("INVALID_INPUT", "/ground/B", "B (or length) is required")
-                }
-                (Some(b), None) => {
-                    if g.angle_deg.is_some() {
-                        issues.push(
-                            "INVALID_INPUT",
-                            "/ground/angle_deg",
-                            "angle_deg goes with length, not with B",
-                        );
-                    }
-                    b_raw = b;
-                    ground_ok = issues.point("/ground/B", "B", b) && a_ok;
-                }
-                (None, Some(l)) => {
-                    let l_ok = issues.length("/ground/length", "ground length l", l);
-                    let gamma = g.angle_deg.unwrap_or(0.0);
-                    let g_ok = issues.angle("/ground/angle_deg", "ground angle", gamma);
-                    if l_ok && g_ok && a_ok {
-                        let b = c64(a_raw) + cis(deg_to_rad(gamma)) * l;
-                        b_raw = [b.re, b.im];
-                        ground_ok = true;
-                    }
-                }
+/// The ground pivots (A, B) of the dimension mode: B given, or A + l·(cos γ, sin γ).
+fn check_ground(v: &mut Validator, ground: Option<&GroundSpec>) -> Option<([f64; 2], [f64; 2])> {
+    let Some(g) = ground else {
+        v.push("/ground", "ground is required (or give `joints`)");
+        return None;
+    };
+    let a_raw = g.a.unwrap_or([0.0, 0.0]);
+    let a_ok = point(v, "/ground/A", "A", a_raw);
+    match (g.b, g.length) {
+        (Some(_), Some(_)) => {
+            v.push("/ground/length", "give either B or length, not both");
+            None
+        }
+        (None, None) => {
+            v.push("/ground/B", "B (or length) is required");
+            None
+        }
+        (Some(b), None) => {
+            if g.angle_deg.is_some() {
+                v.push(
+                    "/ground/angle_deg",
+                    "angle_deg goes with length, not with B",
+                );
             }
+            (point(v, "/ground/B", "B", b) && a_ok).then_some((a_raw, b))
+        }
+        (None, Some(l)) => {
+            let l_ok = bounded(v, "/ground/length", "ground length l", l, LENGTH);
+            let gamma = g.angle_deg.unwrap_or(0.0);
+            let g_ok = angle(v, "/ground/angle_deg", "ground angle", gamma);
+            (l_ok && g_ok && a_ok).then(|| {
+                let b = c64(a_raw) + cis(deg_to_rad(gamma)) * l;
+                (a_raw, [b.re, b.im])
+            })
         }
     }
+}
+
+/// The link lengths (a, b, c), each required and a [`LENGTH`].
+fn check_links(v: &mut Validator, req: &CognatesRequest) -> Option<[f64; 3]> {
     let mut lens = [0.0; 3];
-    let mut lens_ok = true;
-    for (i, (ptr, name, v)) in [
+    let mut ok = true;
+    for (slot, (ptr, name, given)) in lens.iter_mut().zip([
         ("/crank", "crank a", req.crank),
         ("/coupler", "coupler b", req.coupler),
         ("/rocker", "rocker c", req.rocker),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        match v {
+    ]) {
+        match given {
             None => {
-                issues.push(
-                    "INVALID_INPUT",
-                    ptr,
-                    format!("{name} is required (or give `joints`)"),
-                );
-                lens_ok = false;
+                v.push(ptr, format!("{name} is required (or give `joints`)"));
+                ok = false;
             }
             Some(x) => {
-                lens_ok &= issues.length(ptr, name, x);
-                lens[i] = x;
+                ok &= bounded(v, ptr, name, x, LENGTH);
+                *slot = x;
             }
         }
     }
-    let cp_ok = match req.coupler_point {
-        None => {
-            issues.push(
-                "INVALID_INPUT",
-                "/coupler_point",
-                "coupler_point is required (or give `joints`)",
-            );
-            false
-        }
-        Some(CouplerPoint::Triangle { d, e, .. }) => {
-            let a = issues.non_negative("/coupler_point/d", "d", d);
-            issues.non_negative("/coupler_point/e", "e", e) && a
-        }
-        Some(CouplerPoint::Frame { u, v }) => {
-            let a = issues.coord("/coupler_point/u", "u", u);
-            issues.coord("/coupler_point/v", "v", v) && a
-        }
-        Some(CouplerPoint::Polar { p, alpha_deg }) => {
-            let a = issues.non_negative("/coupler_point/p", "p", p);
-            issues.angle("/coupler_point/alpha_deg", "alpha_deg", alpha_deg) && a
-        }
-    };
-    if let Some(x) = req.input_angle_deg {
-        issues.angle("/input_angle_deg", "input_angle_deg", x);
-    }
-    if !(ground_ok && lens_ok && cp_ok && issues.is_clean()) {
-        issues.finish()?;
-    }
-    let Some(cp) = req.coupler_point else {
-        unreachable!("checked above")
-    };
-    let [crank, coupler, rocker] = lens;
-    let a = c64(a_raw);
-    let b = c64(b_raw);
+    ok.then_some(lens)
+}
 
-    // --- coupler ratio k ---
-    let one = C64::new(1.0, 0.0);
-    let coupler_data = match cp {
+/// The coupler point in any of its three forms.
+fn check_coupler_point(v: &mut Validator, cp: Option<CouplerPoint>) -> Option<CouplerPoint> {
+    let Some(cp) = cp else {
+        v.push(
+            "/coupler_point",
+            "coupler_point is required (or give `joints`)",
+        );
+        return None;
+    };
+    let fields: [(&str, f64, Check); 2] = match cp {
+        CouplerPoint::Triangle { d, e, .. } => [("d", d, non_negative), ("e", e, non_negative)],
+        CouplerPoint::Frame { u, v: w } => [("u", u, coordinate), ("v", w, coordinate)],
+        CouplerPoint::Polar { p, alpha_deg } => {
+            [("p", p, non_negative), ("alpha_deg", alpha_deg, angle)]
+        }
+    };
+    let mut ok = true;
+    for (name, x, check) in fields {
+        ok &= check(v, &format!("/coupler_point/{name}"), name, x);
+    }
+    ok.then_some(cp)
+}
+
+/// The coupler ratio k = (P − D)/(E − D) and the distances d = |P − D|, e = |P − E| of a valid
+/// coupler point (`COUPLER_TRIANGLE_INVALID` when the triangle (b, d, e) cannot close).
+fn coupler_data(v: &mut Validator, cp: CouplerPoint, coupler: f64) -> Option<CouplerData> {
+    match cp {
         CouplerPoint::Triangle { d, e, side } => {
             let slack = TRIANGLE_SLACK_REL * coupler.max(d).max(e);
             let violated = [
@@ -538,37 +457,33 @@ fn dimension_mode(
             .into_iter()
             .find(|(x, s, _)| *x > *s + slack);
             if let Some((_, _, what)) = violated {
-                issues.push(
-                    "COUPLER_TRIANGLE_INVALID",
+                v.push_code(
+                    COUPLER_TRIANGLE_INVALID,
                     "/coupler_point",
                     format!("coupler triangle (b, d, e) = ({coupler}, {d}, {e}) violates the triangle inequality: {what}"),
                 );
-                None
-            } else {
-                // Work with lengths scaled by max(b, d, e) so the squares cannot overflow.
-                let m = coupler.max(d).max(e);
-                let (bn, dn, en) = (coupler / m, d / m, e / m);
-                let t = sign_of(side);
-                let re = (dn * dn + (bn - en) * (bn + en)) / (2.0 * bn * bn);
-                let heron = (dn + bn + en) * (-dn + bn + en) * (dn - bn + en) * (dn + bn - en);
-                let im = t.value() * heron.max(0.0).sqrt() / (2.0 * bn * bn);
-                Some(CouplerData {
-                    k: C64::new(re, im),
-                    d,
-                    e,
-                    side: Some(t),
-                })
+                return None;
             }
-        }
-        CouplerPoint::Frame { u, v } => {
-            let k = C64::new(u, v) / coupler;
+            // Work with lengths scaled by max(b, d, e) so the squares cannot overflow.
+            let m = coupler.max(d).max(e);
+            let (bn, dn, en) = (coupler / m, d / m, e / m);
+            let t = sign_of(side);
+            let re = (dn * dn + (bn - en) * (bn + en)) / (2.0 * bn * bn);
+            let heron = (dn + bn + en) * (-dn + bn + en) * (dn - bn + en) * (dn + bn - en);
+            let im = t.value() * heron.max(0.0).sqrt() / (2.0 * bn * bn);
             Some(CouplerData {
-                k,
-                d: u.hypot(v),
-                e: (coupler - u).hypot(v),
-                side: None,
+                k: C64::new(re, im),
+                d,
+                e,
+                side: Some(t),
             })
         }
+        CouplerPoint::Frame { u, v: w } => Some(CouplerData {
+            k: C64::new(u, w) / coupler,
+            d: u.hypot(w),
+            e: (coupler - u).hypot(w),
+            side: None,
+        }),
         CouplerPoint::Polar { p, alpha_deg } => {
             let z = cis(deg_to_rad(alpha_deg)) * p;
             Some(CouplerData {
@@ -578,13 +493,34 @@ fn dimension_mode(
                 side: None,
             })
         }
+    }
+}
+
+fn dimension_mode(
+    req: &CognatesRequest,
+    options: Options,
+    mut v: Validator,
+) -> Result<CognatesInput, CalcFailure> {
+    let pivots = check_ground(&mut v, req.ground.as_ref());
+    let lens = check_links(&mut v, req);
+    let cp = check_coupler_point(&mut v, req.coupler_point);
+    if let Some(x) = req.input_angle_deg {
+        angle(&mut v, "/input_angle_deg", "input_angle_deg", x);
+    }
+    v.checkpoint()?;
+    let (Some((a_raw, b_raw)), Some([crank, coupler, rocker]), Some(cp)) = (pivots, lens, cp)
+    else {
+        unreachable!("every missing part recorded a problem and `checkpoint` returned it")
     };
+    let a = c64(a_raw);
+    let b = c64(b_raw);
+    let ratio = coupler_data(&mut v, cp, coupler);
     let l = (b - a).norm();
-    let (d_len, e_len) = coupler_data.as_ref().map_or((0.0, 0.0), |c| (c.d, c.e));
+    let (d_len, e_len) = ratio.as_ref().map_or((0.0, 0.0), |c| (c.d, c.e));
     let big_l = l.max(crank).max(coupler).max(rocker).max(d_len).max(e_len);
     if l <= COINCIDENT_REL * big_l {
-        issues.push(
-            "COINCIDENT_PIVOTS",
+        v.push_code(
+            COINCIDENT_PIVOTS,
             if req.ground.as_ref().is_some_and(|g| g.length.is_some()) {
                 "/ground/length"
             } else {
@@ -593,34 +529,51 @@ fn dimension_mode(
             format!("ground pivots coincide: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"),
         );
     }
-    for (ptr, name, len) in [
-        ("/crank", "crank a", crank),
-        ("/coupler", "coupler b", coupler),
-        ("/rocker", "rocker c", rocker),
-    ] {
-        if len < LENGTH_FLOOR_REL * big_l {
-            issues.push(
-                "NON_POSITIVE_LENGTH",
-                ptr,
-                format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"),
-            );
-        }
+    length_floor(
+        &mut v,
+        big_l,
+        [
+            ("/crank", "crank a", crank),
+            ("/coupler", "coupler b", coupler),
+            ("/rocker", "rocker c", rocker),
+        ],
+        |len, floor| len < floor,
+    );
+    if let Some(cd) = &ratio {
+        check_at_joint(&mut v, "/coupler_point", cd.k);
     }
-    if let Some(cd) = &coupler_data {
-        check_at_joint(&mut issues, "/coupler_point", cd.k, one);
-    }
-    issues.finish()?;
-    let Some(cd) = coupler_data else {
-        unreachable!("issues would have been reported")
+    v.finish()?;
+    let Some(cd) = ratio else {
+        unreachable!("a missing coupler ratio recorded a problem and `finish` returned it")
     };
+    Ok(normalised(
+        req,
+        options,
+        a_raw,
+        b_raw,
+        [crank, coupler, rocker],
+        &cd,
+    ))
+}
 
-    // --- normalised frame ---
+/// The validated dimension-mode linkage in its normalised frame (origin A, lengths divided by a
+/// power of two near L).
+fn normalised(
+    req: &CognatesRequest,
+    options: Options,
+    a_raw: [f64; 2],
+    b_raw: [f64; 2],
+    [crank, coupler, rocker]: [f64; 3],
+    cd: &CouplerData,
+) -> CognatesInput {
+    let (a, b) = (c64(a_raw), c64(b_raw));
+    let l = (b - a).norm();
+    let big_l = l.max(crank).max(coupler).max(rocker).max(cd.d).max(cd.e);
     let scale = power_of_two_near(big_l);
-    let ground = l / scale;
     let mech = FourBar {
         input_pivot: C64::new(0.0, 0.0),
         output_pivot: (b - a) / scale,
-        ground,
+        ground: l / scale,
         crank: crank / scale,
         coupler: coupler / scale,
         rocker: rocker / scale,
@@ -641,7 +594,7 @@ fn dimension_mode(
             branch: req.branch.map_or(Sign::Plus, sign_of),
         }
     });
-    Ok(CognatesInput {
+    CognatesInput {
         origin: a,
         scale,
         a_raw,
@@ -652,5 +605,5 @@ fn dimension_mode(
         snapshot,
         joints_at_toggle: false,
         options,
-    })
+    }
 }

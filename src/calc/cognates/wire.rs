@@ -73,15 +73,18 @@ pub struct CognatesRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub ground: Option<GroundSpec>,
-    /// Crank (input link) length `a` [length], > 0 (dimension mode).
+    /// Crank (input link) length `a` [length], > 0 and ≥ 1e-12·L, L the largest length of the
+    /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.13)]
     pub crank: Option<f64>,
-    /// Coupler length `b` = |E − D| [length], > 0 (dimension mode).
+    /// Coupler length `b` = |E − D| [length], > 0 and ≥ 1e-12·L, L the largest length of the
+    /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.23)]
     pub coupler: Option<f64>,
-    /// Rocker (output link) length `c` [length], > 0 (dimension mode).
+    /// Rocker (output link) length `c` [length], > 0 and ≥ 1e-12·L, L the largest length of the
+    /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.04)]
     pub rocker: Option<f64>,
@@ -141,10 +144,10 @@ pub struct GroundSpec {
 pub enum CouplerPoint {
     /// Paper form: distances to the coupler joints and the side.
     Triangle {
-        /// `d` = |P − D| [length], ≥ 0.
+        /// `d` = |P − D| [length], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
         #[schema(example = 0.92)]
         d: f64,
-        /// `e` = |P − E| [length], ≥ 0.
+        /// `e` = |P − E| [length], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
         #[schema(example = 1.56)]
         e: f64,
         /// Coupler side `t2`: 1 when P is left of the directed line D→E. Default 1.

@@ -7,8 +7,9 @@ use std::collections::HashMap;
 use super::graph::Digraph;
 use super::structure::LevelMode;
 use super::wire::{
-    BetweennessMode, ComponentImportanceRequest, ConstantWeights, Outputs, PathMethod, TIME_H,
-    WEIGHT, Warning,
+    BETA, BetweennessMode, ComponentImportanceRequest, ConstantWeights, ETA_H, LEVEL,
+    MAX_SIMPLE_PATHS, NON_NEGATIVE, Outputs, PATH_CAP, PROBABILITY, PathMethod, TIME_H, WEIGHT,
+    Warning,
 };
 use crate::calc::{CalcFailure, Validator};
 
@@ -20,8 +21,6 @@ pub const MAX_COMPONENTS: usize = 2000;
 pub const MAX_ID_CHARS: usize = 64;
 /// Maximum number of evaluation times (spec §2).
 pub const MAX_TIMES: usize = 1000;
-/// Weibull shape range (spec §2).
-pub const BETA_RANGE: (f64, f64) = (0.05, 20.0);
 /// Q + O = 1 and Σω_c = 1 are checked to this absolute tolerance (spec §2).
 pub const SUM_TOL: f64 = 1e-9;
 /// Σα of a component may differ from 1 by this much before a warning (spec §2).
@@ -29,10 +28,6 @@ pub const ALPHA_SUM_WARN_TOL: f64 = 1e-3;
 /// An override or entropy time matches a requested time when equal to this relative tolerance
 /// (both come from the same JSON text; the tolerance only absorbs decimal round trips).
 pub const TIME_MATCH_REL_TOL: f64 = 1e-12;
-/// Path cap K range (spec §2).
-pub const PATH_CAP_RANGE: (u32, u32) = (1, 8);
-/// Enumeration budget range (spec §2).
-pub const MAX_SIMPLE_PATHS_RANGE: (f64, f64) = (1e3, 1e8);
 
 /// How ω_c is obtained.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -218,7 +213,7 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
                 match index_of.get(id.as_str()) {
                     None => v.push(p, format!("unknown component id \"{id}\"")),
                     Some(&i) => {
-                        if v.in_range(&p, x, 0.0, 1.0) {
+                        if v.range(&p, "F", x, PROBABILITY) {
                             fo[i] = Some(x);
                         }
                     }
@@ -229,12 +224,8 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
                 match index_of.get(id.as_str()) {
                     None => v.push(p, format!("unknown component id \"{id}\"")),
                     Some(&i) => {
-                        if v.finite(&p, x) {
-                            if x < 0.0 {
-                                v.push(p, format!("RI must be >= 0 [1/h], got {x}"));
-                            } else {
-                                ro[i] = Some(x);
-                            }
+                        if v.range(&p, "RI [1/h]", x, NON_NEGATIVE) {
+                            ro[i] = Some(x);
                         }
                     }
                 }
@@ -261,13 +252,8 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
             let ri_all = all_times(&ri_override, i);
             match c.weibull {
                 Some(w) => {
-                    let ok_eta = v.greater_than(&format!("{base}/weibull/eta_h"), w.eta_h, 0.0);
-                    let ok_beta = v.in_range(
-                        &format!("{base}/weibull/beta"),
-                        w.beta,
-                        BETA_RANGE.0,
-                        BETA_RANGE.1,
-                    );
+                    let ok_eta = v.range(&format!("{base}/weibull/eta_h"), "", w.eta_h, ETA_H);
+                    let ok_beta = v.range(&format!("{base}/weibull/beta"), "", w.beta, BETA);
                     if ok_eta && ok_beta {
                         weibull[i] = Some((w.eta_h, w.beta));
                     }
@@ -289,12 +275,8 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
                 ),
                 (None, Some(s)) => {
                     let p = format!("{base}/mode_sum");
-                    if v.finite(&p, s) {
-                        if s < 0.0 {
-                            v.push(p, format!("mode_sum must be >= 0, got {s}"));
-                        } else {
-                            mode_sum[i] = Some(s);
-                        }
+                    if v.range(&p, "mode_sum", s, NON_NEGATIVE) {
+                        mode_sum[i] = Some(s);
                     }
                 }
                 (Some(modes), None) => {
@@ -305,16 +287,9 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
                     let mut ok = !modes.is_empty();
                     let (mut sum_alpha, mut s) = (0.0, 0.0);
                     for (m, fm) in modes.iter().enumerate() {
-                        ok &= v.in_range(&format!("{p}/{m}/alpha"), fm.alpha, 0.0, 1.0);
+                        ok &= v.range(&format!("{p}/{m}/alpha"), "", fm.alpha, PROBABILITY);
                         let pi = format!("{p}/{m}/impact");
-                        if v.finite(&pi, fm.impact) {
-                            if fm.impact < 0.0 {
-                                v.push(pi, format!("impact must be >= 0, got {}", fm.impact));
-                                ok = false;
-                            }
-                        } else {
-                            ok = false;
-                        }
+                        ok &= v.range(&pi, "impact", fm.impact, NON_NEGATIVE);
                         sum_alpha += fm.alpha;
                         s += fm.alpha * fm.impact;
                     }
@@ -348,23 +323,19 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
             }
             if let Some(x) = c.efficiency_override {
                 let p = format!("{base}/efficiency_override");
-                if v.finite(&p, x) {
-                    if x < 0.0 {
-                        v.push(p, format!("efficiency_override must be >= 0, got {x}"));
-                    } else {
-                        efficiency_override[i] = Some(x);
-                    }
+                if v.range(&p, "efficiency_override", x, NON_NEGATIVE) {
+                    efficiency_override[i] = Some(x);
                 }
             }
-            if let Some(h) = c.level_override {
-                if h < 1 {
-                    v.push(
-                        format!("{base}/level_override"),
-                        "level_override must be an integer >= 1, got 0".to_owned(),
-                    );
-                } else {
-                    level_override[i] = Some(h);
-                }
+            if let Some(h) = c.level_override
+                && v.uint(
+                    &format!("{base}/level_override"),
+                    "level_override",
+                    u64::from(h),
+                    LEVEL,
+                )
+            {
+                level_override[i] = Some(h);
             }
         }
 
@@ -416,8 +387,8 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
 
         // Options.
         let o = &req.options;
-        let ok_q = v.in_range("/options/q_in", o.q_in, 0.0, 1.0);
-        let ok_o = v.in_range("/options/o_out", o.o_out, 0.0, 1.0);
+        let ok_q = v.range("/options/q_in", "", o.q_in, PROBABILITY);
+        let ok_o = v.range("/options/o_out", "", o.o_out, PROBABILITY);
         if ok_q && ok_o && (o.q_in + o.o_out - 1.0).abs() > SUM_TOL {
             v.push(
                 "/options/o_out",
@@ -459,21 +430,17 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
                     })
             }
         };
-        v.ensure(
-            (PATH_CAP_RANGE.0..=PATH_CAP_RANGE.1).contains(&o.path_cap),
+        v.uint(
             "/options/path_cap",
-            || {
-                format!(
-                    "path_cap K must be an integer in [{}, {}], got {}",
-                    PATH_CAP_RANGE.0, PATH_CAP_RANGE.1, o.path_cap
-                )
-            },
+            "path_cap K",
+            u64::from(o.path_cap),
+            PATH_CAP,
         );
-        v.in_range(
+        v.range(
             "/options/max_simple_paths",
+            "",
             o.max_simple_paths,
-            MAX_SIMPLE_PATHS_RANGE.0,
-            MAX_SIMPLE_PATHS_RANGE.1,
+            MAX_SIMPLE_PATHS,
         );
 
         v.finish()?;

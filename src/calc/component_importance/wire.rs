@@ -482,38 +482,56 @@ pub const TIME_H: Range = Range::FINITE.gt(0.0);
 /// A constant weight of the probability/risk pair: positive (the pair sums to 1).
 pub const WEIGHT: Range = Range::FINITE.gt(0.0);
 
+/// A probability or share in [0, 1] (F override, failure-mode α, the pair Q/O) [–].
+pub const PROBABILITY: Range = Range::closed(0.0, 1.0);
+/// A quantity that may be zero (RI override [1/h], mode sum, impact, efficiency override).
+pub const NON_NEGATIVE: Range = Range::FINITE.min(0.0);
+/// Weibull scale η [h]: positive.
+pub const ETA_H: Range = Range::FINITE.gt(0.0);
+/// Weibull shape β [–] (spec §2).
+pub const BETA: Range = Range::closed(0.05, 20.0);
+/// Level override [–]: a level ≥ 1.
+pub const LEVEL: Range = Range::INTEGER.min(1.0);
+/// Path cap K [–] (spec §2).
+pub const PATH_CAP: Range = Range::int(1, 8);
+/// Enumeration budget of simple paths [–] (spec §2).
+pub const MAX_SIMPLE_PATHS: Range = Range::closed(1e3, 1e8);
+
 crate::schema_bounds! {
     ComponentImportanceRequest {
         times_h @items: TIME_H,
     },
     Options {
-        max_simple_paths: Range::FINITE.min(1000.0).max(100_000_000.0),
+        max_simple_paths: MAX_SIMPLE_PATHS,
     },
     ComponentSpec {
-        mode_sum: Range::FINITE.min(0.0),
-        efficiency_override: Range::FINITE.min(0.0),
-        level_override: Range::INTEGER.min(1.0),
+        mode_sum: NON_NEGATIVE,
+        efficiency_override: NON_NEGATIVE,
+        level_override: LEVEL,
     },
     Weibull {
-        eta_h: Range::FINITE.gt(0.0),
-        beta: Range::FINITE.min(0.05).max(20.0),
+        eta_h: ETA_H,
+        beta: BETA,
     },
     FailureMode {
-        alpha: Range::FINITE.min(0.0).max(1.0),
-        impact: Range::FINITE.min(0.0),
+        alpha: PROBABILITY,
+        impact: NON_NEGATIVE,
     },
     Options {
-        q_in: Range::FINITE.min(0.0).max(1.0),
-        o_out: Range::FINITE.min(0.0).max(1.0),
-        path_cap: Range::INTEGER.min(1.0).max(8.0),
+        q_in: PROBABILITY,
+        o_out: PROBABILITY,
+        path_cap: PATH_CAP,
     },
 }
 
-/// Bounds inside the untagged constant-weights alternatives (rendered inline).
+/// Bounds inside the untagged constant-weights alternatives and the per-id override maps
+/// (rendered inline).
 #[must_use]
 pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
-    vec![crate::calc::SchemaBound::at::<ConstantWeights>(
-        "/oneOf/0/items",
-        WEIGHT,
-    )]
+    use crate::calc::SchemaBound;
+    vec![
+        SchemaBound::at::<ConstantWeights>("/oneOf/0/items", WEIGHT),
+        SchemaBound::at::<TimeOverride>("/properties/F/additionalProperties", PROBABILITY),
+        SchemaBound::at::<TimeOverride>("/properties/RI/additionalProperties", NON_NEGATIVE),
+    ]
 }

@@ -16,10 +16,10 @@ use crate::calc::{CalcFailure, ProblemClass, Validator};
 
 use super::wire::{
     ASSEMBLY_MODES_TOL, CELL, COND_MAX, CONTINUATION_STEPS, COORDINATE_M, DIAMETER_M, EI_NM2,
-    GRID_SIDE, JUMP_LIMITS_ANGLE_DEG, JUMP_LIMITS_POSITION_FACTOR, LENGTH_M, MAX_REFINE,
-    MAX_SUBSTEPS, MAX_TRIES, N_GRID, QUASI_TRANSLATIONAL_DEG, RK4_STEPS, ROD_SHAPE_POINTS,
-    SIGMA_ALLOW_PA, SOLVER_MAX_ITER, SOLVER_TOL, STABILITY_SEGMENTS, SUBSTEP_MAX_ITER,
-    YOUNGS_MODULUS_PA,
+    GRID_SIDE, JUMP_LIMITS_ANGLE_DEG, JUMP_LIMITS_POSITION_FACTOR, LENGTH_M, MAX_ACTUATORS,
+    MAX_REFINE, MAX_SUBSTEPS, MAX_TRIES, N_GRID, QUASI_TRANSLATIONAL_DEG, RK4_STEPS,
+    ROD_SHAPE_POINTS, SIGMA_ALLOW_PA, SOLVER_MAX_ITER, SOLVER_TOL, STABILITY_SEGMENTS,
+    SUBSTEP_MAX_ITER, YOUNGS_MODULUS_PA,
 };
 use crate::calc::Range;
 
@@ -194,10 +194,10 @@ fn design_of(
     match &d.actuators {
         None => v.push("/design/actuators", "required (or give design.preset)"),
         Some(acts) => {
-            if acts.is_empty() || acts.len() > 4 {
+            if acts.is_empty() || acts.len() > MAX_ACTUATORS {
                 v.push(
                     "/design/actuators",
-                    format!("must list 1..4 actuators, got {}", acts.len()),
+                    format!("must list 1..{MAX_ACTUATORS} actuators, got {}", acts.len()),
                 );
             }
             for (j, a) in acts.iter().enumerate() {

@@ -862,6 +862,12 @@ pub const COND_MAX: Range = Range::closed(10.0, 1e18);
 pub const QUASI_TRANSLATIONAL_DEG: Range = Range::closed(1e-9, 180.0);
 /// Nodes per side of the workspace grid (spec 4.7).
 pub const GRID_SIDE: Range = Range::int(2, 401);
+/// Most actuators of a design.
+pub const MAX_ACTUATORS: usize = 4;
+/// Index of a design's actuator (below the number of actuators: a cross-field rule).
+pub const ACTUATOR_INDEX: Range = Range::int(0, MAX_ACTUATORS as i64 - 1);
+/// An index into a list (assembly mode, seed node).
+pub const INDEX: Range = Range::INTEGER.min(0.0);
 
 crate::schema_bounds! {
     ContinuumWorkspaceRequest {
@@ -877,7 +883,7 @@ crate::schema_bounds! {
         stroke_m @items: COORDINATE_M,
     },
     RodRequest {
-        actuator: Range::INTEGER.min(0.0).max(3.0),
+        actuator: ACTUATOR_INDEX,
         offset_m @items: COORDINATE_M,
         attach_m @items: COORDINATE_M,
         length_m: LENGTH_M,
@@ -891,7 +897,7 @@ crate::schema_bounds! {
         max_iter: SOLVER_MAX_ITER,
     },
     StartRequest {
-        index: Range::INTEGER.min(0.0),
+        index: INDEX,
         continuation_steps: CONTINUATION_STEPS,
     },
     OutputsRequest {
@@ -899,7 +905,7 @@ crate::schema_bounds! {
         rod_shape_points: ROD_SHAPE_POINTS,
     },
     SeedRequest {
-        index: Range::INTEGER.min(0.0),
+        index: INDEX,
     },
     JumpLimits {
         angle_deg: JUMP_LIMITS_ANGLE_DEG,

@@ -46,6 +46,7 @@
 pub mod efficiency;
 pub mod error;
 pub mod geometry;
+pub mod input;
 pub mod stress;
 pub mod wire;
 

@@ -1,10 +1,10 @@
 //! Wire types shared by both IREFC endpoints: the `geometry` output object, warnings, materials,
-//! profile point sets, and the shared validation of the four initial parameters.
+//! profile point sets, and the bounds of the four initial parameters and the materials (checked by
+//! [`super::input`]).
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use super::error::{BAD_RANGE, Issues, MISSING_FIELD};
 use super::geometry::{
     CHI_MAX, Geometry, GeometryWarning, NEAR_UNDERCUT_FRACTION, Wheel, Z2_MAX, Z2_MIN,
 };
@@ -12,14 +12,26 @@ use crate::calc::Range;
 
 /// Millimetres per metre (wire ↔ SI).
 pub(crate) const MM: f64 = 1e3;
-/// Upper limit of r2 [mm] (spec range).
-pub const R2_MAX_MM: f64 = 10_000.0;
 /// Default number of profile points per wheel (spec).
 pub const PROFILE_POINTS_DEFAULT: u32 = 720;
 /// Largest number of profile points per wheel (keeps responses below a few MB).
 pub const PROFILE_POINTS_MAX: u32 = 100_000;
 /// Smallest number of profile points per wheel (a closed polygon needs a few).
 pub const PROFILE_POINTS_MIN: u32 = 8;
+
+/// Cage pitch radius r2 [mm]: 0 < r2 ≤ 10 000 (spec).
+pub const R2_MM: Range = Range::FINITE.gt(0.0).max(10_000.0);
+/// Number of rolling elements Z2 [–]: 3 ≤ Z2 ≤ 1000 (Z2 = 2 gives Σsin²α = 0).
+pub const Z2: Range = Range::int(Z2_MIN as i64, Z2_MAX as i64);
+/// Displacement coefficient χ [–]: 1 < χ ≤ 5.
+pub const CHI: Range = Range::FINITE.gt(1.0).max(CHI_MAX);
+/// Rolling element radius rb [mm]: > 0. Buildability (rb below rb_overlap and rb_undercut, which
+/// depend on r2, Z2 and χ) is checked on the geometry (`ELEMENT_OVERLAP`, `UNDERCUT`).
+pub const RB_MM: Range = Range::FINITE.gt(0.0);
+/// Young's modulus E [MPa].
+pub const E_MPA: Range = Range::closed(1e3, 1e7);
+/// Poisson's ratio ν [–]: 0 ≤ ν < 0.5.
+pub const NU: Range = Range::FINITE.min(0.0).lt(0.5);
 
 /// A non-fatal warning: stable code and human message.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, ToSchema)]
@@ -100,24 +112,6 @@ impl Default for Material {
 }
 
 impl Material {
-    /// Validate E and ν under `pointer`.
-    pub(crate) fn validate(&self, issues: &mut Issues, pointer: &str) {
-        issues.range(
-            &format!("{pointer}/E_MPa"),
-            "Young's modulus E_MPa",
-            self.e_mpa,
-            1e3,
-            1e7,
-        );
-        issues.range_open_hi(
-            &format!("{pointer}/nu"),
-            "Poisson's ratio nu",
-            self.nu,
-            0.0,
-            0.5,
-        );
-    }
-
     /// Plane-strain modulus term (1 − ν²)/E [1/Pa].
     #[must_use]
     pub fn compliance(&self) -> f64 {
@@ -257,58 +251,11 @@ impl GeometryOut {
     }
 }
 
-/// Validate r2 [mm] at `pointer`; returns it when valid.
-pub(crate) fn check_r2(issues: &mut Issues, pointer: &str, v: f64) -> Option<f64> {
-    issues
-        .range_open_lo(pointer, "cage pitch radius r2_mm", v, 0.0, R2_MAX_MM)
-        .then_some(v)
-}
-
-/// Validate Z2 at `pointer`; returns it when valid.
-pub(crate) fn check_z2(issues: &mut Issues, pointer: &str, v: i64) -> Option<u32> {
-    if issues.int_range(
-        pointer,
-        "number of rolling elements Z2",
-        v,
-        i64::from(Z2_MIN),
-        i64::from(Z2_MAX),
-    ) {
-        u32::try_from(v).ok()
-    } else {
-        None
-    }
-}
-
-/// Validate χ at `pointer`; returns it when valid.
-pub(crate) fn check_chi(issues: &mut Issues, pointer: &str, v: f64) -> Option<f64> {
-    issues
-        .range_open_lo(pointer, "displacement coefficient chi", v, 1.0, CHI_MAX)
-        .then_some(v)
-}
-
-/// Validate rb [mm] > 0 at `pointer` (feasibility limits are checked on the geometry).
-pub(crate) fn check_rb(issues: &mut Issues, pointer: &str, v: f64) -> Option<f64> {
-    let ok = v.is_finite() && v > 0.0;
-    if !ok {
-        issues.push(
-            BAD_RANGE,
-            pointer,
-            format!("rolling element radius rb_mm must be a finite number > 0, got {v}"),
-        );
-    }
-    ok.then_some(v)
-}
-
-/// Record a missing required field.
-pub(crate) fn missing(issues: &mut Issues, pointer: &str, what: &str) {
-    issues.push(MISSING_FIELD, pointer, format!("{what} is required"));
-}
-
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
 crate::schema_bounds! {
     Material {
-        e_mpa as "E_MPa": Range::FINITE.min(1e3).max(1e7),
-        nu: Range::FINITE.min(0.0).lt(0.5),
+        e_mpa as "E_MPa": E_MPA,
+        nu: NU,
     },
 }

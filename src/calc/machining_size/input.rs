@@ -18,9 +18,9 @@ use super::wire::{
     AnalyzeRequest, FRACTION, GRA_RHO, GraNormalise, K_FOLD, LEARNING_RATE, MAX_BACKGROUND,
     MAX_BIN, MAX_DEPTH, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
     MAX_INTERVENTIONAL_PAIRS, MAX_PREDICT_ROWS, MAX_ROWS, MAX_SCORE_CELLS, MAX_SHAP_CELLS,
-    MAX_TREES, MIN_ROWS, N_ESTIMATORS, PCA_COMPONENTS, PredictRequest, REGULARISATION, SMOGN_K,
-    SMOGN_PERTURBATION, SMOGN_THRESHOLD, ShapKind, TARGET, TEST_FRACTION, TrainOutputKind,
-    TrainRequest, TreeMethod,
+    MAX_TREES, MIN_ROWS, N_ESTIMATORS, PCA_COMPONENTS, PredictRequest, REGULARISATION,
+    RELEVANCE_PHI, SMOGN_K, SMOGN_PERTURBATION, SMOGN_THRESHOLD, ShapKind, TARGET, TEST_FRACTION,
+    TrainOutputKind, TrainRequest, TreeMethod,
 };
 
 /// A validated `/train` request.
@@ -194,12 +194,7 @@ fn smogn_params(
     }
     for (i, p) in relevance.iter().enumerate() {
         v.range(&format!("{at}/relevance/{i}/0"), "y", p[0], Range::FINITE);
-        v.range(
-            &format!("{at}/relevance/{i}/1"),
-            "φ",
-            p[1],
-            Range::closed(0.0, 1.0),
-        );
+        v.range(&format!("{at}/relevance/{i}/1"), "φ", p[1], RELEVANCE_PHI);
         if i > 0 && p[0] <= relevance[i - 1][0] {
             v.push(
                 format!("{at}/relevance/{i}/0"),

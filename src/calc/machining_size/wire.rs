@@ -61,6 +61,9 @@ pub const TEST_FRACTION: Range = Range::closed(0.0, 0.5);
 pub const K_FOLD: Range = Range::int(2, 20);
 /// SMOGN relevance threshold.
 pub const SMOGN_THRESHOLD: Range = Range::closed(0.0, 1.0);
+/// SMOGN relevance φ of a control point `[y, φ]` (stated in the field's description: a bound on
+/// the second item of a pair has no JSON Schema form here).
+pub const RELEVANCE_PHI: Range = Range::closed(0.0, 1.0);
 /// SMOGN neighbours per seed.
 pub const SMOGN_K: Range = Range::int(1, 50);
 /// SMOGN relative perturbation.

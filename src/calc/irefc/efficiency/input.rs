@@ -2,28 +2,22 @@
 
 use std::f64::consts::PI;
 
-use super::wire::{EfficiencyModel, IrefcEfficiencyRequest};
-use crate::calc::CalcFailure;
-use crate::calc::irefc::error::{AMBIGUOUS_LOAD, IrefcError, Issues};
+use super::wire::{
+    EfficiencyModel, INPUT_TORQUE_NM, IrefcEfficiencyRequest, N_PHASE, POWER_W,
+    ROLLING_FRICTION_MM, SLIDING_FRICTION, SPEED_RPM, phase_deg_range,
+};
+use crate::calc::irefc::error::{AMBIGUOUS_LOAD, BAD_RANGE, IrefcError};
 use crate::calc::irefc::geometry::Geometry;
-use crate::calc::irefc::wire::{MM, check_chi, check_r2, check_rb, check_z2, missing};
+use crate::calc::irefc::input as design;
+use crate::calc::irefc::wire::MM;
+use crate::calc::{CalcFailure, ProblemClass};
 
-/// Largest input power [W] (spec).
-pub const POWER_MAX_W: f64 = 1e8;
-/// Largest input torque [N·m] (same scale as the stress endpoint's torque limit).
-pub const INPUT_TORQUE_MAX_NM: f64 = 1e7;
-/// Largest input speed [rpm] (spec).
-pub const SPEED_MAX_RPM: f64 = 1e6;
-/// Largest rolling-friction lever arm [mm] (spec).
-pub const ROLLING_FRICTION_MAX_MM: f64 = 10.0;
 /// The paper's rolling-friction lever arm μ = 0.001 m [mm].
 pub const ROLLING_FRICTION_PAPER_MM: f64 = 1.0;
 /// Rolling-friction lever arms above this [mm] get `ROLLING_FRICTION_HIGH` (largest tabulated steel value).
 pub const ROLLING_FRICTION_HIGH_MM: f64 = 0.5;
 /// The paper's sliding friction coefficient.
 pub const SLIDING_FRICTION_PAPER: f64 = 0.1;
-/// Largest number of cage phases (spec).
-pub const N_PHASE_MAX: u32 = 10_000;
 
 /// Validated efficiency input [SI].
 #[derive(Debug, Clone, PartialEq)]
@@ -54,71 +48,70 @@ impl EfficiencyInput {
     /// Validate a request: ranges (`BAD_RANGE`, `MISSING_FIELD`, `AMBIGUOUS_LOAD`, all at once), then
     /// buildability (`UNDERCUT`, `ELEMENT_OVERLAP`).
     pub fn try_from_request(req: &IrefcEfficiencyRequest) -> Result<Self, CalcFailure> {
-        let mut is = Issues::new();
-        let r2 = check_r2(&mut is, "/r2_mm", req.r2_mm);
-        let z2 = check_z2(&mut is, "/Z2", req.z2);
-        let chi = check_chi(&mut is, "/chi", req.chi);
-        let rb = check_rb(&mut is, "/rb_mm", req.rb_mm);
+        let mut v = design::validator();
+        let r2 = design::r2(&mut v, "/r2_mm", req.r2_mm);
+        let z2 = design::z2(&mut v, "/Z2", req.z2);
+        let chi = design::chi(&mut v, "/chi", req.chi);
+        let rb = design::rb(&mut v, "/rb_mm", req.rb_mm);
         match (req.power_w, req.input_torque_nm) {
-            (Some(_), Some(_)) => is.push(
+            (Some(_), Some(_)) => v.push_code(
                 AMBIGUOUS_LOAD,
                 "/input_torque_Nm",
                 "give either power_W or input_torque_Nm, not both",
             ),
-            (None, None) => missing(&mut is, "/power_W", "power_W (or input_torque_Nm)"),
+            (None, None) => design::missing(&mut v, "/power_W", "power_W (or input_torque_Nm)"),
             (Some(p), None) => {
-                is.range_open_lo("/power_W", "input power power_W", p, 0.0, POWER_MAX_W);
+                v.range("/power_W", "input power power_W", p, POWER_W);
             }
             (None, Some(m)) => {
-                is.range_open_lo(
+                v.range(
                     "/input_torque_Nm",
                     "input torque input_torque_Nm",
                     m,
-                    0.0,
-                    INPUT_TORQUE_MAX_NM,
+                    INPUT_TORQUE_NM,
                 );
             }
         }
-        is.range_open_lo(
-            "/speed_rpm",
-            "input speed speed_rpm",
-            req.speed_rpm,
-            0.0,
-            SPEED_MAX_RPM,
-        );
         let mu_mm = req.rolling_friction_mm.unwrap_or(ROLLING_FRICTION_PAPER_MM);
-        is.range(
-            "/rolling_friction_mm",
-            "rolling friction lever arm",
-            mu_mm,
-            0.0,
-            ROLLING_FRICTION_MAX_MM,
-        );
         let fs = req.sliding_friction.unwrap_or(SLIDING_FRICTION_PAPER);
-        is.range(
-            "/sliding_friction",
-            "sliding friction coefficient",
-            fs,
-            0.0,
-            1.0,
-        );
         let n_phase = req.n_phase.unwrap_or(1);
-        is.ensure((1..=N_PHASE_MAX).contains(&n_phase), "/n_phase", || {
-            format!("n_phase must be in [1, {N_PHASE_MAX}], got {n_phase}")
-        });
+        for (pointer, name, x, range) in [
+            (
+                "/speed_rpm",
+                "input speed speed_rpm",
+                req.speed_rpm,
+                SPEED_RPM,
+            ),
+            (
+                "/rolling_friction_mm",
+                "rolling friction lever arm",
+                mu_mm,
+                ROLLING_FRICTION_MM,
+            ),
+            (
+                "/sliding_friction",
+                "sliding friction coefficient",
+                fs,
+                SLIDING_FRICTION,
+            ),
+            ("/n_phase", "n_phase", f64::from(n_phase), N_PHASE),
+        ] {
+            v.range(pointer, name, x, range);
+        }
         let phase_deg = req.phase_deg.unwrap_or(0.0);
         let mut phase_fraction = 0.0;
         if let Some(z) = z2 {
-            let pitch = 360.0 / f64::from(z);
-            if is.range_open_hi("/phase_deg", "cage phase phase_deg", phase_deg, 0.0, pitch) {
-                phase_fraction = (phase_deg / pitch).clamp(0.0, 1.0 - f64::EPSILON);
+            let range = phase_deg_range(z);
+            if v.range("/phase_deg", "cage phase phase_deg", phase_deg, range) {
+                phase_fraction = (phase_deg / range.hi).clamp(0.0, 1.0 - f64::EPSILON);
             }
         }
-        is.finish()?;
+        v.finish()?;
         let (Some(r2), Some(z2), Some(chi), Some(rb)) = (r2, z2, chi, rb) else {
+            // Unreachable: each None recorded a problem and `finish` returned it.
             return Err(CalcFailure::general(
-                crate::calc::ProblemClass::InvalidInput,
-                "BAD_RANGE",
+                ProblemClass::InvalidInput,
+                BAD_RANGE,
                 "incomplete design",
             ));
         };

@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::calc::Range;
-use crate::calc::irefc::wire::{GeometryOut, Warning};
+use crate::calc::irefc::wire::{CHI, GeometryOut, R2_MM, RB_MM, Warning, Z2};
 
 /// Loss model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
@@ -83,7 +83,8 @@ pub struct IrefcEfficiencyRequest {
     /// "paper_table" (default), "paper_abs" or "rigid_body".
     #[schema(nullable = false)]
     pub model: Option<EfficiencyModel>,
-    /// Cage phase: element k at φ2 = phase + 360k/Z2 [deg], in [0, 360/Z2) (default 0, the paper).
+    /// Cage phase: element k at φ2 = phase + 360k/Z2 [deg], in [0, 360/Z2) (default 0, the paper);
+    /// the upper end depends on `Z2`.
     #[schema(example = 0.0)]
     pub phase_deg: Option<f64>,
     /// Number of equally spaced cage phases to average over (1 = the paper; default 1).
@@ -247,20 +248,42 @@ pub struct IrefcEfficiencyResponse {
     pub meta: EfficiencyMeta,
 }
 
+/// Input power P_in [W]: 0 < P ≤ 1e8 (spec).
+pub const POWER_W: Range = Range::FINITE.gt(0.0).max(1e8);
+/// Input torque M_in [N·m]: 0 < M ≤ 1e7 (the stress endpoint's torque scale).
+pub const INPUT_TORQUE_NM: Range = Range::FINITE.gt(0.0).max(1e7);
+/// Input speed [rpm]: 0 < n ≤ 1e6 (spec).
+pub const SPEED_RPM: Range = Range::FINITE.gt(0.0).max(1e6);
+/// Rolling-friction lever arm μ [mm]: 0 ≤ μ ≤ 10 (spec).
+pub const ROLLING_FRICTION_MM: Range = Range::closed(0.0, 10.0);
+/// Sliding friction coefficient f_s [–]: 0 ≤ f_s ≤ 1.
+pub const SLIDING_FRICTION: Range = Range::closed(0.0, 1.0);
+/// Cage phase [deg]: ≥ 0; the upper end 360/Z2 (exclusive) depends on Z2 (a cross-field rule,
+/// [`phase_deg_range`]).
+pub const PHASE_DEG: Range = Range::FINITE.min(0.0);
+/// Number of cage phases averaged (spec).
+pub const N_PHASE: Range = Range::int(1, 10_000);
+
+/// The cage phase range of a design with `z2` elements [deg]: [0, 360/Z2).
+#[must_use]
+pub fn phase_deg_range(z2: u32) -> Range {
+    PHASE_DEG.lt(360.0 / f64::from(z2))
+}
+
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
 crate::schema_bounds! {
     IrefcEfficiencyRequest {
-        r2_mm: Range::FINITE.gt(0.0).max(10000.0),
-        z2 as "Z2": Range::INTEGER.min(3.0).max(1000.0),
-        chi: Range::FINITE.gt(1.0).max(5.0),
-        rb_mm: Range::FINITE.gt(0.0),
-        power_w as "power_W": Range::FINITE.gt(0.0).max(1e8),
-        input_torque_nm as "input_torque_Nm": Range::FINITE.gt(0.0).max(1e7),
-        speed_rpm: Range::FINITE.gt(0.0).max(1e6),
-        rolling_friction_mm: Range::FINITE.min(0.0).max(10.0),
-        sliding_friction: Range::FINITE.min(0.0).max(1.0),
-        phase_deg: Range::FINITE.min(0.0),
-        n_phase: Range::INTEGER.min(1.0).max(10000.0),
+        r2_mm: R2_MM,
+        z2 as "Z2": Z2,
+        chi: CHI,
+        rb_mm: RB_MM,
+        power_w as "power_W": POWER_W,
+        input_torque_nm as "input_torque_Nm": INPUT_TORQUE_NM,
+        speed_rpm: SPEED_RPM,
+        rolling_friction_mm: ROLLING_FRICTION_MM,
+        sliding_friction: SLIDING_FRICTION,
+        phase_deg: PHASE_DEG,
+        n_phase: N_PHASE,
     },
 }

@@ -1,32 +1,26 @@
 //! Validation of an [`IrefcStressRequest`] into SI domain input, collecting every issue.
 
-use super::wire::{IrefcStressRequest, LoadSharing, OutputLink, StressInclude, StressMode};
-use crate::calc::CalcFailure;
-use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, Issues, SWEEP_TOO_LARGE};
-use crate::calc::irefc::wire::{
-    MM, PROFILE_POINTS_DEFAULT, PROFILE_POINTS_MAX, PROFILE_POINTS_MIN, Warning, check_chi,
-    check_r2, check_rb, check_z2, missing,
+use super::wire::{
+    CHI_STEP, CURVES_STRIDE, GRID_INTERVALS_MAX, IntRange, IrefcStressRequest, LB_MAX_OVER_R2,
+    LB_MM, LoadSharing, OutputLink, PROFILE_POINTS, STEP_DEG, STEP_DEG_BUILDABLE, StepRange,
+    StressInclude, StressMode, TORQUE_NM,
 };
+use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, SWEEP_TOO_LARGE};
+use crate::calc::irefc::input as design;
+use crate::calc::irefc::wire::{MM, PROFILE_POINTS_DEFAULT, Warning};
+use crate::calc::{CalcFailure, ProblemClass, Range, Validator};
 
 /// Default φ2 grid step [deg]: 1° + refinement is ≤ 1e-10 from the exact maximum and ~40× cheaper than the
 /// paper's 0.02° grid (whose error is 1.8e-8); see `benches/RESULTS.md` (## irefc).
 pub const STEP_DEG_DEFAULT: f64 = 1.0;
 /// The paper's grid step [deg] (0.02°, no refinement).
 pub const STEP_DEG_PAPER: f64 = 0.02;
-/// Largest admitted grid step [deg] (spec).
-pub const STEP_DEG_MAX: f64 = 10.0;
-/// Largest number of grid intervals 180/step (spec: 180/step ≤ 2·10⁶).
-pub const GRID_INTERVALS_MAX: f64 = 2e6;
 /// Largest number of sweep combinations (spec).
 pub const SWEEP_COMBINATIONS_MAX: u64 = 100_000;
 /// Largest sweep work, combinations × grid points (spec).
 pub const SWEEP_WORK_MAX: f64 = 5e8;
 /// Tolerance on the last χ of a sweep range: χ_i = from + i·step is kept while ≤ to + this (spec).
 pub const CHI_RANGE_TOL: f64 = 1e-12;
-/// Largest output torque [N·m] (spec).
-pub const TORQUE_MAX_NM: f64 = 1e7;
-/// lb may be at most this multiple of r2 (spec).
-pub const LB_MAX_OVER_R2: f64 = 100.0;
 
 /// Scalar settings shared by every combination [SI].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -167,336 +161,389 @@ impl StressInput {
     /// `MISSING_FIELD`), then grid/sweep size (`GRID_TOO_FINE`, `SWEEP_TOO_LARGE`). Feasibility (`UNDERCUT`,
     /// `ELEMENT_OVERLAP`) is checked on the geometry by the caller.
     pub fn try_from_request(req: &IrefcStressRequest) -> Result<Self, CalcFailure> {
-        let mut is = Issues::new();
-        let mut warnings = Vec::new();
+        let mut v = design::validator();
         let mode = match (req.mode, req.sweep.is_some()) {
             (Some(m), _) => m,
             (None, true) => StressMode::Sweep,
             (None, false) => StressMode::Single,
         };
         if mode == StressMode::Single && req.sweep.is_some() {
-            is.push(
-                BAD_RANGE,
-                "/sweep",
-                "sweep is only allowed with mode \"sweep\"",
-            );
+            v.push("/sweep", "sweep is only allowed with mode \"sweep\"");
         }
-
-        is.range(
-            "/torque_Nm",
-            "output torque torque_Nm",
-            req.torque_nm,
-            0.0,
-            TORQUE_MAX_NM,
-        );
-        let wm = req.wheel_material.unwrap_or_default();
-        let rm = req.roller_material.unwrap_or_default();
-        wm.validate(&mut is, "/wheel_material");
-        rm.validate(&mut is, "/roller_material");
-
-        let step_deg = req.step_deg.unwrap_or(STEP_DEG_DEFAULT);
-        let mut n_intervals = 0usize;
-        if is.range_open_lo(
-            "/step_deg",
-            "grid step step_deg",
-            step_deg,
-            0.0,
-            STEP_DEG_MAX,
-        ) {
-            let n = (180.0 / step_deg).round();
-            if 180.0 / step_deg > GRID_INTERVALS_MAX {
-                is.push(
-                    GRID_TOO_FINE,
-                    "/step_deg",
-                    format!("grid step {step_deg} deg gives 180/step = {} intervals > {GRID_INTERVALS_MAX}", 180.0 / step_deg),
-                );
-            } else {
-                // 18 ≤ n ≤ 2e6 here: the conversion is exact.
-                {
-                    n_intervals = n as usize;
-                }
-            }
-        }
-        let include: StressInclude = req.include.unwrap_or_default();
-        if let Some(s) = req.curves_stride {
-            is.ensure(s >= 1, "/curves_stride", || {
-                format!("curves_stride must be >= 1, got {s}")
-            });
-        }
-        if let Some(n) = req.profile_points {
-            is.ensure(
-                (PROFILE_POINTS_MIN..=PROFILE_POINTS_MAX).contains(&n),
-                "/profile_points",
-                || format!("profile_points must be in [{PROFILE_POINTS_MIN}, {PROFILE_POINTS_MAX}], got {n}"),
-            );
-        }
-
-        let r2 = req.r2_mm.and_then(|v| check_r2(&mut is, "/r2_mm", v));
-        let rb = req.rb_mm.and_then(|v| check_rb(&mut is, "/rb_mm", v));
-        let e_star = 1.0 / (wm.compliance() + rm.compliance());
-        let refine = req.refine.unwrap_or(true);
-        let load_sharing = req.load_sharing.unwrap_or_default();
-        let subsurface = include.subsurface.unwrap_or(false);
-
+        let include = req.include.unwrap_or_default();
+        let checked = Checked {
+            req,
+            params: check_params(&mut v, req, &include),
+            include,
+            r2: req.r2_mm.and_then(|x| design::r2(&mut v, "/r2_mm", x)),
+            rb: req.rb_mm.and_then(|x| design::rb(&mut v, "/rb_mm", x)),
+        };
         match mode {
-            StressMode::Single => {
-                if req.r2_mm.is_none() {
-                    missing(&mut is, "/r2_mm", "r2_mm");
-                }
-                if req.rb_mm.is_none() {
-                    missing(&mut is, "/rb_mm", "rb_mm");
-                }
-                let z2 = match req.z2 {
-                    Some(v) => check_z2(&mut is, "/Z2", v),
-                    None => {
-                        missing(&mut is, "/Z2", "Z2 (mode \"single\")");
-                        None
-                    }
-                };
-                let chi = match req.chi {
-                    Some(v) => check_chi(&mut is, "/chi", v),
-                    None => {
-                        missing(&mut is, "/chi", "chi (mode \"single\")");
-                        None
-                    }
-                };
-                let lb = check_lb(&mut is, req.lb_mm, r2.as_slice());
-                is.finish()?;
-                let (Some(r2), Some(z2), Some(chi), Some(rb)) = (r2, z2, chi, rb) else {
-                    // Unreachable: each None recorded an issue and `finish` returned.
-                    return Err(CalcFailure::general(
-                        crate::calc::ProblemClass::InvalidInput,
-                        BAD_RANGE,
-                        "incomplete design",
-                    ));
-                };
-                let params = StressParams {
-                    torque: req.torque_nm,
-                    output_link: req.output_link.unwrap_or_default(),
-                    lb: lb.map(|v| v / MM),
-                    e_star,
-                    step_deg,
-                    n_intervals,
-                    refine,
-                    load_sharing,
-                    subsurface,
-                };
-                let curves_stride = include
-                    .curves
-                    .unwrap_or(false)
-                    .then(|| usize::try_from(req.curves_stride.unwrap_or(1)).unwrap_or(usize::MAX));
-                let profile_points = include
-                    .profiles
-                    .unwrap_or(false)
-                    .then(|| req.profile_points.unwrap_or(PROFILE_POINTS_DEFAULT));
-                Ok(Self::Single(SingleInput {
-                    design: Design {
-                        r2: r2 / MM,
-                        z2,
-                        chi,
-                        rb: rb / MM,
-                    },
-                    params,
-                    elements: include.elements.unwrap_or(true),
-                    curves_stride,
-                    profile_points,
-                }))
-            }
-            StressMode::Sweep => {
-                let Some(sw) = req.sweep.as_ref() else {
-                    missing(&mut is, "/sweep", "sweep (mode \"sweep\")");
-                    return Err(is.finish().err().unwrap_or_else(|| {
-                        CalcFailure::general(
-                            crate::calc::ProblemClass::InvalidInput,
-                            BAD_RANGE,
-                            "sweep missing",
-                        )
-                    }));
-                };
-                // Ignored, but still held to their documented ranges: a request the published
-                // schema rejects is rejected here too.
-                if let Some(v) = req.z2 {
-                    check_z2(&mut is, "/Z2", v);
-                }
-                if let Some(v) = req.chi {
-                    check_chi(&mut is, "/chi", v);
-                }
-                if req.z2.is_some() || req.chi.is_some() {
-                    warnings.push(Warning::new(
-                        "FIELD_IGNORED",
-                        "scalar Z2/chi are ignored in mode \"sweep\" (the sweep ranges are used)",
-                    ));
-                }
-                if include.elements == Some(true)
-                    || include.curves == Some(true)
-                    || include.profiles == Some(true)
-                {
-                    warnings.push(Warning::new(
-                        "FIELD_IGNORED",
-                        "include.elements/curves/profiles are forced off in mode \"sweep\"",
-                    ));
-                }
-                // Z2 range
-                let zf = check_z2(&mut is, "/sweep/Z2/from", sw.z2.from);
-                let zt = check_z2(&mut is, "/sweep/Z2/to", sw.z2.to);
-                let mut z2s = Vec::new();
-                if let (Some(a), Some(b)) = (zf, zt) {
-                    if a > b {
-                        is.push(
-                            BAD_RANGE,
-                            "/sweep/Z2/to",
-                            format!("Z2.to = {b} must be >= Z2.from = {a}"),
-                        );
-                    } else {
-                        z2s = (a..=b).collect();
-                    }
-                }
-                // chi range
-                let cf = check_chi(&mut is, "/sweep/chi/from", sw.chi.from);
-                let ct = check_chi(&mut is, "/sweep/chi/to", sw.chi.to);
-                let step_ok = sw.chi.step.is_finite() && sw.chi.step > 0.0;
-                if !step_ok {
-                    is.push(
-                        BAD_RANGE,
-                        "/sweep/chi/step",
-                        format!("chi.step must be a finite number > 0, got {}", sw.chi.step),
-                    );
-                }
-                let mut chis = Vec::new();
-                let mut chi_too_many = false;
-                if let (Some(a), Some(b), true) = (cf, ct, step_ok) {
-                    if a > b {
-                        is.push(
-                            BAD_RANGE,
-                            "/sweep/chi/to",
-                            format!("chi.to = {b} must be >= chi.from = {a}"),
-                        );
-                    } else if let Some(v) = chi_values(a, b, sw.chi.step, SWEEP_COMBINATIONS_MAX) {
-                        chis = v;
-                    } else {
-                        chi_too_many = true;
-                    }
-                }
-                // rb, r2 lists
-                let rbs: Vec<f64> = match &sw.rb_mm {
-                    Some(list) => {
-                        if list.is_empty() {
-                            is.push(BAD_RANGE, "/sweep/rb_mm", "rb_mm list must not be empty");
-                        }
-                        list.iter()
-                            .enumerate()
-                            .filter_map(|(i, &v)| {
-                                check_rb(&mut is, &format!("/sweep/rb_mm/{i}"), v)
-                            })
-                            .collect()
-                    }
-                    None => {
-                        if req.rb_mm.is_none() {
-                            missing(&mut is, "/rb_mm", "rb_mm (or sweep.rb_mm)");
-                        }
-                        rb.into_iter().collect()
-                    }
-                };
-                let r2s: Vec<f64> = match &sw.r2_mm {
-                    Some(list) => {
-                        if list.is_empty() {
-                            is.push(BAD_RANGE, "/sweep/r2_mm", "r2_mm list must not be empty");
-                        }
-                        list.iter()
-                            .enumerate()
-                            .filter_map(|(i, &v)| {
-                                check_r2(&mut is, &format!("/sweep/r2_mm/{i}"), v)
-                            })
-                            .collect()
-                    }
-                    None => {
-                        if req.r2_mm.is_none() {
-                            missing(&mut is, "/r2_mm", "r2_mm (or sweep.r2_mm)");
-                        }
-                        r2.into_iter().collect()
-                    }
-                };
-                let lb = check_lb(&mut is, req.lb_mm, &r2s);
-                if !is.is_empty() {
-                    is.finish()?;
-                }
-                // Sizes (only once the ranges are valid).
-                let combos = (z2s.len() as u64)
-                    .saturating_mul(chis.len() as u64)
-                    .saturating_mul(rbs.len() as u64)
-                    .saturating_mul(r2s.len() as u64);
-                if chi_too_many || combos > SWEEP_COMBINATIONS_MAX {
-                    is.push(
-                        SWEEP_TOO_LARGE,
-                        "/sweep",
-                        format!(
-                            "the sweep has {} combinations > {SWEEP_COMBINATIONS_MAX}",
-                            if chi_too_many {
-                                "more than 100000".to_owned()
-                            } else {
-                                combos.to_string()
-                            }
-                        ),
-                    );
-                } else {
-                    // combos ≤ 1e5, n_intervals ≤ 2e6: both exact in f64.
-                    let work = combos as f64 * (n_intervals as f64 + 1.0);
-                    if work > SWEEP_WORK_MAX {
-                        is.push(
-                            SWEEP_TOO_LARGE,
-                            "/sweep",
-                            format!(
-                                "combinations x grid points = {combos} x {} = {work} > {SWEEP_WORK_MAX}; use a coarser step_deg",
-                                n_intervals + 1
-                            ),
-                        );
-                    }
-                }
-                is.finish()?;
-                let params = StressParams {
-                    torque: req.torque_nm,
-                    output_link: req.output_link.unwrap_or_default(),
-                    lb: lb.map(|v| v / MM),
-                    e_star,
-                    step_deg,
-                    n_intervals,
-                    refine,
-                    load_sharing,
-                    subsurface,
-                };
-                Ok(Self::Sweep(SweepInput {
-                    z2: z2s,
-                    chi: chis,
-                    rb: rbs.into_iter().map(|v| v / MM).collect(),
-                    r2: r2s.into_iter().map(|v| v / MM).collect(),
-                    params,
-                    warnings,
-                }))
-            }
+            StressMode::Single => single(checked, v).map(Self::Single),
+            StressMode::Sweep => sweep(checked, v).map(Self::Sweep),
         }
     }
 }
 
-/// Validate lb [mm] against 0 < lb ≤ 100·r2 for every r2 given; returns it when valid.
-fn check_lb(is: &mut Issues, lb: Option<f64>, r2s_mm: &[f64]) -> Option<f64> {
-    let v = lb?;
-    let r2_min = r2s_mm.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = if r2_min.is_finite() {
-        LB_MAX_OVER_R2 * r2_min
-    } else {
-        f64::INFINITY
+/// A request with the fields both modes share checked (their problems are in the validator).
+struct Checked<'a> {
+    req: &'a IrefcStressRequest,
+    include: StressInclude,
+    /// The shared settings (`lb` is checked per mode, against the r2 values).
+    params: StressParams,
+    /// Top-level r2 (mm) when given and valid.
+    r2: Option<f64>,
+    /// Top-level rb (mm) when given and valid.
+    rb: Option<f64>,
+}
+
+/// The settings shared by every design (`lb` is checked per mode, against the r2 values).
+fn check_params(
+    v: &mut Validator,
+    req: &IrefcStressRequest,
+    include: &StressInclude,
+) -> StressParams {
+    v.range(
+        "/torque_Nm",
+        "output torque torque_Nm",
+        req.torque_nm,
+        TORQUE_NM,
+    );
+    let wm = req.wheel_material.unwrap_or_default();
+    let rm = req.roller_material.unwrap_or_default();
+    design::material(v, "/wheel_material", &wm);
+    design::material(v, "/roller_material", &rm);
+    let step_deg = req.step_deg.unwrap_or(STEP_DEG_DEFAULT);
+    let n_intervals = grid_intervals(v, step_deg).unwrap_or(0);
+    let counts = [
+        (
+            "/curves_stride",
+            "curves_stride",
+            req.curves_stride,
+            CURVES_STRIDE,
+        ),
+        (
+            "/profile_points",
+            "profile_points",
+            req.profile_points,
+            PROFILE_POINTS,
+        ),
+    ];
+    for (pointer, name, n, range) in counts {
+        if let Some(n) = n {
+            v.range(pointer, name, f64::from(n), range);
+        }
+    }
+    StressParams {
+        torque: req.torque_nm,
+        output_link: req.output_link.unwrap_or_default(),
+        lb: None,
+        e_star: 1.0 / (wm.compliance() + rm.compliance()),
+        step_deg,
+        n_intervals,
+        refine: req.refine.unwrap_or(true),
+        load_sharing: req.load_sharing.unwrap_or_default(),
+        subsurface: include.subsurface.unwrap_or(false),
+    }
+}
+
+/// Grid intervals N = round(180/step) of a valid step: `BAD_RANGE` outside
+/// [`STEP_DEG_BUILDABLE`], `GRID_TOO_FINE` below [`STEP_DEG`].
+fn grid_intervals(v: &mut Validator, step_deg: f64) -> Option<usize> {
+    if !v.range(
+        "/step_deg",
+        "grid step step_deg",
+        step_deg,
+        STEP_DEG_BUILDABLE,
+    ) {
+        return None;
+    }
+    if !STEP_DEG.contains(step_deg) {
+        v.push_code(
+            GRID_TOO_FINE,
+            "/step_deg",
+            format!(
+                "grid step {step_deg} deg gives 180/step = {} intervals > {GRID_INTERVALS_MAX}",
+                180.0 / step_deg
+            ),
+        );
+        return None;
+    }
+    // 18 ≤ N ≤ 2e6 here: the conversion is exact.
+    Some((180.0 / step_deg).round() as usize)
+}
+
+/// The validated single design (the shared checks are already in `v`).
+fn single(checked: Checked<'_>, mut v: Validator) -> Result<SingleInput, CalcFailure> {
+    let Checked {
+        req,
+        include,
+        mut params,
+        r2,
+        rb,
+    } = checked;
+    for (pointer, name, given) in [
+        ("/r2_mm", "r2_mm", req.r2_mm.is_some()),
+        ("/rb_mm", "rb_mm", req.rb_mm.is_some()),
+    ] {
+        if !given {
+            design::missing(&mut v, pointer, name);
+        }
+    }
+    let z2 = required(&mut v, req.z2, "/Z2", "Z2 (mode \"single\")", design::z2);
+    let chi = required(
+        &mut v,
+        req.chi,
+        "/chi",
+        "chi (mode \"single\")",
+        design::chi,
+    );
+    params.lb = check_lb(&mut v, req.lb_mm, r2.as_slice()).map(|x| x / MM);
+    v.finish()?;
+    let (Some(r2), Some(z2), Some(chi), Some(rb)) = (r2, z2, chi, rb) else {
+        return Err(unreachable_incomplete());
     };
-    let ok = v.is_finite() && v > 0.0 && v <= hi;
-    if !ok {
-        is.push(
-            BAD_RANGE,
-            "/lb_mm",
-            if hi.is_finite() {
-                format!("contact length lb_mm must be in (0, 100*r2 = {hi}], got {v}")
-            } else {
-                format!("contact length lb_mm must be in (0, 100*r2], got {v}")
-            },
+    let curves_stride = include
+        .curves
+        .unwrap_or(false)
+        .then(|| usize::try_from(req.curves_stride.unwrap_or(1)).unwrap_or(usize::MAX));
+    let profile_points = include
+        .profiles
+        .unwrap_or(false)
+        .then(|| req.profile_points.unwrap_or(PROFILE_POINTS_DEFAULT));
+    Ok(SingleInput {
+        design: Design {
+            r2: r2 / MM,
+            z2,
+            chi,
+            rb: rb / MM,
+        },
+        params,
+        elements: include.elements.unwrap_or(true),
+        curves_stride,
+        profile_points,
+    })
+}
+
+/// The validated structured array (the shared checks are already in `v`).
+fn sweep(checked: Checked<'_>, mut v: Validator) -> Result<SweepInput, CalcFailure> {
+    let Checked {
+        req,
+        include,
+        mut params,
+        r2,
+        rb,
+    } = checked;
+    let Some(sw) = req.sweep.as_ref() else {
+        design::missing(&mut v, "/sweep", "sweep (mode \"sweep\")");
+        v.finish()?;
+        return Err(unreachable_incomplete());
+    };
+    // Ignored, but still held to their documented ranges: a request the published
+    // schema rejects is rejected here too.
+    if let Some(x) = req.z2 {
+        design::z2(&mut v, "/Z2", x);
+    }
+    if let Some(x) = req.chi {
+        design::chi(&mut v, "/chi", x);
+    }
+    let warnings = ignored_fields(req, &include);
+    let z2s = z2_values(&mut v, &sw.z2);
+    let chis = chi_sweep(&mut v, &sw.chi);
+    let rbs = sweep_list(
+        &mut v,
+        "rb_mm",
+        sw.rb_mm.as_deref(),
+        req.rb_mm,
+        rb,
+        design::rb,
+    );
+    let r2s = sweep_list(
+        &mut v,
+        "r2_mm",
+        sw.r2_mm.as_deref(),
+        req.r2_mm,
+        r2,
+        design::r2,
+    );
+    params.lb = check_lb(&mut v, req.lb_mm, &r2s).map(|x| x / MM);
+    v.checkpoint()?;
+    // Sizes (only once the ranges are valid).
+    check_size(
+        &mut v,
+        &z2s,
+        chis.as_deref(),
+        rbs.len().saturating_mul(r2s.len()),
+        params.n_intervals,
+    );
+    v.finish()?;
+    Ok(SweepInput {
+        z2: z2s,
+        chi: chis.unwrap_or_default(),
+        rb: rbs.into_iter().map(|x| x / MM).collect(),
+        r2: r2s.into_iter().map(|x| x / MM).collect(),
+        params,
+        warnings,
+    })
+}
+
+/// A required field: checked when given, else `MISSING_FIELD`.
+fn required<T, U>(
+    v: &mut Validator,
+    value: Option<T>,
+    pointer: &str,
+    what: &str,
+    check: fn(&mut Validator, &str, T) -> Option<U>,
+) -> Option<U> {
+    match value {
+        Some(x) => check(v, pointer, x),
+        None => {
+            design::missing(v, pointer, what);
+            None
+        }
+    }
+}
+
+/// The failure of a design that validation left incomplete (cannot happen: every missing value
+/// recorded a problem and `finish` returned it).
+fn unreachable_incomplete() -> CalcFailure {
+    CalcFailure::general(ProblemClass::InvalidInput, BAD_RANGE, "incomplete design")
+}
+
+/// `FIELD_IGNORED` warnings for the single-design fields of a sweep request.
+fn ignored_fields(req: &IrefcStressRequest, include: &StressInclude) -> Vec<Warning> {
+    let mut warnings = Vec::new();
+    if req.z2.is_some() || req.chi.is_some() {
+        warnings.push(Warning::new(
+            "FIELD_IGNORED",
+            "scalar Z2/chi are ignored in mode \"sweep\" (the sweep ranges are used)",
+        ));
+    }
+    if [include.elements, include.curves, include.profiles].contains(&Some(true)) {
+        warnings.push(Warning::new(
+            "FIELD_IGNORED",
+            "include.elements/curves/profiles are forced off in mode \"sweep\"",
+        ));
+    }
+    warnings
+}
+
+/// Z2 values of the sweep, ascending (empty when the range is invalid).
+fn z2_values(v: &mut Validator, r: &IntRange) -> Vec<u32> {
+    let from = design::z2(v, "/sweep/Z2/from", r.from);
+    let to = design::z2(v, "/sweep/Z2/to", r.to);
+    match (from, to) {
+        (Some(a), Some(b)) if a > b => {
+            v.push(
+                "/sweep/Z2/to",
+                format!("Z2.to = {b} must be >= Z2.from = {a}"),
+            );
+            Vec::new()
+        }
+        (Some(a), Some(b)) => (a..=b).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// χ values of the sweep (empty when the range is invalid); `None` when there would be more
+/// than [`SWEEP_COMBINATIONS_MAX`] of them.
+fn chi_sweep(v: &mut Validator, r: &StepRange) -> Option<Vec<f64>> {
+    let from = design::chi(v, "/sweep/chi/from", r.from);
+    let to = design::chi(v, "/sweep/chi/to", r.to);
+    let step_ok = v.range("/sweep/chi/step", "chi.step", r.step, CHI_STEP);
+    match (from, to, step_ok) {
+        (Some(a), Some(b), true) if a > b => {
+            v.push(
+                "/sweep/chi/to",
+                format!("chi.to = {b} must be >= chi.from = {a}"),
+            );
+            Some(Vec::new())
+        }
+        (Some(a), Some(b), true) => chi_values(a, b, r.step, SWEEP_COMBINATIONS_MAX),
+        _ => Some(Vec::new()),
+    }
+}
+
+/// The valid values of a sweep list `sweep.<name>` (mm) (each item checked), or without the
+/// list the top-level `<name>` (`top`, already checked; required then).
+fn sweep_list(
+    v: &mut Validator,
+    name: &str,
+    list: Option<&[f64]>,
+    top_given: Option<f64>,
+    top: Option<f64>,
+    check: fn(&mut Validator, &str, f64) -> Option<f64>,
+) -> Vec<f64> {
+    let Some(list) = list else {
+        if top_given.is_none() {
+            design::missing(v, &format!("/{name}"), &format!("{name} (or sweep.{name})"));
+        }
+        return top.into_iter().collect();
+    };
+    if list.is_empty() {
+        v.push(
+            format!("/sweep/{name}"),
+            format!("{name} list must not be empty"),
         );
     }
-    ok.then_some(v)
+    list.iter()
+        .enumerate()
+        .filter_map(|(i, &x)| check(v, &format!("/sweep/{name}/{i}"), x))
+        .collect()
+}
+
+/// `SWEEP_TOO_LARGE` when the sweep has more than [`SWEEP_COMBINATIONS_MAX`] combinations
+/// (`chis` is `None`: more χ values than that alone) or more than [`SWEEP_WORK_MAX`] grid points.
+fn check_size(
+    v: &mut Validator,
+    z2s: &[u32],
+    chis: Option<&[f64]>,
+    n_lists: usize,
+    n_intervals: usize,
+) {
+    let Some(chis) = chis else {
+        v.push_code(
+            SWEEP_TOO_LARGE,
+            "/sweep",
+            format!("the sweep has more than 100000 combinations > {SWEEP_COMBINATIONS_MAX}"),
+        );
+        return;
+    };
+    let combos = (z2s.len() as u64)
+        .saturating_mul(chis.len() as u64)
+        .saturating_mul(n_lists as u64);
+    if combos > SWEEP_COMBINATIONS_MAX {
+        v.push_code(
+            SWEEP_TOO_LARGE,
+            "/sweep",
+            format!("the sweep has {combos} combinations > {SWEEP_COMBINATIONS_MAX}"),
+        );
+        return;
+    }
+    // combos ≤ 1e5, n_intervals ≤ 2e6: both exact in f64.
+    let work = combos as f64 * (n_intervals as f64 + 1.0);
+    if work > SWEEP_WORK_MAX {
+        v.push_code(
+            SWEEP_TOO_LARGE,
+            "/sweep",
+            format!(
+                "combinations x grid points = {combos} x {} = {work} > {SWEEP_WORK_MAX}; use a coarser step_deg",
+                n_intervals + 1
+            ),
+        );
+    }
+}
+
+/// Validate lb (mm) against 0 < lb ≤ 100·r2 for every r2 given ([`LB_MM`], the upper end a
+/// cross-field rule); returns it when valid.
+fn check_lb(v: &mut Validator, lb: Option<f64>, r2s_mm: &[f64]) -> Option<f64> {
+    let x = lb?;
+    let r2_min = r2s_mm.iter().copied().fold(f64::INFINITY, f64::min);
+    let range: Range = if r2_min.is_finite() {
+        LB_MM.max(LB_MAX_OVER_R2 * r2_min)
+    } else {
+        LB_MM
+    };
+    v.range("/lb_mm", "contact length lb_mm", x, range)
+        .then_some(x)
 }

@@ -4,7 +4,9 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::calc::Range;
-use crate::calc::irefc::wire::{GeometryOut, Material, Warning};
+use crate::calc::irefc::wire::{
+    CHI, GeometryOut, Material, PROFILE_POINTS_MAX, PROFILE_POINTS_MIN, R2_MM, RB_MM, Warning, Z2,
+};
 use crate::numerics::SolverReport;
 
 /// Single design or the paper's "structured array" sweep.
@@ -154,8 +156,9 @@ pub struct IrefcStressRequest {
     /// Rolling element material; default steel {210000, 0.3}.
     #[schema(nullable = false)]
     pub roller_material: Option<Material>,
-    /// φ2 grid step over [0°, 180°] [deg]; 0 < step ≤ 10 and 180/step ≤ 2·10⁶. Default 1 with refine
-    /// (see the module docs; the paper used 0.02 without refinement).
+    /// φ2 grid step over [0°, 180°] [deg]; 0 < step ≤ 10 and 180/step ≤ 2·10⁶ (a finer step than
+    /// 9e-5 is `GRID_TOO_FINE`). Default 1 with refine (see the module docs; the paper used 0.02
+    /// without refinement).
     #[schema(example = 1.0)]
     pub step_deg: Option<f64>,
     /// Polish each grid maximum with a bounded Brent search to |Δφ2| ≤ 1e-10 rad (default true).
@@ -447,27 +450,54 @@ pub enum IrefcStressResponse {
     Sweep(StressSweepResponse),
 }
 
+/// Output torque T_out [N·m]: 0 ≤ T ≤ 1e7 (spec).
+pub const TORQUE_NM: Range = Range::closed(0.0, 1e7);
+/// lb may be at most this multiple of r2 (spec).
+pub const LB_MAX_OVER_R2: f64 = 100.0;
+/// Contact length lb [mm]: > 0; the upper end [`LB_MAX_OVER_R2`]·r2 depends on r2 (a cross-field
+/// rule, stated in the field's doc).
+pub const LB_MM: Range = Range::FINITE.gt(0.0);
+/// Largest number of φ2 grid intervals 180/step (spec: 180/step ≤ 2·10⁶).
+pub const GRID_INTERVALS_MAX: f64 = 2e6;
+/// Grid steps a φ2 grid can be built from [deg]: 0 < step ≤ 10 (spec; `BAD_RANGE` outside).
+pub const STEP_DEG_BUILDABLE: Range = Range::FINITE.gt(0.0).max(10.0);
+/// The documented φ2 grid step [deg]: 180/step ≤ 2·10⁶ (step ≥ 9e-5) and step ≤ 10. A positive
+/// step below the lower end is `GRID_TOO_FINE` (a size limit), outside [`STEP_DEG_BUILDABLE`]
+/// `BAD_RANGE`. (Division is correctly rounded and monotone, so `step ≥ 180/2e6` is exactly
+/// `180/step ≤ 2e6`.)
+pub const STEP_DEG: Range = STEP_DEG_BUILDABLE.min(180.0 / GRID_INTERVALS_MAX);
+/// Sweep χ step [–]: > 0.
+pub const CHI_STEP: Range = Range::FINITE.gt(0.0);
+/// Stride of the curve points [–]: ≥ 1.
+pub const CURVES_STRIDE: Range = Range::INTEGER.min(1.0);
+/// Profile points per wheel [–].
+pub const PROFILE_POINTS: Range = Range::int(PROFILE_POINTS_MIN as i64, PROFILE_POINTS_MAX as i64);
+
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
 crate::schema_bounds! {
     IntRange {
-        from: Range::INTEGER.min(3.0).max(1000.0),
-        to: Range::INTEGER.min(3.0).max(1000.0),
+        from: Z2,
+        to: Z2,
     },
     StepRange {
-        from: Range::FINITE.gt(1.0).max(5.0),
-        to: Range::FINITE.gt(1.0).max(5.0),
-        step: Range::FINITE.gt(0.0),
+        from: CHI,
+        to: CHI,
+        step: CHI_STEP,
+    },
+    SweepSpec {
+        rb_mm @items: RB_MM,
+        r2_mm @items: R2_MM,
     },
     IrefcStressRequest {
-        r2_mm: Range::FINITE.gt(0.0).max(10000.0),
-        z2 as "Z2": Range::INTEGER.min(3.0).max(1000.0),
-        chi: Range::FINITE.gt(1.0).max(5.0),
-        rb_mm: Range::FINITE.gt(0.0),
-        torque_nm as "torque_Nm": Range::FINITE.min(0.0).max(1e7),
-        lb_mm: Range::FINITE.gt(0.0),
-        step_deg: Range::FINITE.gt(0.0).max(10.0),
-        curves_stride: Range::INTEGER.min(1.0),
-        profile_points: Range::INTEGER.min(8.0).max(100000.0),
+        r2_mm: R2_MM,
+        z2 as "Z2": Z2,
+        chi: CHI,
+        rb_mm: RB_MM,
+        torque_nm as "torque_Nm": TORQUE_NM,
+        lb_mm: LB_MM,
+        step_deg: STEP_DEG,
+        curves_stride: CURVES_STRIDE,
+        profile_points: PROFILE_POINTS,
     },
 }
