@@ -95,6 +95,8 @@ pub struct BusFuelEconomyInput {
     pub motors: Vec<MotorInput>,
     /// Options.
     pub options: Options,
+    /// The block of motor × cycle pairs to simulate (all when `None`).
+    pub shard: Option<crate::calc::common::Shard>,
 }
 
 /// `lo < x ≤ hi`.
@@ -948,6 +950,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
 
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
+        let shard = crate::calc::common::shard(&mut v, req.shard);
         let veh = vehicle(&mut v, &req.vehicle);
         v.in_range(
             "/inverter/efficiency",
@@ -1126,6 +1129,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
                 hist_bins: (o.op_histogram.speed_bin_rpm, o.op_histogram.torque_bin_nm),
                 weights,
             },
+            shard,
         })
     }
 }
