@@ -54,7 +54,7 @@ fn pick(parts: &[StressSweepResponse], worst: bool) -> Option<usize> {
     for p in parts {
         let i = if worst { p.worst } else { p.best };
         let Some(i) = i else { continue };
-        let start = p.shard.map_or(0, |s| s.start as usize);
+        let start = p.shard.as_deref().map_or(0, |s| s.start as usize);
         let s = p.records[i - start]
             .sigma_max_mpa
             .expect("a picked record is valid");
@@ -84,7 +84,10 @@ fn irefc_sweep_shards_merge_into_the_whole_sweep() {
         let mut records = Vec::new();
         let mut next = 0u64;
         for (i, p) in parts.iter().enumerate() {
-            let s = p.shard.expect("a sharded answer says which shard it is");
+            let s = *p
+                .shard
+                .as_deref()
+                .expect("a sharded answer says which shard it is");
             assert_eq!((s.index, s.count, s.total), (i as u32, count, n as u64));
             assert_eq!(s.start, next, "blocks are contiguous in index order");
             assert_eq!(s.end - s.start, p.records.len() as u64);

@@ -377,8 +377,13 @@ pub fn compute(
             }
             _ => None,
         };
-        for ci in (mine.start - mi * n_c)..(mine.end - mi * n_c) {
-            let c = &input.cycles[ci];
+        let cycles_of_shard = input
+            .cycles
+            .iter()
+            .enumerate()
+            .take(mine.end - mi * n_c)
+            .skip(mine.start - mi * n_c);
+        for (ci, c) in cycles_of_shard {
             let mut ev = match (&ipmsm_map, &m.kind) {
                 (Some(map), MotorKind::Ipmsm(im)) => MotorEvaluator::IpmsmMap {
                     map,

@@ -344,8 +344,9 @@ fn map_wire(id: &str, m: MapData) -> MotorMapData {
 /// Points of a motor's map on `grid` (speed × torque axes), saturated.
 fn map_points(m: &motor::MotorInput, grid: (f64, f64)) -> u64 {
     let points = motor::grid_size(m.n_max_rpm, compute::t_top(m), grid.0, grid.1);
-    // Validated steps give a finite count; the cast saturates absurd ones.
-    points.max(0.0) as u64
+    // Validated steps give a finite count; a larger map is refused by the computation with
+    // its own code (MAP_TOO_LARGE), so the estimate stops at its limit.
+    points.clamp(0.0, compute::MAX_MAP_POINTS) as u64
 }
 
 /// Bytes of one result's scalar fields, names and warnings at most.
@@ -374,9 +375,7 @@ pub fn response_size(input: &BusFuelEconomyInput) -> ResponseSize {
             for m in &input.motors {
                 let speed_bins = (rpm / o.hist_bins.0).floor() + 2.0;
                 let torque_bins = 2.0 * (compute::t_top(m) / o.hist_bins.1).ceil() + 3.0;
-                let bins = (speed_bins * torque_bins)
-                    .min(compute::MAX_HIST_BINS)
-                    .max(0.0) as u64;
+                let bins = (speed_bins * torque_bins).clamp(0.0, compute::MAX_HIST_BINS) as u64;
                 size = size.numbers("/options/op_histogram", bins + 64);
             }
         }
@@ -435,7 +434,7 @@ pub fn merged_comparison(results: &[CycleResult], weights: &[f64]) -> Option<Com
         .iter()
         .take_while(|r| r.motor == first.motor)
         .count();
-    if n_c == 0 || results.len() % n_c != 0 || weights.len() != n_c {
+    if n_c == 0 || !results.len().is_multiple_of(n_c) || weights.len() != n_c {
         return None;
     }
     let n_m = results.len() / n_c;

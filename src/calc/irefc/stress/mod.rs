@@ -58,7 +58,7 @@ pub fn run_stress(
             let shard = shard.unwrap_or(Shard::WHOLE);
             sweep_size(&s, shard).check(budget)?;
             let mut r = run_sweep(&s, shard.range(s.len()), budget);
-            r.shard = req.shard.map(|_| shard.out(s.len()));
+            r.shard = req.shard.map(|_| Box::new(shard.out(s.len())));
             Ok(IrefcStressResponse::Sweep(r))
         }
     }

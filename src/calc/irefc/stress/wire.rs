@@ -441,7 +441,7 @@ pub struct StressSweepResponse {
     /// and `meta.n_combinations` added; `best`/`worst` as stated there.
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
-    pub shard: Option<ShardOut>,
+    pub shard: Option<Box<ShardOut>>,
     /// Valid records.
     pub n_valid: u64,
     /// Invalid records (infeasible, non-finite or not evaluated).
