@@ -31,6 +31,7 @@ pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validato
 pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         crate::numerics::budget::schema_bounds(),
+        common::schema_bounds(),
         bezier_motion::wire::schema_bounds(),
         bus_fuel_economy::wire::schema_bounds(),
         bus_fuel_economy::wire::variant_bounds(),

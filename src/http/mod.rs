@@ -257,8 +257,9 @@ fn json_response(body: Vec<u8>) -> Response {
 ///
 /// `demand` is the request's time limit (`Option<Duration>`) or a [`pool::Demand`] that also
 /// carries the module's cost estimate. An answer larger than `--max-response-bytes` is refused
-/// with a 422 (`/problems/too-large`); modules that can tell the size before computing refuse
-/// earlier, naming the option to change.
+/// with a 422 (`/problems/too-large`) after encoding, as a backstop; modules that can tell the
+/// size before computing refuse earlier, naming the option to change (the limit reaches them in
+/// the [`Budget`], see [`crate::calc::common::ResponseSize`]).
 pub async fn run_calc<T, F>(
     state: &AppState,
     demand: impl Into<pool::Demand>,
@@ -282,6 +283,8 @@ where
         .pool
         .run(demand, move |budget| {
             let started = std::time::Instant::now();
+            // The limit reaches the module, which refuses an oversized answer before computing.
+            let budget = &budget.clone().with_max_response_bytes(max_bytes);
             let out = job(budget).map_err(ApiError::from)?;
             // The module accepted the request: documented bounds it did not check (fields its
             // mode ignores) still make it invalid.

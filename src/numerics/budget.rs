@@ -25,6 +25,7 @@ pub struct Budget {
     threads: usize,
     cancel: Option<Arc<AtomicBool>>,
     progress: Option<Arc<ProgressSink>>,
+    max_response_bytes: Option<u64>,
 }
 
 impl std::fmt::Debug for Budget {
@@ -35,6 +36,7 @@ impl std::fmt::Debug for Budget {
             .field("threads", &self.threads)
             .field("cancelled", &self.cancelled())
             .field("progress", &self.progress.is_some())
+            .field("max_response_bytes", &self.max_response_bytes)
             .finish()
     }
 }
@@ -98,6 +100,7 @@ impl Budget {
             threads: default_threads(),
             cancel: None,
             progress: None,
+            max_response_bytes: None,
         }
     }
 
@@ -185,6 +188,21 @@ impl Budget {
     pub fn with_cancel_flag(mut self, flag: Arc<AtomicBool>) -> Self {
         self.cancel = Some(flag);
         self
+    }
+
+    /// The same budget, with the service's limit on the size of the answer [bytes]: modules
+    /// that can estimate their answer's size refuse a request over it before computing
+    /// ([`crate::calc::common::ResponseSize::check`]).
+    #[must_use]
+    pub fn with_max_response_bytes(mut self, bytes: usize) -> Self {
+        self.max_response_bytes = Some(u64::try_from(bytes).unwrap_or(u64::MAX));
+        self
+    }
+
+    /// The limit on the size of the answer [bytes], if the service sets one.
+    #[must_use]
+    pub fn max_response_bytes(&self) -> Option<u64> {
+        self.max_response_bytes
     }
 
     /// Threads this job may use for its parallel parts (at least 1).

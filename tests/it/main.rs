@@ -39,3 +39,5 @@ mod paper_spatial_coupling;
 mod paper_vibration_absorber;
 mod pictures;
 mod progress_stream;
+mod response_size;
+mod sharding;

@@ -58,6 +58,7 @@ use crate::numerics::Budget;
 /// A [`CalcFailure`] (HTTP 422) for invalid input or a request beyond the method's limits.
 pub fn run(req: BezierMotionRequest, budget: &Budget) -> Result<BezierMotionResponse, CalcFailure> {
     let input = BezierInput::try_from(req)?;
+    output::response_size(&input).check(budget)?;
     let out = compute(&input, budget)?;
     Ok(output::respond(&input, &out, budget))
 }

@@ -11,7 +11,29 @@ use super::wire::{
     BezierMotionResponse, EndState, HistoryOut, KinematicsOut, LawOut, MethodOut, ObjectiveIn,
     OptimizerOut, ReferenceOut, ResidualOut, SensitivityRow, SystemOut,
 };
+use crate::calc::common::ResponseSize;
 use crate::numerics::{Budget, SolverReport, StopReason};
+
+/// Upper estimate of the answer's size from the validated request (checked before computing):
+/// fixed fields and the law's polygons (8 arrays of at most 2m + p + 2 ordinates), the time
+/// history (10 series per sample) and the sensitivity rows (5 numbers and their names each).
+#[must_use]
+pub fn response_size(input: &BezierInput) -> ResponseSize {
+    let ordinates = (2 * input.m + input.p + 2) as u64;
+    let mut size = ResponseSize::fixed(16 * 1024 + 8 * 25 * ordinates);
+    if let Some(h) = &input.history {
+        size = size
+            .numbers("/outputs/time_history/n_samples", 10 * h.n_samples as u64)
+            .numbers("/outputs/time_history/n_after", 10 * h.n_after as u64);
+    }
+    if let Some(f) = &input.sensitivity {
+        size = size.bytes(
+            "/outputs/sensitivity/stiffness_factors",
+            f.len() as u64 * (5 * 25 + 100),
+        );
+    }
+    size
+}
 
 /// Builds the response.
 #[must_use]

@@ -13,6 +13,7 @@ use super::motor::{
 };
 use super::sim::{SimOutcome, SimSettings, simulate};
 use super::wire::MotorEval;
+use crate::calc::common::Shard;
 use crate::numerics::Budget;
 
 /// Most points of one motor map (keeps map building within ~1 s and the response bounded).
@@ -100,8 +101,9 @@ pub struct BusFuelEconomyOutput {
     pub results: Vec<RunResult>,
     /// Motor warnings (conversion, map fallbacks), per motor.
     pub motor_warnings: Vec<Vec<String>>,
-    /// Efficiency maps per motor (if requested).
-    pub maps: Option<Vec<MapData>>,
+    /// Efficiency maps (if requested) with their motor's index: every motor, or with a shard
+    /// the motors whose first cycle is in the shard's block.
+    pub maps: Option<Vec<(usize, MapData)>>,
     /// Comparison (≥ 2 motors).
     pub comparison: Option<ComparisonData>,
     /// Intervals simulated.
@@ -131,7 +133,7 @@ fn reachable_limit(m: &Ipmsm, w_hi: f64) -> f64 {
 }
 
 /// Largest envelope torque of a motor (top of the map torque axis).
-fn t_top(m: &MotorInput) -> f64 {
+pub(crate) fn t_top(m: &MotorInput) -> f64 {
     match &m.kind {
         MotorKind::Constant { envelope, .. } | MotorKind::Map { envelope, .. } => envelope.peak(),
         MotorKind::Ipmsm(im) => im.t_max(0.0),
@@ -292,14 +294,21 @@ fn histogram(
     })
 }
 
-/// Run every motor over every cycle.
+/// Run every motor over every cycle (with `input.shard`: only the shard's block of the
+/// motor × cycle pairs, motor-major; the comparison, which needs every pair, is then omitted).
 ///
 /// # Errors
-/// Deadline, unreachable speed of an ipmsm, oversized map or histogram.
+/// Deadline, unreachable speed of an ipmsm (checked for every motor, also in a shard),
+/// oversized map or histogram.
 pub fn compute(
     input: &BusFuelEconomyInput,
     budget: &Budget,
 ) -> Result<BusFuelEconomyOutput, BusFuelEconomyError> {
+    let n_c = input.cycles.len();
+    let pairs = input
+        .shard
+        .unwrap_or(Shard::WHOLE)
+        .range(input.motors.len() * n_c);
     let o = &input.options;
     let intervals: Vec<Vec<_>> = input
         .cycles
@@ -337,6 +346,11 @@ pub fn compute(
                 }
             }
         }
+        let mine = (mi * n_c).max(pairs.start)..((mi + 1) * n_c).min(pairs.end);
+        if mine.is_empty() {
+            motor_warnings.push(warnings);
+            continue;
+        }
         let ipmsm_map: Option<IpmsmMap> = match (&m.kind, o.motor_eval) {
             (MotorKind::Ipmsm(im), MotorEval::LossMap) => {
                 let points = grid_size(m.n_max_rpm, im.t_max(0.0), o.grid.0, o.grid.1);
@@ -363,7 +377,13 @@ pub fn compute(
             }
             _ => None,
         };
-        for (ci, c) in input.cycles.iter().enumerate() {
+        let cycles_of_shard = input
+            .cycles
+            .iter()
+            .enumerate()
+            .take(mine.end - mi * n_c)
+            .skip(mine.start - mi * n_c);
+        for (ci, c) in cycles_of_shard {
             let mut ev = match (&ipmsm_map, &m.kind) {
                 (Some(map), MotorKind::Ipmsm(im)) => MotorEvaluator::IpmsmMap {
                     map,
@@ -389,15 +409,22 @@ pub fn compute(
             };
             results.push(run_result(mi, ci, c, sim, histogram));
         }
-        if let Some(maps) = maps.as_mut() {
+        if let Some(maps) = maps.as_mut().filter(|_| pairs.contains(&(mi * n_c))) {
             let md = motor_map(m, o.grid, false, budget)?;
             n_eval += md.evaluations;
-            maps.push(md);
+            maps.push((mi, md));
         }
         motor_warnings.push(warnings);
     }
-    let comparison = (input.motors.len() >= 2)
-        .then(|| compare(&results, input.motors.len(), input.cycles.len(), &o.weights));
+    let comparison = (input.motors.len() >= 2 && input.shard.is_none()).then(|| {
+        let fe: Vec<Option<f64>> = results
+            .iter()
+            .map(|r| fuel_economy(r.sim.distance_m, r.sim.e_in))
+            .collect();
+        // f_i = energy drawn over cycle i [kWh].
+        let energy: Vec<f64> = results.iter().map(|r| r.sim.e_in / 3.6e6).collect();
+        compare(&fe, &energy, input.motors.len(), n_c, &o.weights)
+    });
     Ok(BusFuelEconomyOutput {
         results,
         motor_warnings,
@@ -426,10 +453,18 @@ fn run_result(
     }
 }
 
-/// FE change relative to the first motor and desirability per cycle (spec §5.7).
-fn compare(results: &[RunResult], n_m: usize, n_c: usize, weights: &[f64]) -> ComparisonData {
-    let get = |m: usize, c: usize| &results[m * n_c + c];
-    let fe = |m: usize, c: usize| fuel_economy(get(m, c).sim.distance_m, get(m, c).sim.e_in);
+/// FE change relative to the first motor and desirability per cycle (spec §5.7), from the fuel
+/// economy [km/kWh] and the energy drawn [kWh] of every motor × cycle pair (motor-major) — the
+/// `fe_km_per_kwh` and `energy_in_kwh` of the results, so that merged shards can recompute it.
+#[must_use]
+pub fn compare(
+    fe_all: &[Option<f64>],
+    energy_all: &[f64],
+    n_m: usize,
+    n_c: usize,
+    weights: &[f64],
+) -> ComparisonData {
+    let fe = |m: usize, c: usize| fe_all.get(m * n_c + c).copied().flatten();
     let fe_change_pct = (0..n_m)
         .map(|m| {
             (0..n_c)
@@ -437,8 +472,7 @@ fn compare(results: &[RunResult], n_m: usize, n_c: usize, weights: &[f64]) -> Co
                 .collect()
         })
         .collect();
-    // f_i = energy drawn over cycle i [kWh].
-    let energy = |m: usize, c: usize| get(m, c).sim.e_in / 3.6e6;
+    let energy = |m: usize, c: usize| energy_all.get(m * n_c + c).copied().unwrap_or(0.0);
     let mut d = vec![vec![0.0; n_c]; n_m];
     for c in 0..n_c {
         let f_min = (0..n_m).map(|m| energy(m, c)).fold(f64::INFINITY, f64::min);

@@ -96,6 +96,8 @@ pub struct BusFuelEconomyInput {
     pub motors: Vec<MotorInput>,
     /// Options.
     pub options: Options,
+    /// The block of motor × cycle pairs to simulate (all when `None`).
+    pub shard: Option<crate::calc::common::Shard>,
 }
 
 /// Strictly increasing, finite, ≥ `min_len` points, each in `range` (the first checked against
@@ -904,6 +906,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
 
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
+        let shard = crate::calc::common::shard(&mut v, req.shard);
         let veh = vehicle(&mut v, &req.vehicle);
         v.range(
             "/inverter/efficiency",
@@ -1071,6 +1074,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
                 hist_bins: (o.op_histogram.speed_bin_rpm, o.op_histogram.torque_bin_nm),
                 weights,
             },
+            shard,
         })
     }
 }

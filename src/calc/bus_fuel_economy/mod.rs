@@ -70,7 +70,9 @@ use std::collections::BTreeMap;
 pub use error::BusFuelEconomyError;
 pub use wire::{BusFuelEconomyRequest, BusFuelEconomyResponse, MotorMapRequest, MotorMapResponse};
 
-use self::compute::{BusFuelEconomyOutput, MapData, RunResult, compute, fuel_economy, motor_map};
+use self::compute::{
+    BusFuelEconomyOutput, ComparisonData, MapData, RunResult, compute, fuel_economy, motor_map,
+};
 use self::input::{BusFuelEconomyInput, validate_motor};
 use self::ipmsm::rad_s_to_rpm;
 use self::wire::{
@@ -78,6 +80,7 @@ use self::wire::{
     MotorMapData, OpHistogram, Traces,
 };
 use crate::calc::CalcFailure;
+use crate::calc::common::ResponseSize;
 use crate::numerics::{Budget, SolverReport, StopReason};
 
 /// J → kWh.
@@ -93,6 +96,7 @@ pub fn run(
     budget: &Budget,
 ) -> Result<BusFuelEconomyResponse, CalcFailure> {
     let input = BusFuelEconomyInput::try_from(&req)?;
+    response_size(&input).check(budget)?;
     let out = compute(&input, budget)?;
     Ok(response(&input, out, budget))
 }
@@ -106,6 +110,10 @@ pub fn run_motor_map(
     budget: &Budget,
 ) -> Result<MotorMapResponse, CalcFailure> {
     let (m, grid) = validate_motor(&req.motor, &req.grid)?;
+    let series = if req.include_components { 9 } else { 2 };
+    ResponseSize::fixed(8 * 1024)
+        .numbers("/grid", map_points(&m, grid).saturating_mul(series))
+        .check(budget)?;
     let data = motor_map(&m, grid, req.include_components, budget).map_err(|e| {
         let mut f = CalcFailure::from(e);
         for issue in &mut f.errors {
@@ -333,49 +341,132 @@ fn map_wire(id: &str, m: MapData) -> MotorMapData {
     }
 }
 
+/// Points of a motor's map on `grid` (speed × torque axes), saturated.
+fn map_points(m: &motor::MotorInput, grid: (f64, f64)) -> u64 {
+    let points = motor::grid_size(m.n_max_rpm, compute::t_top(m), grid.0, grid.1);
+    // Validated steps give a finite count; a larger map is refused by the computation with
+    // its own code (MAP_TOO_LARGE), so the estimate stops at its limit.
+    points.clamp(0.0, compute::MAX_MAP_POINTS) as u64
+}
+
+/// Bytes of one result's scalar fields, names and warnings at most.
+const RESULT_BYTES: u64 = 4096;
+
+/// Upper estimate of the answer's size from the validated request (checked before computing):
+/// per motor × cycle a result record, its traces (8 series per simulated interval) and its
+/// operating-point histogram (speed bins up to the cycle's top motor speed × torque bins over
+/// ± the envelope's top torque, at most `MAX_HIST_BINS`), and per motor its efficiency map.
+/// The histogram's torque range is the envelope's: a histogram of torques beyond it (motoring
+/// demand over the envelope in `backward` mode) can exceed the estimate and is then caught by
+/// the service's check of the encoded answer.
+#[must_use]
+pub fn response_size(input: &BusFuelEconomyInput) -> ResponseSize {
+    let o = &input.options;
+    let motors = input.motors.len() as u64;
+    let mut size = ResponseSize::fixed(16 * 1024 + motors * 2048)
+        .bytes("/motors", motors * input.cycles.len() as u64 * RESULT_BYTES);
+    for c in &input.cycles {
+        let intervals = (c.time_s.len().saturating_sub(1) * o.substeps.max(1)) as u64;
+        if o.traces {
+            size = size.numbers("/options/outputs", motors * 8 * intervals);
+        }
+        if o.histogram {
+            let rpm = rad_s_to_rpm(input.vehicle.motor_speed(c.max_speed_mps()));
+            for m in &input.motors {
+                let speed_bins = (rpm / o.hist_bins.0).floor() + 2.0;
+                let torque_bins = 2.0 * (compute::t_top(m) / o.hist_bins.1).ceil() + 3.0;
+                let bins = (speed_bins * torque_bins).clamp(0.0, compute::MAX_HIST_BINS) as u64;
+                size = size.numbers("/options/op_histogram", bins + 64);
+            }
+        }
+    }
+    if o.efficiency_map {
+        for m in &input.motors {
+            size = size.numbers("/options/loss_map_grid", map_points(m, o.grid) + 64);
+        }
+    }
+    size
+}
+
+/// The wire form of a comparison of motors `ids` over `cycles`.
+fn comparison_wire(
+    ids: &[String],
+    cycles: Vec<String>,
+    weights: &[f64],
+    c: &ComparisonData,
+) -> Comparison {
+    let mut fe_change_pct = BTreeMap::new();
+    let mut desirability = BTreeMap::new();
+    for (mi, id) in ids.iter().enumerate() {
+        if mi > 0 {
+            let row: BTreeMap<String, Option<f64>> = cycles
+                .iter()
+                .cloned()
+                .zip(c.fe_change_pct[mi].iter().copied())
+                .collect();
+            fe_change_pct.insert(id.clone(), row);
+        }
+        desirability.insert(
+            id.clone(),
+            Desirability {
+                d: c.d[mi].clone(),
+                overall: c.overall[mi],
+            },
+        );
+    }
+    Comparison {
+        reference_motor: ids.first().cloned().unwrap_or_default(),
+        cycles,
+        weights: weights.to_vec(),
+        fe_change_pct,
+        desirability,
+    }
+}
+
+/// The comparison of the merged `results` of every shard (motor-major, as in the unsharded
+/// answer), with the request's normalised desirability `weights` (one per cycle): the merge
+/// rule of sharded answers, equal to the unsharded answer's `comparison`. `None` with fewer
+/// than 2 motors, or when `results` is not a full motor × cycle table.
+#[must_use]
+pub fn merged_comparison(results: &[CycleResult], weights: &[f64]) -> Option<Comparison> {
+    let first = results.first()?;
+    let n_c = results
+        .iter()
+        .take_while(|r| r.motor == first.motor)
+        .count();
+    if n_c == 0 || !results.len().is_multiple_of(n_c) || weights.len() != n_c {
+        return None;
+    }
+    let n_m = results.len() / n_c;
+    let ids: Vec<String> = results
+        .iter()
+        .step_by(n_c)
+        .map(|r| r.motor.clone())
+        .collect();
+    let cycle_names: Vec<String> = results[..n_c].iter().map(|r| r.cycle.clone()).collect();
+    let fe: Vec<Option<f64>> = results.iter().map(|r| r.fe_km_per_kwh).collect();
+    let energy: Vec<f64> = results.iter().map(|r| r.energy_in_kwh).collect();
+    (n_m >= 2).then(|| {
+        let c = compute::compare(&fe, &energy, n_m, n_c, weights);
+        comparison_wire(&ids, cycle_names, weights, &c)
+    })
+}
+
 fn response(
     input: &BusFuelEconomyInput,
     out: BusFuelEconomyOutput,
     budget: &Budget,
 ) -> BusFuelEconomyResponse {
     let o = &input.options;
-    let comparison = out.comparison.as_ref().map(|c| {
-        let cycles: Vec<String> = input.cycles.iter().map(|c| c.name.clone()).collect();
-        let mut fe_change_pct = BTreeMap::new();
-        let mut desirability = BTreeMap::new();
-        for (mi, m) in input.motors.iter().enumerate() {
-            if mi > 0 {
-                let row: BTreeMap<String, Option<f64>> = cycles
-                    .iter()
-                    .cloned()
-                    .zip(c.fe_change_pct[mi].iter().copied())
-                    .collect();
-                fe_change_pct.insert(m.id.clone(), row);
-            }
-            desirability.insert(
-                m.id.clone(),
-                Desirability {
-                    d: c.d[mi].clone(),
-                    overall: c.overall[mi],
-                },
-            );
-        }
-        Comparison {
-            reference_motor: input
-                .motors
-                .first()
-                .map(|m| m.id.clone())
-                .unwrap_or_default(),
-            cycles,
-            weights: o.weights.clone(),
-            fe_change_pct,
-            desirability,
-        }
-    });
+    let ids: Vec<String> = input.motors.iter().map(|m| m.id.clone()).collect();
+    let cycle_names: Vec<String> = input.cycles.iter().map(|c| c.name.clone()).collect();
+    let comparison = out
+        .comparison
+        .as_ref()
+        .map(|c| comparison_wire(&ids, cycle_names, &o.weights, c));
     let motor_maps = out.maps.map(|maps| {
         maps.into_iter()
-            .zip(&input.motors)
-            .map(|(m, mi)| map_wire(&mi.id, m))
+            .map(|(mi, m)| map_wire(&input.motors[mi].id, m))
             .collect()
     });
     let results = out
@@ -386,10 +477,12 @@ fn response(
             result_wire(input, r, &w)
         })
         .collect();
+    let pairs = input.motors.len() * input.cycles.len();
     BusFuelEconomyResponse {
         results,
         comparison,
         motor_maps,
+        shard: input.shard.map(|s| s.out(pairs)),
         echo: Echo {
             mode: o.mode,
             power_convention: o.convention,

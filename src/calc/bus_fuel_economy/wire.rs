@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::calc::Range;
+use crate::calc::common::{Shard, ShardOut};
 use crate::numerics::SolverReport;
 
 // ---------------------------------------------------------------------------------------------
@@ -38,6 +39,12 @@ pub struct BusFuelEconomyRequest {
     /// Simulation options.
     #[serde(default)]
     pub options: OptionsSpec,
+    /// Simulate only block `index` of `count` near-equal contiguous blocks of the motor × cycle
+    /// pairs (motor-major, as `results`): the answers of shards 0..count, merged as `shard` in
+    /// the answer says, equal the unsharded answer.
+    #[serde(default)]
+    #[schema(nullable = false)]
+    pub shard: Option<Shard>,
 }
 
 /// Vehicle of the backward longitudinal model (§3.1, paper eq. 4-5).
@@ -650,10 +657,20 @@ pub struct BusFuelEconomyResponse {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub comparison: Option<Comparison>,
-    /// Efficiency maps per motor (only with `outputs: ["efficiency_map"]`).
+    /// Efficiency maps per motor (only with `outputs: ["efficiency_map"]`; with `shard`, the
+    /// maps of the motors whose first result is in the shard's block).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub motor_maps: Option<Vec<MotorMapData>>,
+    /// Which block of the motor × cycle pairs this answer holds (only when the request gave
+    /// `shard`). Merged: `results` and `motor_maps` concatenated in shard order; `comparison`
+    /// (omitted in a sharded answer: it needs every motor) recomputed from the merged results'
+    /// `fe_km_per_kwh` and `energy_in_kwh` with paper eq. 11-13 and the request's normalised
+    /// `desirability_weights` (in Rust: `bus_fuel_economy::merged_comparison`); `report`
+    /// counters added.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub shard: Option<ShardOut>,
     /// Settings used.
     pub echo: Echo,
     /// Work done and how the run stopped.

@@ -5,22 +5,34 @@ use super::catalogue::NamedLaw;
 use super::input::{EvaluateInput, LawChoice};
 use super::law::{BoundaryConditions, JUMP_REL_TOL, Jump, Quantity, SevenSegmentLaw};
 use super::wire::{Curves, EvaluateRequest, EvaluateResponse, PeaksOut, Warning};
+use crate::calc::common::ResponseSize;
 use crate::calc::{CalcFailure, ProblemClass};
 use crate::numerics::Budget;
 
 /// Validate, compute and build the wire response of `POST /v1/cam-law/evaluate`.
 ///
-/// The work is `O(N)` in the number of abscissae (≤ 200 000 points, a few ms), so the budget is
-/// not polled.
+/// The work is `O(N)` in the number of abscissae (≤ 200 000 points, a few ms), so the budget's
+/// clock is not polled; its response limit is checked before evaluating.
 ///
 /// # Errors
 /// [`CalcFailure`] with every offending field (JSON pointers into the request) for invalid input;
 /// `LAW_OVERFLOW` / `NON_FINITE_RESULT` when the law's values would overflow f64.
-pub fn run(req: EvaluateRequest, _budget: &Budget) -> Result<EvaluateResponse, CalcFailure> {
+pub fn run(req: EvaluateRequest, budget: &Budget) -> Result<EvaluateResponse, CalcFailure> {
     let input = EvaluateInput::try_from(req)?;
+    response_size(&input).check(budget)?;
     let response = compute(&input)?;
     ensure_finite(&response)?;
     Ok(response)
+}
+
+/// Upper estimate of the answer's size from the validated request (checked before computing):
+/// fixed fields (law, peaks, knots, jumps) and the curves, one number per abscissa for `x` and
+/// each requested quantity.
+#[must_use]
+pub fn response_size(input: &EvaluateInput) -> ResponseSize {
+    let n = input.xs.as_ref().map_or(0, Vec::len) as u64;
+    let series = 1 + input.quantities.len() as u64;
+    ResponseSize::fixed(8 * 1024).numbers("/abscissa", n * series)
 }
 
 /// Evaluate a validated request.

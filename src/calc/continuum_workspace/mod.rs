@@ -83,6 +83,7 @@ use self::wire::{
     RodRequest, SeedOut, SolverState, StabilityOut, WaveOut, WorkspaceResponse,
 };
 use crate::calc::CalcFailure;
+use crate::calc::common::ResponseSize;
 use crate::numerics::angles::wrap_pi;
 use crate::numerics::{Budget, SolverReport, StopReason};
 
@@ -92,12 +93,41 @@ pub fn run(
     budget: &Budget,
 ) -> Result<ContinuumWorkspaceResponse, CalcFailure> {
     let input = Input::try_from(&req)?;
+    response_size(&input).check(budget)?;
     let budget = match input.time_limit {
         Some(t) => budget.clone().capped(t),
         None => budget.clone(),
     };
     let out = compute::compute(&input, &budget)?;
     Ok(respond(&input, out, &budget))
+}
+
+/// Bytes of one node in `nodes` at most: a status code and 8 numbers (or nulls).
+const NODE_BYTES: u64 = 24 + 8 * 25;
+
+/// Upper estimate of the answer's size from the validated request (checked before computing):
+/// fixed fields, the rod shapes of `fk` (rods × `rod_shape_points` × 4 numbers), and for
+/// `workspace` the grid axes and, with `return_nodes`, one node record per grid node and wave.
+/// The number of waves of seed `all_stable_modes` is known only after the assembly-mode search;
+/// the estimate counts one (the encoded answer is still checked against the limit).
+#[must_use]
+pub fn response_size(input: &Input) -> ResponseSize {
+    let rods = input.model.design.rods.len() as u64;
+    let mut size = ResponseSize::fixed(16 * 1024 + rods * 1024);
+    if input.mode == Mode::Fk && input.shape_points > 0 {
+        size = size.numbers(
+            "/outputs/rod_shape_points",
+            rods * 4 * input.shape_points as u64,
+        );
+    }
+    if let (Mode::Workspace, Some(sw)) = (input.mode, &input.sweep) {
+        let [n1, n2] = sw.settings.grid.map(|n| n as u64);
+        size = size.numbers("/workspace/grid", n1 + n2);
+        if sw.return_nodes {
+            size = size.bytes("/workspace/grid", n1 * n2 * NODE_BYTES);
+        }
+    }
+    size
 }
 
 /// The request's own time limit (`time_limit_ms`, capped at the service maximum).

@@ -274,7 +274,12 @@ fn cross_validate(
     threads: usize,
 ) -> (Cv, u64) {
     let n = input.x.n_rows();
-    let folds = data::folds(n, k, input.split_seed);
+    let mut folds = data::folds(n, k, input.split_seed);
+    // A shard evaluates its block of the folds, each exactly as in the whole cross-validation.
+    if let Some(shard) = input.shard {
+        let mine = shard.range(folds.len());
+        folds = folds.drain(mine).collect();
+    }
     let results = par_map(threads, &folds, |_, fold| {
         if budget.expired() {
             return Err(budget.check(0).unwrap_or(StopReason::Deadline));

@@ -44,6 +44,8 @@ pub struct TrainInput {
     pub test_fraction: f64,
     /// Folds of cross-validation.
     pub k_fold: Option<usize>,
+    /// The block of folds to evaluate (all when `None`).
+    pub shard: Option<crate::calc::common::Shard>,
     /// Seed of the holdout and fold permutations.
     pub split_seed: u64,
     /// Optional outputs.
@@ -322,6 +324,12 @@ impl TryFrom<TrainRequest> for TrainInput {
         if let Some(k) = val.k_fold {
             v.uint("/validation/k_fold", "k_fold", u64::from(k), K_FOLD);
         }
+        let shard = crate::calc::common::shard(&mut v, req.shard);
+        v.ensure(
+            req.shard.is_none() || val.k_fold.is_some(),
+            "/shard",
+            || "shard splits the k-fold cross-validation: set validation.k_fold".to_owned(),
+        );
         let smogn = req.preprocessing.smogn.as_ref().map(|s| {
             smogn_params(
                 &mut v,
@@ -425,6 +433,7 @@ impl TryFrom<TrainRequest> for TrainInput {
             smogn,
             test_fraction: val.test_fraction,
             k_fold: val.k_fold.map(|k| k as usize),
+            shard,
             split_seed: val.seed,
             outputs,
         })

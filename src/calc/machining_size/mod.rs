@@ -71,6 +71,7 @@ pub mod smogn;
 pub mod wire;
 
 use crate::calc::CalcFailure;
+use crate::calc::common::ResponseSize;
 use crate::numerics::Budget;
 
 pub use error::MachiningSizeError;
@@ -97,8 +98,26 @@ pub fn run_train(req: TrainRequest, budget: &Budget) -> Result<TrainResponse, Ca
 /// A [`CalcFailure`] (HTTP 422) for invalid input, a rejected model document or a spent budget.
 pub fn run_predict(req: PredictRequest, budget: &Budget) -> Result<PredictResponse, CalcFailure> {
     let input = PredictInput::try_from(req)?;
+    predict_size(&input).check(budget)?;
     let out = compute::predict(&input, budget)?;
     Ok(output::respond_predict(&input, &out, budget))
+}
+
+/// Upper estimate of a `/predict` answer from the validated request (checked before
+/// computing): the model summary and warnings, one prediction per row, with `shap` d values per
+/// row and with `interactions` a d × d matrix per row.
+#[must_use]
+pub fn predict_size(input: &PredictInput) -> ResponseSize {
+    let rows = input.rows.len() as u64;
+    let d = input.model.n_features as u64;
+    let mut size = ResponseSize::fixed(8 * 1024).numbers("/rows", rows);
+    if input.shap != wire::ShapKind::None {
+        size = size.numbers("/shap", rows * (d + 1));
+    }
+    if input.interactions {
+        size = size.numbers("/interactions", rows * d * (d + 1));
+    }
+    size
 }
 
 /// Entry point of `POST /v1/machining-size/analyze`: validate, analyse, respond.

@@ -29,6 +29,28 @@ const SMALL_TEST_SET: usize = 50;
 /// Consecutive kept eigenvalues closer than this (relative) make components unstable (§8.8).
 const NEAR_EQUAL_EIGEN: f64 = 0.05;
 
+/// Cross-validation metrics of `k` folds from the folds' metrics: the folds, the mean and
+/// sample sd (ddof 1) of R² (over the folds that have one) and RMSE, the mean MAE. The merge
+/// rule of sharded answers: this over the concatenated folds of every shard.
+#[must_use]
+pub fn cv_metrics(k: u32, folds: Vec<SplitMetrics>) -> CvMetrics {
+    let r2: Vec<f64> = folds.iter().filter_map(|m| m.r2).collect();
+    let rmse: Vec<f64> = folds.iter().map(|m| m.rmse).collect();
+    let mae: Vec<f64> = folds.iter().map(|m| m.mae).collect();
+    let (r2_mean, r2_sd) = mean_sd(&r2);
+    let (rmse_mean, rmse_sd) = mean_sd(&rmse);
+    CvMetrics {
+        k,
+        folds,
+        shard: None,
+        r2_mean: (!r2.is_empty()).then_some(r2_mean),
+        r2_sd: (!r2.is_empty()).then_some(r2_sd),
+        rmse_mean,
+        rmse_sd,
+        mae_mean: mean_sd(&mae).0,
+    }
+}
+
 fn u32_of(n: usize) -> u32 {
     u32::try_from(n).unwrap_or(u32::MAX)
 }
@@ -240,20 +262,10 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
             ));
         }
         cv.folds.as_ref().map(|folds| {
-            let r2: Vec<f64> = folds.iter().filter_map(|m| m.r2).collect();
-            let rmse: Vec<f64> = folds.iter().map(|m| m.rmse).collect();
-            let mae: Vec<f64> = folds.iter().map(|m| m.mae).collect();
-            let (r2_mean, r2_sd) = mean_sd(&r2);
-            let (rmse_mean, rmse_sd) = mean_sd(&rmse);
-            CvMetrics {
-                k: u32_of(folds.len()),
-                folds: folds.iter().map(split_metrics).collect(),
-                r2_mean: (!r2.is_empty()).then_some(r2_mean),
-                r2_sd: (!r2.is_empty()).then_some(r2_sd),
-                rmse_mean,
-                rmse_sd,
-                mae_mean: mean_sd(&mae).0,
-            }
+            let k = input.k_fold.unwrap_or(folds.len());
+            let mut m = cv_metrics(u32_of(k), folds.iter().map(split_metrics).collect());
+            m.shard = input.shard.map(|s| s.out(k));
+            m
         })
     });
     if out.test_rows.len() < SMALL_TEST_SET && !out.test_rows.is_empty() && out.cv.is_none() {

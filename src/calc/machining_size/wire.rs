@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::calc::Range;
-use crate::calc::common::{TimeLimited, Warning};
+use crate::calc::common::{Shard, ShardOut, TimeLimited, Warning};
 use crate::numerics::SolverReport;
 
 // ---------------------------------------------------------------------------------------------
@@ -146,6 +146,12 @@ pub struct TrainRequest {
     #[serde(default)]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,
+    /// Evaluate only block `index` of `count` near-equal contiguous blocks of the k
+    /// cross-validation folds (needs `validation.k_fold`); the model, holdout metrics and other
+    /// outputs are those of the unsharded request. Merge rule: see `metrics.cv.shard`.
+    #[serde(default)]
+    #[schema(nullable = false)]
+    pub shard: Option<Shard>,
 }
 
 fn default_outputs() -> Vec<TrainOutputKind> {
@@ -461,10 +467,18 @@ pub struct SplitMetrics {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = machining_size::CvMetrics)]
 pub struct CvMetrics {
-    /// Folds.
+    /// Folds (of the whole cross-validation, also in a sharded answer).
     pub k: u32,
-    /// Test metrics of each fold (trained on the other folds).
+    /// Test metrics of each fold (trained on the other folds); with `shard` the folds
+    /// `shard.start..shard.end`.
     pub folds: Vec<SplitMetrics>,
+    /// Which folds this answer holds (only when the request gave `shard`); the means and sds
+    /// below are then over these folds. Merged: `folds` concatenated in shard order, and
+    /// `R2_mean`, `R2_sd`, `RMSE_mean`, `RMSE_sd`, `MAE_mean` recomputed over the merged folds
+    /// (mean, and sample sd with ddof 1; R² over the folds that have one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub shard: Option<ShardOut>,
     /// Mean R² over folds with a defined R².
     #[serde(rename = "R2_mean", skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]

@@ -110,6 +110,7 @@ pub fn run(
     budget: &Budget,
 ) -> Result<VibrationAbsorberResponse, CalcFailure> {
     let input = VibrationAbsorberInput::try_from(req)?;
+    output::response_size(&input).check(budget)?;
     let out = compute(&input, budget)?;
     Ok(output::respond(&input, &out, budget))
 }

@@ -12,7 +12,51 @@ use super::wire::{
     GainsOut, ModeShapesOut, NaturalFrequenciesOut, Stability, StepOut, TimeOut, TimePointOut,
     VibrationAbsorberResponse,
 };
+use crate::calc::common::ResponseSize;
 use crate::numerics::Budget;
+
+/// Upper estimate of the answer's size from the validated request (checked before computing):
+/// fixed fields and per-mode tables, then each requested series: absorber step responses
+/// (2 responses × 2 series × 5001 samples), frequency grids (frequency, magnitude and phase per
+/// point and abscissa), the time response (per kept sample: time, w per abscissa, stroke and
+/// force) and mode shapes (per sample: x and one value per mode).
+#[must_use]
+pub fn response_size(input: &VibrationAbsorberInput) -> ResponseSize {
+    let o = &input.outputs;
+    let modes = input.beam.n_modes as u64;
+    let mut size = ResponseSize::fixed(16 * 1024 + modes * 1024);
+    if o.ava_step_series {
+        let samples = super::response::SETTLING_SAMPLES as u64 + 1;
+        size = size.numbers("/outputs/ava_step_series", 4 * samples);
+    }
+    if let Some(g) = &o.ava_frf {
+        size = size.numbers("/outputs/ava_frequency_response/n_points", 3 * g.n as u64);
+    }
+    if let Some((g, points)) = &o.frf {
+        let per_point = 1 + 2 * points.len() as u64;
+        size = size
+            .numbers(
+                "/outputs/frequency_response/n_points",
+                per_point * g.n as u64,
+            )
+            .bytes(
+                "/outputs/frequency_response/n_points",
+                100 * points.len() as u64,
+            );
+    }
+    if let Some(t) = &o.time {
+        let p = t.points.len() as u64;
+        size = size.bytes("/outputs/time_response/points_m", p * (4 * 25 + 100));
+        if t.series {
+            let kept = (t.steps / t.decimate.max(1)) as u64 + 2;
+            size = size.numbers("/outputs/time_response/decimate", kept * (p + 3));
+        }
+    }
+    if let Some(n) = o.mode_shapes {
+        size = size.numbers("/outputs/mode_shapes/n_points", n as u64 * (modes + 1));
+    }
+    size
+}
 
 /// Magnitude and phase [deg] of optional complex values.
 fn mag_phase(h: &[Option<Complex<f64>>]) -> (Vec<Option<f64>>, Vec<Option<f64>>) {

@@ -860,9 +860,17 @@ pub struct SweepResult {
 /// deterministic. Before each combination the budget is checked: on a deadline, or once the
 /// evaluation cap (counted in combinations) is reached, the remaining combinations are
 /// `NotEvaluated`.
+///
+/// Only the combinations `items` (global indices, see [`crate::calc::common::Shard`]) are run;
+/// outcome `k` is combination `items.start + k`, computed exactly as in the whole sweep.
 #[must_use]
-pub fn compute_sweep(input: &SweepInput, budget: &Budget) -> SweepResult {
-    let total = input.len();
+pub fn compute_sweep(
+    input: &SweepInput,
+    items: std::ops::Range<usize>,
+    budget: &Budget,
+) -> SweepResult {
+    let items = items.start.min(input.len())..items.end.min(input.len());
+    let total = items.len();
     let p = input.params;
     let n = p.n_intervals;
     let table = (n < TRIG_TABLE_MAX_POINTS).then(|| TrigTable::new(n));
@@ -875,9 +883,9 @@ pub fn compute_sweep(input: &SweepInput, budget: &Budget) -> SweepResult {
             g.get_or_insert(r);
         }
     };
-    let combos: Vec<usize> = (0..total).collect();
-    let results = par_map_while(threads, &combos, |_, &i| {
-        if let Some(r) = budget.check(i as u64) {
+    let combos: Vec<usize> = items.collect();
+    let results = par_map_while(threads, &combos, |k, &i| {
+        if let Some(r) = budget.check(k as u64) {
             record(r);
             return None;
         }

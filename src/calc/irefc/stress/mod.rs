@@ -17,10 +17,11 @@ use wire::{
     StressMode, StressSingleResponse, StressSweepResponse, SweepMeta, SweepRecord, WheelMax,
 };
 
-use super::error::IrefcError;
+use super::error::{BAD_RANGE, IrefcError};
 use super::geometry::Geometry;
 use super::wire::{GeometryOut, MM, Warning, geometry_warnings};
-use crate::calc::CalcFailure;
+use crate::calc::common::{self, ResponseSize, Shard};
+use crate::calc::{CalcFailure, ProblemClass, Validator};
 use crate::numerics::{Budget, SolverReport};
 
 /// Pascals per MPa.
@@ -31,17 +32,69 @@ const MPA: f64 = 1e6;
 /// # Errors
 /// `BAD_RANGE`/`MISSING_FIELD` (every offending field), `GRID_TOO_FINE`, `SWEEP_TOO_LARGE`, and for mode
 /// "single" `UNDERCUT`/`ELEMENT_OVERLAP`, `NON_FINITE` (absurd scales) or `DEADLINE`. Infeasible sweep
-/// combinations are records with `valid: false`, not errors.
+/// combinations are records with `valid: false`, not errors. `shard` (mode "sweep" only) runs one
+/// block of the combinations; `RESPONSE_TOO_LARGE` (before computing) when the estimated answer
+/// exceeds the service's response limit.
 pub fn run_stress(
     req: IrefcStressRequest,
     budget: &Budget,
 ) -> Result<IrefcStressResponse, CalcFailure> {
-    match StressInput::try_from_request(&req)? {
+    let mut v = Validator::new();
+    let shard = common::shard(&mut v, req.shard);
+    match common::with_issues(v, StressInput::try_from_request(&req))? {
         StressInput::Single(s) => {
+            if req.shard.is_some() {
+                return Err(CalcFailure::field(
+                    ProblemClass::InvalidInput,
+                    BAD_RANGE,
+                    "/shard",
+                    "shard splits a sweep; mode \"single\" has one design",
+                ));
+            }
+            single_size(&s).check(budget)?;
             run_single(&s, budget).map(|r| IrefcStressResponse::Single(Box::new(r)))
         }
-        StressInput::Sweep(s) => Ok(IrefcStressResponse::Sweep(run_sweep(&s, budget))),
+        StressInput::Sweep(s) => {
+            let shard = shard.unwrap_or(Shard::WHOLE);
+            sweep_size(&s, shard).check(budget)?;
+            let mut r = run_sweep(&s, shard.range(s.len()), budget);
+            r.shard = req.shard.map(|_| Box::new(shard.out(s.len())));
+            Ok(IrefcStressResponse::Sweep(r))
+        }
     }
+}
+
+/// Upper estimate of a single-design answer (before computing): fixed fields, then the element
+/// table (Z2 rows), the curves ((N/stride + 2) points × 6 series) and the profiles (2 wheels ×
+/// profile_points × 2 coordinates).
+fn single_size(s: &SingleInput) -> ResponseSize {
+    let n = s.params.n_intervals as u64;
+    let mut size = ResponseSize::fixed(8 * 1024);
+    if s.elements {
+        size = size.bytes("/include/elements", u64::from(s.design.z2) * (5 * 25 + 80));
+    }
+    if let Some(stride) = s.curves_stride {
+        let points = n / (stride.max(1) as u64) + 2;
+        size = size
+            .numbers("/curves_stride", 6 * points)
+            .bytes("/curves_stride", 200);
+    }
+    if let Some(p) = s.profile_points {
+        size = size
+            .numbers("/profile_points", 4 * u64::from(p))
+            .bytes("/profile_points", 6 * u64::from(p));
+    }
+    size
+}
+
+/// Bytes of one sweep record at most: 15 numbers, their names, a reason message and warning
+/// codes.
+const SWEEP_RECORD_BYTES: u64 = 1536;
+
+/// Upper estimate of a sweep answer: fixed fields and one record per combination of the shard.
+fn sweep_size(s: &SweepInput, shard: Shard) -> ResponseSize {
+    let records = shard.range(s.len()).len() as u64;
+    ResponseSize::fixed(8 * 1024).bytes("/sweep", records.saturating_mul(SWEEP_RECORD_BYTES))
 }
 
 fn run_single(inp: &SingleInput, budget: &Budget) -> Result<StressSingleResponse, CalcFailure> {
@@ -142,14 +195,22 @@ fn wheel_max(m: &WheelMaxResult, subsurface: bool) -> WheelMax {
     }
 }
 
-fn run_sweep(inp: &SweepInput, budget: &Budget) -> StressSweepResponse {
+/// The sweep over combinations `items` (all of them, or a shard's block): records in order,
+/// `best`/`worst` as global indices.
+fn run_sweep(
+    inp: &SweepInput,
+    items: std::ops::Range<usize>,
+    budget: &Budget,
+) -> StressSweepResponse {
     let t0 = Instant::now();
-    let res = compute_sweep(inp, budget);
+    let offset = items.start;
+    let res = compute_sweep(inp, items, budget);
     let mut records = Vec::with_capacity(res.outcomes.len());
     let (mut n_valid, mut n_invalid, mut n_not) = (0u64, 0u64, 0u64);
     let mut worst: Option<(usize, f64)> = None;
     let mut best: Option<(usize, f64)> = None;
-    for (i, o) in res.outcomes.iter().enumerate() {
+    for (k, o) in res.outcomes.iter().enumerate() {
+        let i = offset + k;
         let d = inp.design(i);
         let base = |valid: bool, reason: Option<Reason>, g: Option<&Geometry>| SweepRecord {
             z2: d.z2,
@@ -237,6 +298,7 @@ fn run_sweep(inp: &SweepInput, budget: &Budget) -> StressSweepResponse {
         mode: StressMode::Sweep,
         worst: worst.map(|w| w.0),
         best: best.map(|b| b.0),
+        shard: None,
         n_valid,
         n_invalid,
         n_not_evaluated: n_not,

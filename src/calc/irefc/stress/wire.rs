@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::calc::Range;
+use crate::calc::common::{Shard, ShardOut};
 use crate::calc::irefc::wire::{
     CHI, GeometryOut, Material, PROFILE_POINTS_MAX, PROFILE_POINTS_MIN, R2_MM, RB_MM, Warning, Z2,
 };
@@ -180,6 +181,11 @@ pub struct IrefcStressRequest {
     /// The structured array (mode "sweep").
     #[schema(nullable = false)]
     pub sweep: Option<SweepSpec>,
+    /// Compute only block `index` of `count` near-equal contiguous blocks of the combinations
+    /// (mode "sweep" only): the answers of shards 0..count, merged as `shard` in the answer
+    /// says, equal the unsharded answer.
+    #[schema(nullable = false)]
+    pub shard: Option<Shard>,
 }
 
 /// One element of the phase-0 set (force paper "temporary array").
@@ -404,7 +410,7 @@ pub struct SweepMeta {
     /// Grid points per combination as requested (with "phase_exact" + refine each combination scans at
     /// least 4·Z2 + 1 points).
     pub n_grid: u64,
-    /// Combinations in the sweep.
+    /// Combinations in this answer (the whole sweep, or the shard's block).
     pub n_combinations: u64,
     /// Worker threads used.
     pub threads: u32,
@@ -421,12 +427,24 @@ pub struct SweepMeta {
 pub struct StressSweepResponse {
     /// Always "sweep".
     pub mode: StressMode,
-    /// One record per combination, ordered by Z2, then χ, then rb, then r2.
+    /// One record per combination, ordered by Z2, then χ, then rb, then r2 (with `shard`: the
+    /// combinations `shard.start..shard.end` of that order).
     pub records: Vec<SweepRecord>,
-    /// Index of the valid record with the largest sigma_max (null if none is valid).
+    /// Index of the valid record with the largest sigma_max (null if none is valid); the first
+    /// such record on ties. With `shard` a global index (counted from the start of the whole
+    /// sweep); merged: the shards' `worst` with the largest `sigma_max_MPa`, the lowest index
+    /// on ties.
     pub worst: Option<usize>,
-    /// Index of the valid record with the smallest sigma_max (null if none is valid).
+    /// Index of the valid record with the smallest sigma_max (null if none is valid); the first
+    /// such record on ties. With `shard` a global index; merged: the shards' `best` with the
+    /// smallest `sigma_max_MPa`, the lowest index on ties.
     pub best: Option<usize>,
+    /// Which block of the sweep this answer holds (only when the request gave `shard`).
+    /// Merged: records concatenated in shard order; `n_valid`, `n_invalid`, `n_not_evaluated`
+    /// and `meta.n_combinations` added; `best`/`worst` as stated there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub shard: Option<Box<ShardOut>>,
     /// Valid records.
     pub n_valid: u64,
     /// Invalid records (infeasible, non-finite or not evaluated).

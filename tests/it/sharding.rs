@@ -1,0 +1,286 @@
+//! `shard: {index, count}` on the sweeps: for count ∈ {1, 2, 3, 7} the shards' answers, merged by
+//! the rule documented on each answer's `shard` (concatenate the per-item arrays in shard order,
+//! add the counters, recompute the named reductions), equal the unsharded answer exactly — the
+//! per-item numbers compared as JSON text, i.e. bit for bit. Bad shards are 422 with the
+//! field's pointer.
+
+use crate::common;
+
+use mechcalc::calc::bus_fuel_economy::{self, BusFuelEconomyRequest, BusFuelEconomyResponse};
+use mechcalc::calc::irefc::stress::wire::StressSweepResponse;
+use mechcalc::calc::irefc::{IrefcStressRequest, IrefcStressResponse, run_stress};
+use mechcalc::calc::machining_size::wire::SplitMetrics;
+use mechcalc::calc::machining_size::{self, TrainRequest, TrainResponse};
+use mechcalc::numerics::Budget;
+use serde::Serialize;
+use serde_json::{Value, json};
+
+const COUNTS: [u32; 4] = [1, 2, 3, 7];
+
+/// JSON text of a value: equal text means equal numbers to the last bit (shortest round-trip
+/// formatting).
+fn text<T: Serialize>(v: &T) -> String {
+    serde_json::to_string(v).expect("serializable")
+}
+
+fn with_shard(body: &Value, index: u32, count: u32) -> Value {
+    let mut b = body.clone();
+    b["shard"] = json!({"index": index, "count": count});
+    b
+}
+
+// ---------------------------------------------------------------------------------------------
+// IREFC design sweep
+// ---------------------------------------------------------------------------------------------
+
+/// 7 × Z2, 6 × χ: 42 combinations, some of them infeasible (undercut at small χ and large Z2).
+fn irefc_body() -> Value {
+    json!({"mode": "sweep", "r2_mm": 20, "rb_mm": 2, "torque_Nm": 119.366207, "step_deg": 2,
+           "refine": true, "sweep": {"Z2": {"from": 10, "to": 16}, "chi": {"from": 1.05, "to": 1.55, "step": 0.1}}})
+}
+
+fn irefc(body: &Value) -> StressSweepResponse {
+    let req: IrefcStressRequest = serde_json::from_value(body.clone()).expect("valid request");
+    match run_stress(req, &Budget::unlimited()).expect("sweep runs") {
+        IrefcStressResponse::Sweep(r) => r,
+        IrefcStressResponse::Single(_) => panic!("a sweep request answered as single"),
+    }
+}
+
+/// The merge rule of `best`/`worst`: among the shards' picks the largest (worst) or smallest
+/// (best) `sigma_max_MPa`, the lowest index on ties.
+fn pick(parts: &[StressSweepResponse], worst: bool) -> Option<usize> {
+    let mut out: Option<(usize, f64)> = None;
+    for p in parts {
+        let i = if worst { p.worst } else { p.best };
+        let Some(i) = i else { continue };
+        let start = p.shard.as_deref().map_or(0, |s| s.start as usize);
+        let s = p.records[i - start]
+            .sigma_max_mpa
+            .expect("a picked record is valid");
+        let better = out.is_none_or(|(_, o)| if worst { s > o } else { s < o });
+        if better {
+            out = Some((i, s));
+        }
+    }
+    out.map(|o| o.0)
+}
+
+#[test]
+fn irefc_sweep_shards_merge_into_the_whole_sweep() {
+    let body = irefc_body();
+    let whole = irefc(&body);
+    let n = whole.records.len();
+    assert_eq!(n, 42);
+    assert!(
+        whole.n_valid > 0 && whole.n_invalid > 0,
+        "the sweep mixes valid and invalid"
+    );
+    assert!(whole.shard.is_none(), "no shard statement without a shard");
+    for count in COUNTS {
+        let parts: Vec<StressSweepResponse> = (0..count)
+            .map(|i| irefc(&with_shard(&body, i, count)))
+            .collect();
+        let mut records = Vec::new();
+        let mut next = 0u64;
+        for (i, p) in parts.iter().enumerate() {
+            let s = *p
+                .shard
+                .as_deref()
+                .expect("a sharded answer says which shard it is");
+            assert_eq!((s.index, s.count, s.total), (i as u32, count, n as u64));
+            assert_eq!(s.start, next, "blocks are contiguous in index order");
+            assert_eq!(s.end - s.start, p.records.len() as u64);
+            assert_eq!(p.meta.n_combinations, p.records.len() as u64);
+            next = s.end;
+            records.extend(p.records.iter().cloned());
+        }
+        assert_eq!(next, n as u64, "count {count}: the blocks cover the sweep");
+        assert_eq!(
+            text(&records),
+            text(&whole.records),
+            "count {count}: records"
+        );
+        let sum = |f: fn(&StressSweepResponse) -> u64| parts.iter().map(f).sum::<u64>();
+        assert_eq!(sum(|p| p.n_valid), whole.n_valid);
+        assert_eq!(sum(|p| p.n_invalid), whole.n_invalid);
+        assert_eq!(sum(|p| p.n_not_evaluated), whole.n_not_evaluated);
+        assert_eq!(pick(&parts, true), whole.worst, "count {count}: worst");
+        assert_eq!(pick(&parts, false), whole.best, "count {count}: best");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bus: motors × cycles
+// ---------------------------------------------------------------------------------------------
+
+fn bus_body() -> Value {
+    let motor = |id: &str, eff: f64| {
+        json!({"id": id, "model": "constant", "efficiency": eff, "t_peak_nm": 800,
+               "p_peak_w": 130000, "n_max_rpm": 5200})
+    };
+    json!({"cycles": ["manhattan", "hwfet", "hdudds"],
+           "motors": [motor("a", 0.93), motor("b", 0.9), motor("c", 0.95)],
+           "options": {"outputs": ["loss_breakdown", "efficiency_map"],
+                       "desirability_weights": [1, 2, 1]}})
+}
+
+fn bus(body: &Value) -> BusFuelEconomyResponse {
+    let req: BusFuelEconomyRequest = serde_json::from_value(body.clone()).expect("valid request");
+    bus_fuel_economy::run(req, &Budget::unlimited()).expect("runs")
+}
+
+#[test]
+fn bus_comparison_shards_merge_into_the_whole_comparison() {
+    let body = bus_body();
+    let whole = bus(&body);
+    assert_eq!(whole.results.len(), 9);
+    let comparison = whole.comparison.as_ref().expect("3 motors are compared");
+    let weights = comparison.weights.clone();
+    for count in COUNTS {
+        let parts: Vec<BusFuelEconomyResponse> = (0..count)
+            .map(|i| bus(&with_shard(&body, i, count)))
+            .collect();
+        let mut results = Vec::new();
+        let mut maps = Vec::new();
+        let mut next = 0u64;
+        for (i, p) in parts.iter().enumerate() {
+            let s = p.shard.expect("a sharded answer says which shard it is");
+            assert_eq!(
+                (s.index, s.count, s.total, s.start),
+                (i as u32, count, 9, next)
+            );
+            assert_eq!(s.end - s.start, p.results.len() as u64);
+            assert!(p.comparison.is_none(), "a shard cannot compare all motors");
+            next = s.end;
+            results.extend(p.results.iter().cloned());
+            maps.extend(p.motor_maps.iter().flatten().cloned());
+        }
+        assert_eq!(
+            text(&results),
+            text(&whole.results),
+            "count {count}: results"
+        );
+        assert_eq!(text(&maps), text(&whole.motor_maps), "count {count}: maps");
+        let merged = bus_fuel_economy::merged_comparison(&results, &weights);
+        assert_eq!(
+            text(&merged),
+            text(&whole.comparison),
+            "count {count}: comparison"
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Machining size: k-fold cross-validation folds
+// ---------------------------------------------------------------------------------------------
+
+fn train_body() -> Value {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("api/machining_size/train_synthetic.json");
+    let mut b: Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("example")).expect("json");
+    b["params"]["n_estimators"] = json!(25);
+    b["validation"]["k_fold"] = json!(7);
+    b["outputs"] = json!(["importance"]);
+    b
+}
+
+fn train(body: &Value) -> TrainResponse {
+    let req: TrainRequest = serde_json::from_value(body.clone()).expect("valid request");
+    machining_size::run_train(req, &Budget::unlimited()).expect("trains")
+}
+
+#[test]
+fn machining_cv_fold_shards_merge_into_the_whole_cross_validation() {
+    let body = train_body();
+    let whole = train(&body);
+    let cv = whole.metrics.cv.as_ref().expect("7-fold CV finished");
+    assert_eq!((cv.k, cv.folds.len()), (7, 7));
+    for count in COUNTS {
+        let parts: Vec<TrainResponse> = (0..count)
+            .map(|i| train(&with_shard(&body, i, count)))
+            .collect();
+        let mut folds: Vec<SplitMetrics> = Vec::new();
+        let mut next = 0u64;
+        for (i, p) in parts.iter().enumerate() {
+            assert_eq!(
+                text(&p.model),
+                text(&whole.model),
+                "every shard trains the same model"
+            );
+            assert_eq!(text(&p.metrics.test), text(&whole.metrics.test));
+            let c = p.metrics.cv.as_ref().expect("the shard's folds finished");
+            let s = c.shard.expect("a sharded answer says which shard it is");
+            assert_eq!(
+                (s.index, s.count, s.total, s.start),
+                (i as u32, count, 7, next)
+            );
+            assert_eq!(c.k, 7);
+            assert_eq!(s.end - s.start, c.folds.len() as u64);
+            next = s.end;
+            folds.extend(c.folds.iter().cloned());
+        }
+        assert_eq!(next, 7);
+        let merged = machining_size::output::cv_metrics(7, folds);
+        assert_eq!(
+            text(&merged),
+            text(cv),
+            "count {count}: folds and their statistics"
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad shards over HTTP
+// ---------------------------------------------------------------------------------------------
+
+#[tokio::test]
+async fn bad_shards_are_422_with_the_fields_pointer() {
+    let endpoints = [
+        ("/v1/irefc-stress", irefc_body()),
+        ("/v1/bus-fuel-economy", bus_body()),
+        ("/v1/machining-size/train", train_body()),
+    ];
+    let cases = [
+        (2, 2, "/shard/index"),
+        (7, 3, "/shard/index"),
+        (0, 0, "/shard/count"),
+        (0, 10_001, "/shard/count"),
+        (0, 4_000_000_000, "/shard/count"),
+    ];
+    for (path, body) in &endpoints {
+        for (index, count, pointer) in cases {
+            let r = common::post_json(path, &with_shard(body, index, count)).await;
+            let p = r.problem(422);
+            assert_eq!(p["type"], "/problems/invalid-input", "{path}: {p}");
+            assert_eq!(r.pointers(), vec![pointer], "{path} {index}/{count}");
+        }
+    }
+    // A shard of a mode without a sweep, or of a training without k-fold CV.
+    let mut single = irefc_body();
+    single["mode"] = json!("single");
+    single["Z2"] = json!(26);
+    single["chi"] = json!(1.4);
+    single.as_object_mut().map(|o| o.remove("sweep"));
+    let r = common::post_json("/v1/irefc-stress", &with_shard(&single, 0, 2)).await;
+    r.problem(422);
+    assert_eq!(r.pointers(), vec!["/shard"]);
+    let mut no_cv = train_body();
+    no_cv["validation"] = json!({"test_fraction": 0.2});
+    let r = common::post_json("/v1/machining-size/train", &with_shard(&no_cv, 0, 2)).await;
+    r.problem(422);
+    assert_eq!(r.pointers(), vec!["/shard"]);
+}
+
+#[tokio::test]
+async fn a_sharded_http_answer_states_its_block() {
+    let r = common::post_json("/v1/irefc-stress", &with_shard(&irefc_body(), 1, 3)).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let b = r.json();
+    assert_eq!(
+        b["shard"],
+        json!({"index": 1, "count": 3, "start": 14, "end": 28, "total": 42})
+    );
+    assert_eq!(b["records"].as_array().map(Vec::len), Some(14));
+}
