@@ -377,7 +377,9 @@ struct FkRow {
 
 /// Spec 6.2 FK table (AM1, start home, 30 continuation steps, rk4_steps 32, tol 1e-10,
 /// Kirchhoff rods; reference with 1024 steps and tol 1e-12). Tolerances: position 1e-7 m, angle
-/// 1e-5 deg, forces 1e-4 N, margin 1 %.
+/// 1e-5 deg, forces 1e-4 N, margin 1 %. Each row runs the spec's path (`continuation: fixed`,
+/// 30 equal steps) and the default adaptive path (issue 17), which must meet the same tolerances
+/// and land on the fixed path's platform position to 1e-9 L_ref.
 #[test]
 fn fk_reference_table() {
     let rows = [
@@ -445,14 +447,19 @@ fn fk_reference_table() {
             margin: 3.08,
         },
     ];
-    for row in &rows {
+    let mut fixed_pose: Vec<[f64; 2]> = Vec::new();
+    for (row, continuation) in rows.iter().flat_map(|r| [(r, "fixed"), (r, "adaptive")]) {
         let r = call(
             json!({"mode": "fk", "design": {"preset": row.preset}, "inputs_m": row.inputs,
             "load": {"force_n": row.force}, "solver": {"rk4_steps": 32, "tol": 1e-10},
-            "start": {"kind": "home", "continuation_steps": 30},
+            "start": {"kind": "home", "continuation_steps": 30, "continuation": continuation},
             "outputs": {"stability": true, "stability_segments": 40}}),
         );
-        let tag = format!("{} {:?} F {:?}", row.preset, row.inputs, row.force);
+        let tag = format!(
+            "{} {:?} F {:?} ({continuation})",
+            row.preset, row.inputs, row.force
+        );
+        assert_eq!(r["diagnostics"]["continuation"], continuation, "{tag}");
         assert_eq!(r["status"], "ok", "{tag}");
         close(
             &format!("{tag} px"),
@@ -497,11 +504,24 @@ fn fk_reference_table() {
             r["stability"]["det_sign"], 1,
             "{tag}: stable solutions have det J > 0 (spec 4.5)"
         );
-        assert_eq!(
-            r["diagnostics"]["continuation_steps"].as_u64(),
-            Some(30),
-            "{tag}"
-        );
+        let steps = r["diagnostics"]["continuation_steps"].as_u64();
+        if continuation == "fixed" {
+            assert_eq!(steps, Some(30), "{tag}: the spec's 30 equal steps");
+            fixed_pose.push([
+                num(&r, "/platform/position_m/0"),
+                num(&r, "/platform/position_m/1"),
+            ]);
+        } else {
+            assert!(steps.is_some_and(|s| s < 30), "{tag}: {steps:?} steps");
+            let f = fixed_pose.last().copied().expect("fixed row ran first");
+            let l_ref = 0.5;
+            let dp = (num(&r, "/platform/position_m/0") - f[0])
+                .hypot(num(&r, "/platform/position_m/1") - f[1]);
+            assert!(
+                dp <= 1e-9 * l_ref,
+                "{tag}: adaptive position differs from the fixed path's by {dp:.2e} m"
+            );
+        }
     }
 }
 
