@@ -249,6 +249,13 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 .map(|r| {
                     continuation_steps = r.steps;
                     total_iterations = r.newton_iterations;
+                    continuation = Some(r.walked);
+                    if let Some(at) = r.fell_back_at {
+                        warnings.push(format!(
+                            "continuation_fallback: the adaptive path from home stalled at {:.1} % of the way; the spec's {k} equal steps were walked instead",
+                            100.0 * at
+                        ));
+                    }
                     r.solution
                 })
             }

@@ -230,8 +230,13 @@ pub struct ContinuationResult {
     pub solution: Solution,
     /// Accepted continuation steps.
     pub steps: usize,
-    /// Newton iterations over all steps.
+    /// Newton iterations over all steps (those of an abandoned adaptive attempt included).
     pub newton_iterations: usize,
+    /// The step control that reached the target.
+    pub walked: Stepping,
+    /// Where an adaptive attempt stopped (fraction of the path) before the fixed steps were
+    /// walked instead; `None` when the requested stepping arrived by itself.
+    pub fell_back_at: Option<f64>,
 }
 
 /// Continuation parameter distance to 1 treated as arrival (round-off of k additions of 1/k).
@@ -313,7 +318,8 @@ pub enum Stepping {
 }
 
 /// Continue `start` at `from` to `to` with the chosen stepping; `k` is the spec's step count
-/// (the fixed path's steps, the adaptive path's first step `1/k`).
+/// (the fixed path's steps, the adaptive path's first step `1/k`). An adaptive walk that fails
+/// for any reason but the budget is followed by the fixed walk from the same start.
 #[expect(
     clippy::too_many_arguments,
     reason = "the continuation's full context; grouping it would only rename it"
@@ -331,7 +337,20 @@ pub fn continue_path(
 ) -> Result<ContinuationResult, Failed> {
     match stepping {
         Stepping::Fixed => continuation(model, start, from, to, k, opts, budget, counter),
-        Stepping::Adaptive => adaptive(model, start, from, to, k, opts, budget, counter),
+        Stepping::Adaptive => {
+            // The adaptive path is the fast one; where it stalls (a singular Jacobian at home, a
+            // near-fold far out) the spec's equal steps are walked from the same start, so an
+            // answer never depends on which stepping was asked for when both can arrive.
+            match adaptive(model, start.clone(), from, to, k, opts, budget, counter) {
+                Err(f) if !matches!(f.reason, NewtonFailure::Budget(_)) => {
+                    let mut r = continuation(model, start, from, to, k, opts, budget, counter)?;
+                    r.newton_iterations += f.iterations;
+                    r.fell_back_at = Some(f.progress);
+                    Ok(r)
+                }
+                other => other,
+            }
+        }
     }
 }
 
@@ -397,6 +416,8 @@ pub fn continuation(
         solution: sol,
         steps: accepted,
         newton_iterations: iters,
+        walked: Stepping::Fixed,
+        fell_back_at: None,
     })
 }
 
@@ -663,5 +684,7 @@ pub fn adaptive(
         solution: sol,
         steps: accepted,
         newton_iterations: iters,
+        walked: Stepping::Adaptive,
+        fell_back_at: None,
     })
 }

@@ -273,7 +273,10 @@ pub struct StartRequest {
 #[schema(as = continuum_workspace::ContinuationKind)]
 #[serde(rename_all = "snake_case")]
 pub enum ContinuationKind {
-    /// Adaptive step length, tangent predictor, chord Newton corrector (default).
+    /// Adaptive step length, tangent predictor, chord Newton corrector (default). Where it
+    /// stalls (e.g. a singular Jacobian at home, a path close to a fold) the fixed steps are
+    /// walked from the same start instead; `diagnostics.continuation` then says `fixed` and a
+    /// `continuation_fallback` warning says where the adaptive walk stopped.
     #[default]
     Adaptive,
     /// The spec's `K` equal steps with full Newton per step.
