@@ -3,7 +3,9 @@
 //! the stability segments M, the 31 x 31 and 61 x 61 sweeps with each stability mode, the sweep
 //! knobs (sub-steps, predictor, threads) and the assembly-mode search grid.
 //!
-//! Run: `cargo bench --bench continuum_workspace`. Plain tables (median and worst of repeated
+//! Run: `cargo bench --bench continuum_workspace [filter]`; a filter runs the tables whose name
+//! contains it (`rod`, `fk`, `fk_cold`, `stability`, `modes`, `sweep`) and the criterion
+//! benchmarks whose id matches (`fk_cold` runs the cold-start table and `fk_cold/*`). Plain tables (median and worst of repeated
 //! timings, plus process CPU time for the sweeps) are printed first for `benches/RESULTS.md`, then
 //! criterion times the hot paths.
 
@@ -12,13 +14,18 @@
 // Benchmark arithmetic stays in textbook form.
 #![allow(clippy::suboptimal_flops)]
 
+#[path = "support/mod.rs"]
+mod support;
+
 use std::hint::black_box;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mechcalc::calc::continuum_workspace::closed_form::elastica;
 use mechcalc::calc::continuum_workspace::model::{Model, Params};
-use mechcalc::calc::continuum_workspace::newton::{self, Counter, NewtonOptions, Solution};
+use mechcalc::calc::continuum_workspace::newton::{
+    self, Counter, NewtonOptions, Solution, Stepping,
+};
 use mechcalc::calc::continuum_workspace::presets::Preset;
 use mechcalc::calc::continuum_workspace::sweep::{self, Limits, StabilityCheck, SweepSettings};
 use mechcalc::calc::continuum_workspace::{
@@ -141,6 +148,7 @@ fn solve_home(model: &Model, lambda: [f64; 2], tol: f64) -> Solution {
         &home,
         &p,
         k,
+        Stepping::Fixed,
         NewtonOptions::new(tol, 50),
         &Budget::unlimited(),
         &mut Counter::default(),
@@ -294,8 +302,12 @@ fn fk_table() {
     let budget = Budget::unlimited();
     for (name, extra) in [
         (
-            "home start (20 continuation steps), no stability",
+            "home start (adaptive continuation, default), no stability",
             json!({"outputs": {"stability": false}}),
+        ),
+        (
+            "home start (fixed: 20 equal continuation steps), no stability",
+            json!({"outputs": {"stability": false}, "start": {"kind": "home", "continuation": "fixed"}}),
         ),
         (
             "home start, stability M = 20",
@@ -316,6 +328,225 @@ fn fk_table() {
             black_box(run(r.clone(), &budget).ok());
         });
         println!("| {name} | {m:.0} | {w:.0} |");
+    }
+}
+
+/// Spec 9 FK request (d1 at (-0.15, 0.2225), F = (0, -50) N) with `extra` merged at the top
+/// level and into `start`.
+fn spec_fk_request(start: Value, solver: Value) -> ContinuumWorkspaceRequest {
+    serde_json::from_value(json!({"mode": "fk", "design": {"preset": "keops_d1"},
+        "inputs_m": [-0.15, 0.2225], "load": {"force_n": [0, -50]}, "solver": solver,
+        "start": start, "outputs": {"stability": false}}))
+    .expect("valid")
+}
+
+/// Deterministic uniform numbers in [0, 1) (splitmix64).
+struct Uniform(u64);
+
+impl Uniform {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.next()
+    }
+}
+
+/// Issue 17: cold FK from home, adaptive against the spec's fixed-step continuation.
+fn fk_cold_table() {
+    let model = d1(32);
+    let refm = d1(4096);
+    let home = compute::resolve_home(&model).expect("home");
+    let p = Params {
+        lambda: vec![-0.15, 0.2225],
+        force: [0.0, -50.0],
+        moment: 0.0,
+    };
+    let rhome = compute::resolve_home(&refm).expect("home");
+    let reference = fk::from_home(
+        &refm,
+        &rhome,
+        &p,
+        30,
+        Stepping::Fixed,
+        NewtonOptions::new(1e-13, 50),
+        &Budget::unlimited(),
+        &mut Counter::default(),
+    )
+    .expect("reference")
+    .solution;
+    let (rp, rt) = (refm.position(&reference.v), refm.angle(&reference.v));
+    println!(
+        "\n### Cold FK from home: adaptive vs fixed-step continuation (spec 9 request: d1 at (-0.15, 0.2225), F = (0, -50) N, 32 RK4 steps, no stability; reference 4096 steps, tol 1e-13)\n"
+    );
+    println!(
+        "| continuation | continuation_steps | tol | steps taken | Newton iterations | evaluations | `run()` wall µs (median / worst) | `run()` CPU µs (mean) | position error [m] | angle error [deg] | Δp vs fixed, same k and tol [m] |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for (k, tol) in [
+        (20u32, 1e-10f64),
+        (10, 1e-10),
+        (30, 1e-10),
+        (20, 1e-8),
+        (20, 1e-12),
+    ] {
+        let mut fixed_pos = [f64::NAN; 2];
+        for kind in ["fixed", "adaptive"] {
+            let r = spec_fk_request(
+                json!({"kind": "home", "continuation_steps": k, "continuation": kind}),
+                json!({"rk4_steps": 32, "tol": tol}),
+            );
+            let (t, out) = support::time_for(Duration::from_millis(400), 2000, || {
+                run(r.clone(), &Budget::unlimited()).expect("fk")
+            });
+            let v = serde_json::to_value(&out).expect("json");
+            let pos = [
+                v["platform"]["position_m"][0].as_f64().unwrap_or(f64::NAN),
+                v["platform"]["position_m"][1].as_f64().unwrap_or(f64::NAN),
+            ];
+            let th = v["platform"]["parasitic_angle_deg"]
+                .as_f64()
+                .unwrap_or(f64::NAN);
+            if kind == "fixed" {
+                fixed_pos = pos;
+            }
+            let default = k == 20 && (tol - 1e-10).abs() < 1e-20 && kind == "adaptive";
+            let mark = if default { " (default)" } else { "" };
+            println!(
+                "| {kind}{mark} | {k} | {tol:e} | {} | {} | {} | {:.0} / {:.0} | {:.0} | {:.2e} | {:.2e} | {:.1e} |",
+                v["diagnostics"]["continuation_steps"],
+                v["report"]["iterations"],
+                v["report"]["evaluations"],
+                t.median_us(),
+                t.worst_us(),
+                t.cpu_s.map_or(f64::NAN, |c| c * 1e6),
+                (pos[0] - rp[0]).hypot(pos[1] - rp[1]),
+                (th - rt.to_degrees()).abs(),
+                (pos[0] - fixed_pos[0]).hypot(pos[1] - fixed_pos[1]),
+            );
+        }
+    }
+
+    let n: usize = std::env::var("CW_BENCH_TARGETS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(300);
+    println!(
+        "\n### Cold FK over {n} random targets (d1, inputs in [-0.35, -0.12] x [0.17, 0.37] m, F in [-20, 20]^2 N, 32 RK4 steps, tol 1e-10, default k; targets whose fixed-path solution is stable at M = 20)\n"
+    );
+    let opts = NewtonOptions::new(1e-10, 50);
+    let mut rng = Uniform(20_261_121);
+    let mut stats = [ColdStats::default(), ColdStats::default()];
+    let (mut stable, mut adaptive_failed, mut agree) = (0usize, 0usize, 0usize);
+    let (mut worst_dp, mut worst_dt, mut worst_dv, mut worst_df) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let tol_l = 1e-9 * model.l_ref;
+    for _ in 0..n {
+        let p = Params {
+            lambda: vec![rng.range(-0.35, -0.12), rng.range(0.17, 0.37)],
+            force: [rng.range(-20.0, 20.0), rng.range(-20.0, 20.0)],
+            moment: 0.0,
+        };
+        let k = fk::continuation_steps(&model, &home.lambda, &p.lambda);
+        let solve = |s: Stepping| {
+            let mut c = Counter::default();
+            let r = fk::from_home(&model, &home, &p, k, s, opts, &Budget::unlimited(), &mut c);
+            (r, c.evaluations)
+        };
+        let (Ok(fixed), fe) = solve(Stepping::Fixed) else {
+            continue;
+        };
+        if !fk::margin_of(&model, &fixed.solution, 20).is_some_and(|g| g > fk::STABLE_MARGIN) {
+            continue;
+        }
+        stable += 1;
+        let (adaptive, ae) = solve(Stepping::Adaptive);
+        let Ok(adaptive) = adaptive else {
+            adaptive_failed += 1;
+            continue;
+        };
+        let (a, f) = (&adaptive.solution.v, &fixed.solution.v);
+        let (pa, pf) = (model.position(a), model.position(f));
+        let dp = (pa[0] - pf[0]).hypot(pa[1] - pf[1]);
+        let dt = (model.angle(a) - model.angle(f)).abs() * model.l_ref;
+        let dv = a
+            .iter()
+            .zip(f)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        let df = adaptive
+            .solution
+            .eval
+            .forces
+            .iter()
+            .zip(&fixed.solution.eval.forces)
+            .fold(0.0f64, |m, (x, y)| {
+                m.max((x[0] - y[0]).abs()).max((x[1] - y[1]).abs())
+            });
+        if dp <= tol_l && dt <= tol_l {
+            agree += 1;
+        }
+        worst_dp = worst_dp.max(dp);
+        worst_dt = worst_dt.max(dt);
+        worst_dv = worst_dv.max(dv);
+        worst_df = worst_df.max(df);
+        let [sf, sa] = &mut stats;
+        for (st, s, r, e) in [
+            (sf, Stepping::Fixed, &fixed, fe),
+            (sa, Stepping::Adaptive, &adaptive, ae),
+        ] {
+            let (t, _) = support::time_runs(3, || solve(s));
+            st.add(r.steps, r.newton_iterations, e, t.median_us());
+        }
+    }
+    println!(
+        "Stable targets: {stable}; adaptive failed where fixed converged: {adaptive_failed}; same solution (|Δp| and L_ref |Δθ| <= 1e-9 L_ref = {tol_l:.1e} m): {agree} of {}. Worst |Δp| {worst_dp:.2e} m, worst L_ref |Δθ| {worst_dt:.2e} m, worst scaled unknown {worst_dv:.2e}, worst rod force {worst_df:.2e} N.\n",
+        stable - adaptive_failed
+    );
+    println!(
+        "| continuation | steps (mean / max) | Newton iterations (mean / max) | evaluations (mean) | solve wall µs (median / worst over targets of each target's median of 3 runs) |"
+    );
+    println!("|---|---|---|---|---|");
+    for (name, st) in [("fixed", &stats[0]), ("adaptive (default)", &stats[1])] {
+        println!("| {name} | {} |", st.row());
+    }
+}
+
+/// Per-path totals of the random-target table.
+#[derive(Default)]
+struct ColdStats {
+    steps: Vec<usize>,
+    iters: Vec<usize>,
+    evals: Vec<u64>,
+    us: Vec<f64>,
+}
+
+impl ColdStats {
+    fn add(&mut self, steps: usize, iters: usize, evals: u64, us: f64) {
+        self.steps.push(steps);
+        self.iters.push(iters);
+        self.evals.push(evals);
+        self.us.push(us);
+    }
+    fn row(&self) -> String {
+        let n = self.steps.len().max(1) as f64;
+        let mean = |v: &[usize]| v.iter().sum::<usize>() as f64 / n;
+        let max = |v: &[usize]| v.iter().copied().max().unwrap_or(0);
+        let mut us = self.us.clone();
+        us.sort_by(f64::total_cmp);
+        let med = us.get(us.len() / 2).copied().unwrap_or(f64::NAN);
+        let worst = us.last().copied().unwrap_or(f64::NAN);
+        format!(
+            "{:.1} / {} | {:.1} / {} | {:.0} | {med:.0} / {worst:.0}",
+            mean(&self.steps),
+            max(&self.steps),
+            mean(&self.iters),
+            max(&self.iters),
+            self.evals.iter().sum::<u64>() as f64 / n,
+        )
     }
 }
 
@@ -648,6 +879,19 @@ fn criterion_benches(c: &mut Criterion) {
         b.iter(|| fk::margin_of(&model, black_box(&sol), 40))
     });
     g.finish();
+
+    // Issue 17: the cold FK request of spec 9 (no stability), `run()` end to end.
+    let mut g = c.benchmark_group("fk_cold");
+    for kind in ["adaptive", "fixed"] {
+        let r = spec_fk_request(
+            json!({"kind": "home", "continuation": kind}),
+            json!({"rk4_steps": 32, "tol": 1e-10}),
+        );
+        g.bench_function(kind, |b| {
+            b.iter(|| run(black_box(r.clone()), &Budget::unlimited()).ok())
+        });
+    }
+    g.finish();
 }
 
 fn tables(_: &mut Criterion) {
@@ -657,11 +901,26 @@ fn tables(_: &mut Criterion) {
             .unwrap_or_default()
             .trim()
     );
-    rod_table();
-    fk_table();
-    stability_table();
-    modes_table();
-    sweep_tables();
+    // A positional argument (criterion's filter; option values are numbers) selects the tables whose name contains it.
+    let filters: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-') && a.parse::<f64>().is_err())
+        .collect();
+    let wanted =
+        |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()));
+    let all: [(&str, fn()); 6] = [
+        ("rod", rod_table),
+        ("fk", fk_table),
+        ("fk_cold", fk_cold_table),
+        ("stability", stability_table),
+        ("modes", modes_table),
+        ("sweep", sweep_tables),
+    ];
+    for (name, table) in all {
+        if wanted(name) {
+            table();
+        }
+    }
 }
 
 criterion_group! {

@@ -6,7 +6,7 @@
 #![allow(clippy::suboptimal_flops)]
 
 use mechcalc::calc::continuum_workspace::model::{Model, Params};
-use mechcalc::calc::continuum_workspace::newton::NewtonOptions;
+use mechcalc::calc::continuum_workspace::newton::{self, NewtonOptions};
 use mechcalc::calc::continuum_workspace::presets::Preset;
 use mechcalc::calc::continuum_workspace::sweep::{self, Limits, StabilityCheck, SweepSettings};
 use mechcalc::calc::continuum_workspace::{compute, fk, run};
@@ -181,6 +181,7 @@ fn sweep_is_independent_of_thread_count() {
             &home,
             &target,
             30,
+            newton::Stepping::Adaptive,
             opts,
             &Budget::unlimited(),
             &mut counter,
@@ -207,6 +208,82 @@ fn sweep_is_independent_of_thread_count() {
             ),
             (None, None) => {}
             _ => panic!("node accepted by one run only"),
+        }
+    }
+}
+
+/// Issue 17 (adaptive continuation): over seeded random targets and loads in design 1's stable
+/// workspace, the adaptive path from home (the default) lands on the same equilibrium as the
+/// spec's fixed-step path: the platform point P and every rod tip B_i agree to 1e-9 L_ref (the
+/// issue's criterion, on positions). The platform angle and the scaled unknowns (rod forces,
+/// base moments) are compared at what the two end solves can honestly share: both stop at
+/// `||g||_inf < tol` on the same discrete map, so they differ by at most about
+/// `||J^-1|| ||g_a - g_f|| <= cond(J) 2 sqrt(n) tol` (||J||_2 >= 1: the closure rows hold -I2 in
+/// the position columns). Measured over 300 targets (benches/RESULTS.md): P 9.5e-12 m apart,
+/// L_ref |dtheta| 9.7e-11 m, unknowns 5.8e-10; with a tighter chord tolerance one target's angle
+/// differed by L_ref |dtheta| = 6.0e-10 m, so the angle is not held to 1e-9 L_ref.
+/// Targets whose fixed-path solution is not stable (margin of spec 4.5) are outside the claim.
+/// CI runs 32 cases; `PROPTEST_CASES=300` runs the issue's few hundred.
+mod adaptive_continuation {
+    use mechcalc::calc::continuum_workspace::model::{Model, Params};
+    use mechcalc::calc::continuum_workspace::newton::{Counter, NewtonOptions, Stepping};
+    use mechcalc::calc::continuum_workspace::presets::Preset;
+    use mechcalc::calc::continuum_workspace::{compute, fk};
+    use mechcalc::numerics::Budget;
+    use proptest::prelude::*;
+    use std::sync::OnceLock;
+
+    fn model() -> &'static Model {
+        static M: OnceLock<Model> = OnceLock::new();
+        M.get_or_init(|| Model::new(Preset::KeopsD1.design(), 32, false))
+    }
+
+    proptest! {
+        #![proptest_config(crate::support::proptest_cfg::cases(32))]
+
+        #[test]
+        fn adaptive_path_reaches_the_fixed_paths_solution(
+            l0 in -0.35..-0.12f64,
+            l1 in 0.17..0.37f64,
+            fx in -20.0..20.0f64,
+            fy in -20.0..20.0f64,
+        ) {
+            let m = model();
+            let home = compute::resolve_home(m).expect("design 1 has a home");
+            let p = Params { lambda: vec![l0, l1], force: [fx, fy], moment: 0.0 };
+            let k = fk::continuation_steps(m, &home.lambda, &p.lambda);
+            let tol = 1e-10;
+            let opts = NewtonOptions::new(tol, 50);
+            let run = |s: Stepping| {
+                fk::from_home(m, &home, &p, k, s, opts, &Budget::unlimited(), &mut Counter::default())
+            };
+            let Ok(fixed) = run(Stepping::Fixed) else {
+                return Ok(());
+            };
+            let stable = fk::margin_of(m, &fixed.solution, 20).is_some_and(|g| g > fk::STABLE_MARGIN);
+            prop_assume!(stable);
+            let adaptive = run(Stepping::Adaptive);
+            prop_assert!(adaptive.is_ok(), "adaptive path failed at {:?}: {:?}", p, adaptive.err());
+            let adaptive = adaptive.expect("checked");
+            let (a, f) = (&adaptive.solution.v, &fixed.solution.v);
+            prop_assert!(adaptive.solution.eval.norm_inf() < tol);
+            let dp = {
+                let (pa, pf) = (m.position(a), m.position(f));
+                (pa[0] - pf[0]).hypot(pa[1] - pf[1])
+            };
+            let dtip = adaptive.solution.eval.tips.iter().zip(&fixed.solution.eval.tips)
+                .fold(0.0f64, |x, (u, w)| x.max((u[0] - w[0]).hypot(u[1] - w[1])));
+            let limit = 1e-9 * m.l_ref;
+            prop_assert!(dp <= limit && dtip <= limit,
+                "branch differs at {:?}: P {:.2e} m, tips {:.2e} m (limit {:.1e} m); steps {} vs {}",
+                p, dp, dtip, limit, adaptive.steps, fixed.steps);
+            let dv = a.iter().zip(f).fold(0.0f64, |x, (u, w)| x.max((u - w).abs()));
+            let cond = fk::condition(m, &fixed.solution);
+            let shared = cond * 2.0 * (a.len() as f64).sqrt() * tol;
+            let dt = (m.angle(a) - m.angle(f)).abs();
+            prop_assert!(dv <= shared && dt <= shared,
+                "unknowns differ by {:.2e}, angle by {:.2e} rad > cond(J) 2 sqrt(n) tol = {:.2e} at {:?}",
+                dv, dt, shared, p);
         }
     }
 }

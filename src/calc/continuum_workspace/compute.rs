@@ -6,7 +6,7 @@ use super::fk::{self, Described, HOME_REL_TOL, Home};
 use super::input::{Input, SeedInput, Start};
 use super::model::{Model, Params};
 use super::modes::{self, ModeResult, ModeSolution};
-use super::newton::{self, Counter, Failed, NewtonFailure, Solution};
+use super::newton::{self, Counter, Failed, NewtonFailure, Solution, Stepping};
 use super::sweep::{self, NodeData, NodeStatus, WaveResult};
 use super::wire::{FkStatus, Mode, SeedKind};
 use crate::numerics::{Budget, StopReason};
@@ -32,6 +32,8 @@ pub struct FkOutput {
     pub total_iterations: usize,
     /// Continuation steps.
     pub continuation_steps: usize,
+    /// Step control of the continuation walked from home (None: no continuation from home).
+    pub continuation: Option<Stepping>,
     /// Stability segments used (when the test ran).
     pub segments: Option<usize>,
     /// Warnings.
@@ -195,6 +197,7 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
     let mut counter = Counter::default();
     let mut warnings = input.warnings.clone();
     let mut continuation_steps = 0usize;
+    let mut continuation = None;
     let mut total_iterations = 0usize;
     let result: Result<Solution, Failed> = match &input.start {
         Start::Guess(v) => newton::solve(model, target, v, input.newton, budget, &mut counter)
@@ -232,13 +235,29 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 let k = input
                     .continuation_steps
                     .unwrap_or_else(|| fk::continuation_steps(model, &home.lambda, &target.lambda));
-                fk::from_home(model, &home, target, k, input.newton, budget, &mut counter).map(
-                    |r| {
-                        continuation_steps = r.steps;
-                        total_iterations = r.newton_iterations;
-                        r.solution
-                    },
+                continuation = Some(input.stepping);
+                fk::from_home(
+                    model,
+                    &home,
+                    target,
+                    k,
+                    input.stepping,
+                    input.newton,
+                    budget,
+                    &mut counter,
                 )
+                .map(|r| {
+                    continuation_steps = r.steps;
+                    total_iterations = r.newton_iterations;
+                    continuation = Some(r.walked);
+                    if let Some(at) = r.fell_back_at {
+                        warnings.push(format!(
+                            "continuation_fallback: the adaptive path from home stalled at {:.1} % of the way; the spec's {k} equal steps were walked instead",
+                            100.0 * at
+                        ));
+                    }
+                    r.solution
+                })
             }
             None => {
                 let res = modes::search(
@@ -311,6 +330,7 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 newton_iterations: f.iterations,
                 total_iterations: total_iterations.max(f.iterations),
                 continuation_steps,
+                continuation,
                 segments: None,
                 warnings,
                 evaluations: counter.evaluations,
@@ -356,6 +376,7 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 newton_iterations: sol.iterations,
                 total_iterations: total_iterations.max(sol.iterations),
                 continuation_steps,
+                continuation,
                 segments,
                 solution: Some((sol, described)),
                 warnings,
@@ -439,8 +460,16 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
             match &home {
                 Some(h) => {
                     let k = fk::continuation_steps(model, &h.lambda, &lam0);
-                    let r =
-                        fk::from_home(model, h, &params0, k, input.newton, budget, &mut counter);
+                    let r = fk::from_home(
+                        model,
+                        h,
+                        &params0,
+                        k,
+                        input.stepping,
+                        input.newton,
+                        budget,
+                        &mut counter,
+                    );
                     seeds.push((None, r.map(|r| r.solution).map_err(fail)));
                 }
                 None => {

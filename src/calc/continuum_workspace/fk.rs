@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 
 use super::model::{Model, Params};
-use super::newton::{self, ContinuationResult, Counter, Failed, NewtonOptions, Solution};
+use super::newton::{self, ContinuationResult, Counter, Failed, NewtonOptions, Solution, Stepping};
 use super::stability::{self, RodDisc, Tips};
 use crate::numerics::Budget;
 use crate::numerics::dense;
@@ -98,12 +98,18 @@ pub fn continuation_steps(model: &Model, from: &[f64], to: &[f64]) -> usize {
     }
 }
 
-/// Solve at home then continue to `target` (spec 4.3 rule 2).
+/// Solve at home then continue to `target` (spec 4.3 rule 2) with `stepping` (`k`: the spec's
+/// number of equal steps; the adaptive path's first step is `1/k`).
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the continuation's full context; grouping it would only rename it"
+)]
 pub fn from_home(
     model: &Model,
     home: &Home,
     target: &Params,
     k: usize,
+    stepping: Stepping,
     opts: NewtonOptions,
     budget: &Budget,
     counter: &mut Counter,
@@ -115,7 +121,8 @@ pub fn from_home(
     };
     let v0 = model.home_state(home.position);
     let start = newton::solve(model, &start_params, &v0, opts, budget, counter)?;
-    newton::continuation(
+    newton::continue_path(
+        stepping,
         model,
         start,
         &start_params,

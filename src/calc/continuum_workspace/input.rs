@@ -5,12 +5,12 @@ use std::time::Duration;
 use super::fk::{self, HOME_REL_TOL};
 use super::model::{Actuator, Design, Model, Params, Rod};
 use super::modes::{self, ModeSearch};
-use super::newton::NewtonOptions;
+use super::newton::{NewtonOptions, Stepping};
 use super::presets::Preset;
 use super::sweep::{Limits, StabilityCheck, SweepSettings};
 use super::wire::{
-    AreaMethod, ContinuumWorkspaceRequest, Mode, PresetName, RodCrossing, SeedKind,
-    StabilityCheckName, StartKind,
+    AreaMethod, ContinuationKind, ContinuumWorkspaceRequest, Mode, PresetName, RodCrossing,
+    SeedKind, StabilityCheckName, StartKind,
 };
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
@@ -103,6 +103,8 @@ pub struct Input {
     pub start: Start,
     /// Continuation step override.
     pub continuation_steps: Option<usize>,
+    /// Step control of the continuation from home.
+    pub stepping: Stepping,
     /// Run the FK stability test.
     pub stability: bool,
     /// Stability segments of FK and mode search.
@@ -493,6 +495,10 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
                     30,
                 ))
             });
+        let stepping = match start_req.as_ref().and_then(|s| s.continuation) {
+            Some(ContinuationKind::Fixed) => Stepping::Fixed,
+            Some(ContinuationKind::Adaptive) | None => Stepping::Adaptive,
+        };
         // Outputs.
         let outputs = req.outputs.clone().unwrap_or_default();
         let stability = outputs.stability.unwrap_or(true);
@@ -786,6 +792,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             newton: NewtonOptions::new(tol, usize_of(max_iter)),
             start,
             continuation_steps,
+            stepping,
             stability,
             segments: usize_of(segments),
             shape_points: usize_of(shape_points),

@@ -252,6 +252,35 @@ pub struct StartRequest {
     #[serde(default)]
     #[schema(example = 30)]
     pub continuation_steps: Option<u32>,
+    /// Step control of the continuation from home (kind = home; the path runs in the
+    /// continuation parameter t from 0 = home inputs, no load, to 1 = the request's inputs and
+    /// load): `adaptive` (default) starts with the step `1/continuation_steps`, doubles it (up
+    /// to 1/4 of the path) after a step whose chord-Newton corrector (the previous point's
+    /// Jacobian) converged in at most 3 iterations, and halves it when the corrector fails or
+    /// moves more than half the predictor's step away from the tangent prediction (down to
+    /// `1/(continuation_steps 2^8)`); `fixed` is the spec 4.3 path: `continuation_steps` equal
+    /// steps, each solved by full Newton, halved only on failure (the path of the spec's
+    /// reference values). Both end with full Newton to `solver.tol` at the target and land on
+    /// the same equilibrium branch: over 300 random stable targets of design 1 their platform
+    /// positions agree to 1e-9 `L_ref` (tests/slow/props_continuum_workspace.rs).
+    #[serde(default)]
+    #[schema(nullable = false)]
+    pub continuation: Option<ContinuationKind>,
+}
+
+/// Step control of the continuation from home (spec 4.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::ContinuationKind)]
+#[serde(rename_all = "snake_case")]
+pub enum ContinuationKind {
+    /// Adaptive step length, tangent predictor, chord Newton corrector (default). Where it
+    /// stalls (e.g. a singular Jacobian at home, a path close to a fold) the fixed steps are
+    /// walked from the same start instead; `diagnostics.continuation` then says `fixed` and a
+    /// `continuation_fallback` warning says where the adaptive walk stopped.
+    #[default]
+    Adaptive,
+    /// The spec's `K` equal steps with full Newton per step.
+    Fixed,
 }
 
 /// Optional FK outputs.
@@ -564,15 +593,20 @@ pub struct StabilityOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = continuum_workspace::DiagnosticsOut)]
 pub struct DiagnosticsOut {
-    /// Newton iterations of the final solve (the total over all continuation steps is in
-    /// `report.iterations`).
+    /// Newton iterations of the final solve (the total over all continuation steps, chord
+    /// iterations of the adaptive continuation included, is in `report.iterations`).
     pub newton_iterations: u64,
     /// `||g||_inf` at the returned point.
     pub residual_inf: f64,
     /// 2-norm condition number of the scaled Jacobian (capped at 1e20).
     pub jacobian_condition: f64,
-    /// Accepted continuation steps (home start).
+    /// Accepted continuation steps (home start; 0 otherwise).
     pub continuation_steps: u64,
+    /// Step control of the continuation from home that was walked (`start.continuation`);
+    /// absent when the start was not the continuation from home.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub continuation: Option<ContinuationKind>,
     /// Base RK4 steps per rod.
     pub rk4_steps: u32,
     /// RK4 steps actually used per rod (load rule of spec 4.1; extension).
@@ -632,7 +666,10 @@ pub struct FkResponse {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub preset: Option<PresetOut>,
-    /// Cost and stop reason.
+    /// Cost and stop reason: `iterations` counts the Newton iterations over all solves (on a
+    /// home start: every continuation step, the adaptive path's chord iterations included, and
+    /// the final solve; the steps are in `diagnostics.continuation_steps`), `evaluations` the
+    /// rod-system evaluations (residual, with or without Jacobian).
     pub report: SolverReport,
 }
 
