@@ -887,12 +887,31 @@ impl Fill<'_> {
 impl<'a> InterventionalTables<'a> {
     /// The tables of `model`'s trees for `background` (prepared rows). `None` when the budget
     /// ran out (checked after every tree).
+    ///
+    /// A tree keeps its table when a row's walk over it (its nodes plus its entries) is expected
+    /// to cost less than the pair recursion (about 3·(depth + 1) node visits per background row,
+    /// measured on the bench's models): deep trees with few background rows keep the pairs.
     #[must_use]
     pub fn new(
         model: &'a Model,
         background: &'a [Vec<f64>],
         wt: &'a InterventionalWeights,
         budget: &Budget,
+    ) -> Option<Self> {
+        let nb = background.len();
+        Self::build(model, background, wt, budget, |nodes, entries, depth| {
+            nodes + entries <= 3 * nb * (depth + 1)
+        })
+    }
+
+    /// [`InterventionalTables::new`] with the choice of table or pairs per tree given by
+    /// `keep(nodes, entries, depth)`.
+    fn build(
+        model: &'a Model,
+        background: &'a [Vec<f64>],
+        wt: &'a InterventionalWeights,
+        budget: &Budget,
+        keep: impl Fn(usize, usize, usize) -> bool,
     ) -> Option<Self> {
         let mut trees = Vec::with_capacity(model.trees.len());
         let mut entries = 0usize;
@@ -907,6 +926,7 @@ impl<'a> InterventionalTables<'a> {
             }
             let table = if entries < TABLE_MAX_ENTRIES {
                 TreeTable::build(t, &cols, nb, &mut masks)
+                    .filter(|tt| keep(t.nodes.len(), tt.entries(), t.depth()))
             } else {
                 None
             };
@@ -1107,23 +1127,32 @@ mod tests {
                 .collect::<Vec<_>>()
         };
         let bg: Vec<Vec<f64>> = (0..37).map(grid).collect();
-        let tables = InterventionalTables::new(&m, &bg, &wt, &Budget::unlimited()).unwrap();
+        let all = |_, _, _| true;
+        let tables = InterventionalTables::build(&m, &bg, &wt, &Budget::unlimited(), all).unwrap();
         assert!(tables.trees.iter().all(Option::is_some));
+        let chosen = InterventionalTables::new(&m, &bg, &wt, &Budget::unlimited()).unwrap();
+        assert!(
+            chosen.trees.iter().any(Option::is_none),
+            "some trees keep the pairs"
+        );
         let mut buf = PathBuffer::for_depth(m.max_depth());
         let forest = ShapForest::new(&m);
         for k in 0..9 {
             let x = grid(100 + 5 * k);
             let mut fast = vec![0.0; d as usize];
             tables.shap(&x, &mut fast);
+            let mut mixed = vec![0.0; d as usize];
+            chosen.shap(&x, &mut mixed);
             let mut pairs = vec![0.0; d as usize];
             for t in &m.trees {
                 interventional_pairs(t, &x, &bg, &wt, &mut pairs);
             }
-            for (a, b) in fast.iter().zip(&pairs) {
+            for ((a, b), c) in fast.iter().zip(&pairs).zip(&mixed) {
                 assert!(
                     (a - b / bg.len() as f64).abs() < 1e-13,
                     "{fast:?} vs {pairs:?}"
                 );
+                assert!((a - c).abs() < 1e-13, "{fast:?} vs {mixed:?}");
             }
             let f = m.predict_prepared(&x);
             let e = bg.iter().map(|r| m.predict_prepared(r)).sum::<f64>() / bg.len() as f64;
