@@ -1130,29 +1130,39 @@ mod tests {
         let all = |_, _, _| true;
         let tables = InterventionalTables::build(&m, &bg, &wt, &Budget::unlimited(), all).unwrap();
         assert!(tables.trees.iter().all(Option::is_some));
-        let chosen = InterventionalTables::new(&m, &bg, &wt, &Budget::unlimited()).unwrap();
+        // With 3 background rows the deep trees keep the pair recursion, the shallow ones a table.
+        let few = &bg[..3];
+        let chosen = InterventionalTables::new(&m, few, &wt, &Budget::unlimited()).unwrap();
         assert!(
             chosen.trees.iter().any(Option::is_none),
             "some trees keep the pairs"
         );
+        assert!(
+            chosen.trees.iter().any(Option::is_some),
+            "some trees keep a table"
+        );
+        let few_all = InterventionalTables::build(&m, few, &wt, &Budget::unlimited(), all).unwrap();
         let mut buf = PathBuffer::for_depth(m.max_depth());
         let forest = ShapForest::new(&m);
         for k in 0..9 {
             let x = grid(100 + 5 * k);
             let mut fast = vec![0.0; d as usize];
             tables.shap(&x, &mut fast);
-            let mut mixed = vec![0.0; d as usize];
+            let (mut mixed, mut few_tables) = (vec![0.0; d as usize], vec![0.0; d as usize]);
             chosen.shap(&x, &mut mixed);
+            few_all.shap(&x, &mut few_tables);
             let mut pairs = vec![0.0; d as usize];
             for t in &m.trees {
                 interventional_pairs(t, &x, &bg, &wt, &mut pairs);
             }
-            for ((a, b), c) in fast.iter().zip(&pairs).zip(&mixed) {
+            for (a, b) in fast.iter().zip(&pairs) {
                 assert!(
                     (a - b / bg.len() as f64).abs() < 1e-13,
                     "{fast:?} vs {pairs:?}"
                 );
-                assert!((a - c).abs() < 1e-13, "{fast:?} vs {mixed:?}");
+            }
+            for (a, c) in few_tables.iter().zip(&mixed) {
+                assert!((a - c).abs() < 1e-13, "{few_tables:?} vs {mixed:?}");
             }
             let f = m.predict_prepared(&x);
             let e = bg.iter().map(|r| m.predict_prepared(r)).sum::<f64>() / bg.len() as f64;
