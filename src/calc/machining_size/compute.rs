@@ -13,7 +13,7 @@ use super::input::{AnalyzeInput, PredictInput, TrainInput};
 use super::model::{Model, ModelSource, Routing, Tree};
 use super::pca::{self, Pca};
 use super::rng;
-use super::shap::{self, InterventionalWeights, PathBuffer};
+use super::shap::{InterventionalTables, InterventionalWeights, PathBuffer, ShapForest};
 use super::smogn::{self, Smogn};
 use super::wire::ShapKind;
 
@@ -335,6 +335,7 @@ fn shap_rows(
     let d = model.n_features;
     let phi0 = model.expected_value();
     let depth = model.max_depth();
+    let forest = ShapForest::new(model);
     let chunks: Vec<&[Vec<f64>]> = rows.chunks(ROW_CHUNK).collect();
     let parts = par_map_while(threads, &chunks, |_, chunk| {
         if budget.expired() {
@@ -346,7 +347,7 @@ fn shap_rows(
             .iter()
             .map(|x| {
                 let mut phi = vec![0.0; d];
-                shap::path_dependent(model, x, &mut phi, &mut buf);
+                forest.path_dependent(x, &mut phi, &mut buf);
                 let f = model.predict_prepared(x);
                 worst = worst.max((phi0 + phi.iter().sum::<f64>() - f).abs());
                 phi
@@ -513,6 +514,8 @@ pub fn predict(input: &PredictInput, budget: &Budget) -> Result<PredictOutput, M
             let bg = &input.background;
             let wt = InterventionalWeights::new(model.max_depth());
             let phi0 = bg.iter().map(|r| model.predict_prepared(r)).sum::<f64>() / bg.len() as f64;
+            let tables = InterventionalTables::new(model, bg, &wt, budget)
+                .ok_or_else(|| deadline("interventional SHAP", 0))?;
             let chunks: Vec<&[Vec<f64>]> = input.rows.chunks(ROW_CHUNK).collect();
             let parts = par_map_while(threads, &chunks, |_, chunk| {
                 let mut out = Vec::with_capacity(chunk.len());
@@ -522,7 +525,7 @@ pub fn predict(input: &PredictInput, budget: &Budget) -> Result<PredictOutput, M
                         return None;
                     }
                     let mut phi = vec![0.0; model.n_features];
-                    shap::interventional(model, x, bg, &wt, &mut phi);
+                    tables.shap(x, &mut phi);
                     let f = model.predict_prepared(x);
                     worst = worst.max((phi0 + phi.iter().sum::<f64>() - f).abs());
                     out.push(phi);
@@ -536,7 +539,7 @@ pub fn predict(input: &PredictInput, budget: &Budget) -> Result<PredictOutput, M
                 values.extend(v);
                 worst = worst.max(w);
             }
-            traversals += (n * bg.len()) as u64 * trees;
+            traversals += tables.traversals(n);
             Some(ShapValues {
                 expected_value: phi0,
                 values,
@@ -548,6 +551,7 @@ pub fn predict(input: &PredictInput, budget: &Budget) -> Result<PredictOutput, M
     let interactions = if input.interactions {
         let d = model.n_features;
         let depth = model.max_depth();
+        let forest = ShapForest::new(model);
         let chunks: Vec<&[Vec<f64>]> = input.rows.chunks(4).collect();
         let parts = par_map_while(threads, &chunks, |_, chunk| {
             if budget.expired() {
@@ -561,7 +565,7 @@ pub fn predict(input: &PredictInput, budget: &Budget) -> Result<PredictOutput, M
                     .map(|x| {
                         let mut phi = vec![0.0; d];
                         let mut out = vec![0.0; d * d];
-                        shap::interactions(model, x, &mut phi, &mut out, &mut buf, &mut scratch);
+                        forest.interactions(x, &mut phi, &mut out, &mut buf, &mut scratch);
                         out
                     })
                     .collect::<Vec<Vec<f64>>>(),
