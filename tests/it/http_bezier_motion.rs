@@ -1,6 +1,8 @@
 //! `POST /v1/bezier-motion-law` over HTTP: the api/ examples are answered, optional outputs only
 //! when asked, and bad requests get problem+json with a JSON pointer per offending field (400
-//! malformed, 415 content type, 422 out of range).
+//! malformed, 415 content type, 422 out of range, shape rules, wrong types, and the typed
+//! `too-large` refusals RHO_TOO_LARGE / HISTORY_TOO_LARGE); ξ ≥ 1 omits the oscillation-only
+//! outputs (never `null`) and warns.
 
 use serde_json::{Value, json};
 
@@ -79,4 +81,206 @@ async fn malformed_json_and_wrong_content_type() {
     let body = serde_json::to_vec(&example("optimize_paper")).expect("json");
     let r = common::send("POST", PATH, Some("text/plain"), body).await;
     assert_eq!(r.status, 415, "{}", String::from_utf8_lossy(&r.bytes));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Every kind of bad request: a problem+json 422 naming each offending field (spec §2).
+
+fn paper() -> Value {
+    json!({
+        "mode": "simulate",
+        "system": {"inertias_kgm2": [0.005, 0.005, 2.8], "k_Nm_per_rad": 8000.0, "c_Nms_per_rad": 35.0, "z": 0.05},
+        "motion": {"Phi_rev": 20.0, "T_s": 1.0, "m": 2, "p": 3}
+    })
+}
+
+fn with(pointer: &str, value: Value) -> Value {
+    let mut b = paper();
+    *b.pointer_mut(pointer)
+        .unwrap_or_else(|| panic!("{pointer}")) = value;
+    b
+}
+
+/// Posts `body`, asserts a 422 of `kind` naming every pointer in `pointers`, returns the problem.
+async fn rejected(body: &Value, kind: &str, pointers: &[&str]) -> Value {
+    let r = post_json(PATH, body).await;
+    let p = r.problem(422);
+    assert_eq!(p["type"], format!("/problems/{kind}"), "{p}");
+    let got = r.pointers();
+    for want in pointers {
+        assert!(got.iter().any(|g| g == want), "{want} not in {got:?}: {p}");
+    }
+    p
+}
+
+#[tokio::test]
+async fn simulates_the_paper_case_without_optional_extras() {
+    let r = post_json(PATH, &paper()).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let b = r.json();
+    let e = b["residual"]["E_T_J"].as_f64().expect("E");
+    assert!((e / 5.0327322960901e-02 - 1.0).abs() < 1e-10);
+    for key in [
+        "optimizer",
+        "reference",
+        "time_history",
+        "sensitivity",
+        "robust",
+    ] {
+        assert!(
+            b.get(key).is_none(),
+            "{key} present in simulate without being asked"
+        );
+    }
+}
+
+#[tokio::test]
+async fn each_out_of_range_field_is_422_with_its_pointer() {
+    let cases: Vec<(&str, Value)> = vec![
+        ("/system/k_Nm_per_rad", json!(0.0)),
+        ("/system/k_Nm_per_rad", json!(-8000.0)),
+        ("/system/c_Nms_per_rad", json!(-1.0)),
+        ("/system/z", json!(0.0)),
+        ("/system/z", json!(2000.0)),
+        ("/motion/T_s", json!(0.0)),
+        ("/motion/T_s", json!(2e4)),
+        ("/motion/Phi_rev", json!(0.0)),
+        ("/motion/m", json!(0)),
+        ("/motion/m", json!(7)),
+        ("/motion/p", json!(0)),
+        ("/motion/p", json!(21)),
+    ];
+    for (pointer, value) in cases {
+        rejected(&with(pointer, value), "invalid-input", &[pointer]).await;
+    }
+    let mut b = paper();
+    b["system"]["inertias_kgm2"] = json!([0.005, -1.0]);
+    rejected(&b, "invalid-input", &["/system/inertias_kgm2/1"]).await;
+    b["system"]["inertias_kgm2"] = json!([0.0, 0.0]);
+    rejected(&b, "invalid-input", &["/system/inertias_kgm2"]).await;
+}
+
+#[tokio::test]
+async fn shape_rules_are_422_with_their_pointers() {
+    // N = 2m + p − 1 > 30: Bernstein conditioning (spec §6).
+    let mut b = paper();
+    b["motion"]["m"] = json!(6);
+    b["motion"]["p"] = json!(20);
+    let p = rejected(&b, "invalid-input", &["/motion/p"]).await;
+    assert!(p.to_string().contains("N = 2m + p − 1"), "{p}");
+    // The largest admissible degree, N = 30, is answered.
+    b["motion"]["p"] = json!(19);
+    assert_eq!(post_json(PATH, &b).await.status, 200);
+    // γ of the wrong length, and one beyond 1e3·|Phi|.
+    let mut b = paper();
+    b["motion"]["gamma_rad"] = json!([1.0, 2.0]);
+    rejected(&b, "invalid-input", &["/motion/gamma_rad"]).await;
+    b["motion"]["gamma_rad"] = json!([1.0, 2.0e6, 3.0]);
+    rejected(&b, "invalid-input", &["/motion/gamma_rad/1"]).await;
+    // Both or neither of the alternatives.
+    let mut b = paper();
+    b["system"]["J_eq_kgm2"] = json!(2.81);
+    rejected(&b, "invalid-input", &["/system/J_eq_kgm2"]).await;
+    let mut b = paper();
+    b["motion"].as_object_mut().expect("obj").remove("Phi_rev");
+    rejected(&b, "invalid-input", &["/motion/Phi_rad"]).await;
+    // Every offending field at once.
+    let mut b = paper();
+    b["system"]["k_Nm_per_rad"] = json!(-1.0);
+    b["motion"]["T_s"] = json!(0.0);
+    b["outputs"] = json!({"sensitivity": {"stiffness_factors": [1.0, 0.0]}});
+    rejected(
+        &b,
+        "invalid-input",
+        &[
+            "/system/k_Nm_per_rad",
+            "/motion/T_s",
+            "/outputs/sensitivity/stiffness_factors/1",
+        ],
+    )
+    .await;
+}
+
+#[tokio::test]
+async fn wrong_types_and_unknown_fields_are_422() {
+    post_json(PATH, &with("/motion/m", json!(-2)))
+        .await
+        .problem(422);
+    post_json(PATH, &with("/mode", json!("integrate")))
+        .await
+        .problem(422);
+    let mut b = paper();
+    b["motion"]["q"] = json!(1);
+    post_json(PATH, &b).await.problem(422);
+}
+
+#[tokio::test]
+async fn too_fast_poles_are_typed_422s() {
+    // ξ = 5e5: the GL path would need rho_max = 1e6 > 2e5.
+    let body = json!({
+        "mode": "simulate",
+        "system": {"J_eq_kgm2": 1.0, "k_Nm_per_rad": 1.0, "c_Nms_per_rad": 1e6, "z": 1.0},
+        "motion": {"Phi_rad": 1.0, "T_s": 1.0}
+    });
+    let p = rejected(&body, "too-large", &["/system/c_Nms_per_rad"]).await;
+    assert_eq!(p["code"], "RHO_TOO_LARGE");
+    // A stiff joint: fine in closed form, but a history would need > 2e5 sub-steps.
+    let mut body = json!({
+        "mode": "simulate",
+        "system": {"J_eq_kgm2": 1.0, "k_Nm_per_rad": 1e13, "c_Nms_per_rad": 0.0, "z": 1.0},
+        "motion": {"Phi_rad": 1.0, "T_s": 1.0}
+    });
+    let r = post_json(PATH, &body).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    body["outputs"] = json!({"time_history": {"n_samples": 100}});
+    let p = rejected(&body, "too-large", &["/outputs/time_history/n_samples"]).await;
+    assert_eq!(p["code"], "HISTORY_TOO_LARGE");
+}
+
+#[tokio::test]
+async fn non_oscillating_joint_omits_amplitudes_and_warns() {
+    let body = json!({
+        "mode": "optimize",
+        "system": {"J_eq_kgm2": 1.0, "k_Nm_per_rad": 900.0, "c_Nms_per_rad": 90.0, "z": 1.0},
+        "motion": {"Phi_rad": 1.0, "T_s": 0.3}
+    });
+    let r = post_json(PATH, &body).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let b = r.json();
+    assert!(
+        crate::support::finite::all_numbers_finite(&b),
+        "omitted, never null: {b}"
+    );
+    for (block, key) in [
+        ("residual", "Q"),
+        ("residual", "residual_amplitude_rad"),
+        ("residual", "residual_accel_envelope_rad_s2"),
+        ("system", "omega_d_rad_s"),
+        ("system", "eta"),
+    ] {
+        assert!(
+            b[block].get(key).is_none(),
+            "{block}.{key} present at ξ = 1.5"
+        );
+    }
+    let codes: Vec<&str> = b["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(|w| w["code"].as_str())
+        .collect();
+    assert!(codes.contains(&"NOT_OSCILLATORY"), "{codes:?}");
+}
+
+#[tokio::test]
+async fn robust_setting_in_simulate_is_ignored_with_a_warning() {
+    let mut b = paper();
+    b["optimize"] = json!({"robust_stiffness_rel": 0.1});
+    let r = post_json(PATH, &b).await;
+    assert_eq!(r.status, 200);
+    let w = &r.json()["warnings"][0];
+    assert_eq!(w["code"], "ROBUST_IGNORED");
+    assert_eq!(w["pointer"], "/optimize/robust_stiffness_rel");
+    b["optimize"] = json!({"robust_stiffness_rel": 0.6});
+    rejected(&b, "invalid-input", &["/optimize/robust_stiffness_rel"]).await;
 }

@@ -15,6 +15,7 @@ mod props_irefc;
 mod props_machining_size;
 mod props_spatial_coupling;
 mod props_vibration_absorber;
+mod stress_bezier_motion;
 mod stress_bus_fuel_economy;
 mod stress_cam_law;
 mod stress_cam_law_fit;

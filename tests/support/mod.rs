@@ -6,6 +6,7 @@
     reason = "shared by several test crates; each crate uses a different part"
 )]
 
+pub mod bezier_ode;
 pub mod bus_demo_motor;
 pub mod cam_table1;
 pub mod finite;

@@ -112,12 +112,20 @@ pub struct BezierOutput {
 }
 
 /// The nominal `H`, or the typed error of spec §2 when the GL path would exceed its limit.
+///
+/// A stiffness factor can underflow `k·f` to 0 at the bottom of the `k` range (`ωn = 0`, ξ
+/// infinite or 0/0): that drive has no response matrix and is refused as non-finite.
 fn matrix_for(
     plant: &Plant,
     n: usize,
     t: f64,
     pointer: String,
 ) -> Result<ResponseMatrix, BezierMotionError> {
+    if !(plant.wn > 0.0 && plant.wn.is_finite()) || plant.xi.is_nan() {
+        return Err(BezierMotionError::NonFinite {
+            what: "natural frequency of the drive with the scaled stiffness k·f",
+        });
+    }
     response_matrix(plant, n, t).ok_or_else(|| BezierMotionError::RhoTooLarge {
         rho_max: t * plant.pole_magnitudes().1,
         limit: RHO_MAX_GL,

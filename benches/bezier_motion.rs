@@ -1,0 +1,263 @@
+//! Benchmarks of the Bezier-motion endpoint (spec §7): for V2 (paper ramp), V3 (paper optimum,
+//! min_deviation) and V7 (GL path, r = 1.8) the end state `x(T)` by (a) the production path,
+//! (b) single-panel Gauss–Legendre with Q ∈ {16, 20, 24, 28, 32, 40, 55} nodes, (c) the adaptive
+//! Dormand–Prince 5(4) integrator of tests/support/bezier_ode.rs at rtol 1e-3 … 1e-13; error =
+//! ‖Δx‖_E / ‖x_ref‖_E against the spec's truth values (V3: x_ref = the V2 truth, x_true = 0).
+//! Then the full paper-case request (`run`, all defaults; and `compute` alone), and the same
+//! request with time history and sensitivity (the api/ example).
+//!
+//! The bench asserts the spec's targets: production error ≤ 1e-13 and production time ≤ 1e-2 ×
+//! RK45(rtol = 1e-9) time.
+//!
+//! Run: `cargo bench --bench bezier_motion -- --measurement-time 2 --warm-up-time 1`. The tables
+//! for `benches/RESULTS.md` are printed before criterion runs.
+
+// `criterion_group!` generates an undocumented public function.
+#![allow(missing_docs)]
+
+#[path = "support/mod.rs"]
+mod support;
+
+#[path = "../tests/support/bezier_ode.rs"]
+#[allow(dead_code, reason = "the tests use more of it")]
+mod bezier_ode;
+
+use std::f64::consts::PI;
+use std::hint::black_box;
+use std::time::Duration;
+
+use bezier_ode::{Drive, energy_distance, energy_size, rk45_end_state};
+use criterion::{Criterion, criterion_group, criterion_main};
+use mechcalc::calc::bezier_motion::law::BezierLaw;
+use mechcalc::calc::bezier_motion::plant::{Plant, response_gl, response_matrix};
+use mechcalc::calc::bezier_motion::{BezierInput, BezierMotionRequest, compute, run};
+use mechcalc::numerics::Budget;
+use serde_json::{Value, json};
+use support::{Timing, time_for};
+
+const PHI: f64 = 40.0 * PI;
+const GL_NODES: [usize; 7] = [16, 20, 24, 28, 32, 40, 55];
+const RTOLS: [f64; 11] = [
+    1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13,
+];
+
+/// One benchmark case: drive, law, truth and the norm's reference size.
+struct Case {
+    name: &'static str,
+    plant: Plant,
+    law: BezierLaw,
+    truth: [f64; 2],
+    ref_size: f64,
+}
+
+fn paper_request(mode: &str) -> Value {
+    json!({
+        "mode": mode,
+        "system": {"inertias_kgm2": [0.005, 0.005, 2.8], "k_Nm_per_rad": 8000.0, "c_Nms_per_rad": 35.0, "z": 0.05},
+        "motion": {"Phi_rev": 20.0, "T_s": 1.0, "m": 2, "p": 3}
+    })
+}
+
+fn req(v: &Value) -> BezierMotionRequest {
+    serde_json::from_value(v.clone()).expect("valid request")
+}
+
+fn cases() -> Vec<Case> {
+    let paper = Plant::new(2.81, 8000.0, 35.0, 0.05);
+    let v2_truth = [1.3921466652460e-03, -1.7407617592708e-01];
+    let v2_size = energy_size(paper.wn, v2_truth);
+    let v3_gamma = run(req(&paper_request("optimize")), &Budget::unlimited())
+        .expect("V3 optimum")
+        .law
+        .gamma_rad;
+    let (j7, wn7, xi7) = (0.5_f64, 20.0_f64, 0.02);
+    let k7 = wn7 * wn7 * j7;
+    let v7 = Plant::new(j7, k7, 2.0 * xi7 * (k7 * j7).sqrt(), 0.1);
+    let v7_truth = [-1.88835148476e-02, -2.10350506096];
+    vec![
+        Case {
+            name: "V2",
+            plant: paper,
+            law: BezierLaw::new(2, PHI, &[PHI / 4.0, PHI / 2.0, 0.75 * PHI], 1.0),
+            truth: v2_truth,
+            ref_size: v2_size,
+        },
+        Case {
+            name: "V3",
+            plant: paper,
+            law: BezierLaw::new(2, PHI, &v3_gamma, 1.0),
+            truth: [0.0, 0.0],
+            ref_size: v2_size,
+        },
+        Case {
+            name: "V7",
+            plant: v7,
+            law: BezierLaw::new(3, 10.0, &[2.0, 4.0, 6.0, 8.0], 0.5),
+            truth: v7_truth,
+            ref_size: energy_size(v7.wn, v7_truth),
+        },
+    ]
+}
+
+impl Case {
+    fn error(&self, x: [f64; 2]) -> f64 {
+        energy_distance(self.plant.wn, x, self.truth) / self.ref_size
+    }
+    fn drive(&self) -> Drive {
+        Drive {
+            wn: self.plant.wn,
+            xi: self.plant.xi,
+            z: self.plant.z,
+        }
+    }
+}
+
+fn row(case: &str, method: &str, knob: &str, t: &Timing, err: f64, evals: &str) {
+    println!(
+        "| {case} | {method} | {knob} | {:.3} | {:.3} | {err:.1e} | {evals} |",
+        t.median_us(),
+        t.worst_us()
+    );
+}
+
+/// The knob table; returns nothing, asserts the spec's targets.
+fn print_knob_table() {
+    let short = Duration::from_millis(200);
+    println!("\n### x(T): production vs Gauss–Legendre vs RK45 (spec §7)\n");
+    println!("| case | method | knob | median µs | worst µs | error | f-evals |");
+    println!("|---|---|---|---|---|---|---|");
+    for c in cases() {
+        let n = c.law.accel_degree();
+        let t_end = c.law.t;
+        let (tp, xp) = time_for(short, 200_000, || {
+            response_matrix(black_box(&c.plant), n, t_end)
+                .expect("admissible")
+                .apply(&c.law.a)
+        });
+        let h = response_matrix(&c.plant, n, t_end).expect("admissible");
+        let label = format!("{:?} (default)", h.method);
+        let e_prod = c.error(xp);
+        row(c.name, "production", &label, &tp, e_prod, "–");
+        for q in GL_NODES {
+            let (t, x) = time_for(short, 200_000, || {
+                response_gl(black_box(&c.plant), n, t_end, 1, q).apply(&c.law.a)
+            });
+            row(
+                c.name,
+                "Gauss–Legendre",
+                &format!("Q = {q}"),
+                &t,
+                c.error(x),
+                "–",
+            );
+        }
+        let mut rk9 = None;
+        for rtol in RTOLS {
+            let (t, r) = time_for(short, 20_000, || {
+                rk45_end_state(&c.drive(), black_box(&c.law.a), t_end, rtol)
+            });
+            if rtol == 1e-9 {
+                rk9 = Some(t.median_s);
+            }
+            let knob = format!("rtol {rtol:.0e}");
+            row(
+                c.name,
+                "RK45",
+                &knob,
+                &t,
+                c.error(r.x),
+                &r.evals.to_string(),
+            );
+        }
+        let rk9 = rk9.expect("rtol 1e-9 timed");
+        assert!(
+            e_prod <= 1e-13,
+            "{}: production error {e_prod:e} > 1e-13",
+            c.name
+        );
+        assert!(
+            tp.median_s <= 1e-2 * rk9,
+            "{}: production {:.3} µs > 1e-2 × RK45(1e-9) {:.3} µs",
+            c.name,
+            tp.median_us(),
+            rk9 * 1e6
+        );
+        println!(
+            "| {} | check | error ≤ 1e-13, time ≤ 1e-2·RK45(1e-9) | {:.3} | ratio {:.1e} | {e_prod:.1e} | – |",
+            c.name,
+            tp.median_us(),
+            tp.median_s / rk9
+        );
+    }
+    println!();
+}
+
+fn print_request_table() {
+    let budget = Budget::unlimited();
+    let target = Duration::from_millis(500);
+    println!("\n### Whole requests (paper case)\n");
+    println!("| request | median µs | worst µs | CPU µs/run |");
+    println!("|---|---|---|---|");
+    let example: Value =
+        serde_json::from_str(include_str!("../api/bezier_motion/optimize_paper.json"))
+            .expect("example");
+    let mut no_peaks = paper_request("optimize");
+    no_peaks["outputs"] = json!({"kinematic_peaks": false});
+    let rows = [
+        ("optimize, all defaults: `run`", paper_request("optimize")),
+        ("optimize, kinematic peaks off: `run`", no_peaks),
+        ("simulate, all defaults: `run`", paper_request("simulate")),
+        (
+            "optimize + history (200 + 100) + sensitivity (5): `run` (api example)",
+            example,
+        ),
+    ];
+    for (name, v) in rows {
+        let r = req(&v);
+        let (t, _) = time_for(target, 200_000, || {
+            run(black_box(r.clone()), &budget).expect("runs")
+        });
+        println!(
+            "| {name} | {:.2} | {:.2} | {} |",
+            t.median_us(),
+            t.worst_us(),
+            t.cpu_s.map_or("–".into(), |c| format!("{:.2}", c * 1e6))
+        );
+    }
+    let input = BezierInput::try_from(req(&paper_request("optimize"))).expect("valid");
+    let (t, _) = time_for(target, 200_000, || {
+        compute(black_box(&input), &budget).expect("computes")
+    });
+    println!(
+        "| optimize, all defaults: `compute` only | {:.2} | {:.2} | {} |",
+        t.median_us(),
+        t.worst_us(),
+        t.cpu_s.map_or("–".into(), |c| format!("{:.2}", c * 1e6))
+    );
+    println!();
+}
+
+fn benches(c: &mut Criterion) {
+    print_knob_table();
+    print_request_table();
+    let budget = Budget::unlimited();
+    let mut g = c.benchmark_group("bezier_motion");
+    g.sample_size(20).measurement_time(Duration::from_secs(2));
+    let paper = req(&paper_request("optimize"));
+    g.bench_function("paper_optimize_defaults_run", |b| {
+        b.iter(|| run(black_box(paper.clone()), &budget))
+    });
+    let plant = Plant::new(2.81, 8000.0, 35.0, 0.05);
+    let law = BezierLaw::new(2, PHI, &[PHI / 4.0, PHI / 2.0, 0.75 * PHI], 1.0);
+    g.bench_function("v2_end_state_production", |b| {
+        b.iter(|| {
+            response_matrix(black_box(&plant), 6, 1.0)
+                .expect("admissible")
+                .apply(&law.a)
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(bezier_motion_bench, benches);
+criterion_main!(bezier_motion_bench);
