@@ -22,11 +22,10 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use mechcalc::calc::cam_law::catalogue::{NamedLaw, TABLE3};
 use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
-use mechcalc::calc::cam_law_fit::compute::{LawModel, Settings, fit};
+use mechcalc::calc::cam_law_fit::compute::{Algorithm, LawModel, Settings, fit};
 use mechcalc::calc::cam_law_fit::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
 use mechcalc::calc::cam_law_fit::optim::ga::GaParams;
 use mechcalc::calc::cam_law_fit::optim::normalized;
-use mechcalc::calc::cam_law_fit::wire::Method;
 use mechcalc::numerics::Budget;
 use mechcalc::numerics::grid::linspace;
 
@@ -212,7 +211,7 @@ fn max_err(a: &[f64], b: &[f64]) -> f64 {
 #[derive(Clone, Copy)]
 struct Variant {
     label: &'static str,
-    method: Method,
+    method: Algorithm,
     polish: bool,
     stochastic: bool,
     dtw: bool,
@@ -221,42 +220,42 @@ struct Variant {
 const VARIANTS: [Variant; 6] = [
     Variant {
         label: "GA (paper)",
-        method: Method::Ga,
+        method: Algorithm::Ga,
         polish: false,
         stochastic: true,
         dtw: true,
     },
     Variant {
         label: "DE",
-        method: Method::De,
+        method: Algorithm::De,
         polish: false,
         stochastic: true,
         dtw: true,
     },
     Variant {
         label: "DE+LSQ",
-        method: Method::De,
+        method: Algorithm::De,
         polish: true,
         stochastic: true,
         dtw: false,
     },
     Variant {
         label: "CMA-ES",
-        method: Method::Cmaes,
+        method: Algorithm::Cmaes,
         polish: false,
         stochastic: true,
         dtw: true,
     },
     Variant {
         label: "LSQ from 1/7",
-        method: Method::Lsq,
+        method: Algorithm::Lsq,
         polish: false,
         stochastic: false,
         dtw: false,
     },
     Variant {
         label: "auto",
-        method: Method::Auto,
+        method: Algorithm::Auto,
         polish: true,
         stochastic: false,
         dtw: true,

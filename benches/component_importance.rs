@@ -21,12 +21,14 @@ use mechcalc::calc::component_importance::centrality::kendall_tau_b;
 use mechcalc::calc::component_importance::compute::{self, PropagationAlgorithm};
 use mechcalc::calc::component_importance::error::Work;
 use mechcalc::calc::component_importance::graph::Digraph;
-use mechcalc::calc::component_importance::input::{ComponentImportanceInput, WeightSpec};
+use mechcalc::calc::component_importance::input::{
+    Betweenness, ComponentImportanceInput, Paths, WeightSpec,
+};
 use mechcalc::calc::component_importance::structure::{self, LevelMode};
 use mechcalc::calc::component_importance::synthetic::random_edges;
 use mechcalc::calc::component_importance::weights::variable_weights;
 use mechcalc::calc::component_importance::wire::{
-    BetweennessMode, ComponentImportanceRequest, Outputs, PathMethod,
+    BetweennessMode, ComponentImportanceRequest, Outputs,
 };
 use mechcalc::calc::component_importance::{ComponentImportanceOutput, propagation, run};
 use mechcalc::numerics::Budget;
@@ -46,8 +48,8 @@ struct Case {
     acyclic: bool,
     seed: u64,
     k: usize,
-    method: PathMethod,
-    betweenness: BetweennessMode,
+    method: Paths,
+    betweenness: Betweenness,
     n_times: usize,
 }
 
@@ -59,8 +61,8 @@ impl Case {
             acyclic: true,
             seed: 1000 + n as u64 + (d as u64) * 7,
             k,
-            method: PathMethod::Exact,
-            betweenness: BetweennessMode::AllSimplePaths,
+            method: Paths::Exact,
+            betweenness: Betweenness::AllSimplePaths,
             n_times: 1,
         }
     }
@@ -68,7 +70,7 @@ impl Case {
     fn cyclic(n: usize, d: f64, k: usize) -> Self {
         Self {
             acyclic: false,
-            betweenness: BetweennessMode::ShortestPaths,
+            betweenness: Betweenness::ShortestPaths,
             ..Self::dag(n, d, k)
         }
     }
@@ -110,7 +112,7 @@ fn input(c: &Case) -> ComponentImportanceInput {
         levels: LevelMode::Paper,
         betweenness: c.betweenness,
         max_simple_paths: 20_000_000,
-        outputs: Outputs::default(),
+        outputs: Outputs::default().into(),
         warnings: Vec::new(),
     }
 }
@@ -509,7 +511,7 @@ fn sweep_betweenness() {
             });
             let exact = compute(&inp);
             let sp = compute(&input(&Case {
-                betweenness: BetweennessMode::ShortestPaths,
+                betweenness: Betweenness::ShortestPaths,
                 ..case
             }));
             let dci = max_abs(&exact.times[0].ci, &sp.times[0].ci);
@@ -599,14 +601,14 @@ fn sweep_enumeration_budget() {
                 .unwrap()
         });
         let mut case = Case::cyclic(n, 3.0, 3);
-        case.betweenness = BetweennessMode::AllSimplePaths;
+        case.betweenness = Betweenness::AllSimplePaths;
         let mut a = input(&case);
         let (g2, csr) = Digraph::from_edges(n, &edges).unwrap();
         a.graph = g2;
         a.edge_csr = csr;
         a.max_simple_paths = 100_000_000;
         let exact = compute(&a);
-        a.betweenness = BetweennessMode::ShortestPaths;
+        a.betweenness = Betweenness::ShortestPaths;
         let sp = compute(&a);
         let per_path = et.cpu_ms.unwrap_or(et.median_ms) * 1e6 / (2.0 * paths as f64);
         println!(

@@ -469,13 +469,13 @@ fn sweep_shap(paper: &Set, reference: Option<&Value>) {
         };
         let ours = t.median_us() / prepared.len() as f64;
         let shap_pd = refnum(reference, &format!("{key}/path_dependent_us"));
-        if let Some(v) = refnum(reference, &format!("{key}/path_dependent_no_additivity_us")) {
-            if !key.is_empty() {
-                println!(
-                    "| {label} | {leaves} | (shap path-dependent without its additivity check) | — | {v:.1} | — | {:.2} |",
-                    v / ours
-                );
-            }
+        if let Some(v) = refnum(reference, &format!("{key}/path_dependent_no_additivity_us"))
+            && !key.is_empty()
+        {
+            println!(
+                "| {label} | {leaves} | (shap path-dependent without its additivity check) | — | {v:.1} | — | {:.2} |",
+                v / ours
+            );
         }
         let xgb_pd = refnum(reference, &format!("{key}/pred_contribs_us_1t"));
         println!(
@@ -533,17 +533,17 @@ fn sweep_shap(paper: &Set, reference: Option<&Value>) {
                 opt(s, 1),
                 opt(s.map(|v| v / ours), 2)
             );
-            if let Some(c) = refnum(reference, &format!("{key}/interventional_{nb}_capped_us")) {
-                if !key.is_empty() {
-                    let rows = refnum(
-                        reference,
-                        &format!("{key}/interventional_{nb}_capped_background_rows"),
-                    )
-                    .unwrap_or(f64::NAN);
-                    println!(
-                        "| {label} | {leaves} | (shap's default `data=` masker, subsampled to {rows} rows) | — | {c:.1} | — | — |"
-                    );
-                }
+            if let Some(c) = refnum(reference, &format!("{key}/interventional_{nb}_capped_us"))
+                && !key.is_empty()
+            {
+                let rows = refnum(
+                    reference,
+                    &format!("{key}/interventional_{nb}_capped_background_rows"),
+                )
+                .unwrap_or(f64::NAN);
+                println!(
+                    "| {label} | {leaves} | (shap's default `data=` masker, subsampled to {rows} rows) | — | {c:.1} | — | — |"
+                );
             }
         }
         let d = m.n_features;

@@ -3,11 +3,11 @@
 
 use super::catalogue::NamedLaw;
 use super::law::{
-    BoundaryConditions, LawError, MIN_RELATIVE_INTERVAL, Quantity, normalize_coefficients,
+    BoundaryConditions, LawError, LawNotice, MIN_RELATIVE_INTERVAL, Quantity,
+    normalize_coefficients,
 };
 use super::wire::{
     AbscissaIn, BOUNDARY_VALUE, COEFFICIENT, EvaluateRequest, GRID_COUNT, MAX_POINTS, Units,
-    Warning,
 };
 use crate::calc::{CalcFailure, Validator};
 
@@ -48,7 +48,7 @@ pub struct EvaluateInput {
     /// Requested quantities, deduplicated, in the order s, v, a, j.
     pub quantities: Vec<Quantity>,
     /// Warnings raised during validation (`coefficients_renormalized`).
-    pub warnings: Vec<Warning>,
+    pub warnings: Vec<LawNotice>,
     /// Unit labels to echo.
     pub units: Option<Units>,
 }
@@ -220,7 +220,7 @@ impl TryFrom<EvaluateRequest> for EvaluateInput {
             (Some(c), None) => {
                 check_coefficients(&mut v, c, req.normalize).map(|(coefficients, warn)| {
                     if warn {
-                        warnings.push(Warning::CoefficientsRenormalized);
+                        warnings.push(LawNotice::CoefficientsRenormalized);
                     }
                     LawChoice::SevenSegment {
                         coefficients,

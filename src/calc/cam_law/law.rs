@@ -22,7 +22,7 @@ use std::f64::consts::{FRAC_2_PI, FRAC_PI_2};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::calc::{CalcFailure, ProblemClass};
+pub use super::error::LawError;
 
 /// `K1 = 2/π` (spec §3.1): area of a unit quarter-sine pulse per unit duration.
 pub const K1: f64 = FRAC_2_PI;
@@ -234,95 +234,60 @@ pub struct Jump {
     pub a_right: f64,
 }
 
-/// Why a 7-segment law cannot be built.
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum LawError {
-    /// A coefficient is NaN or infinite.
-    #[error("coefficient {index} must be finite, got {value}")]
-    NonFiniteCoefficient {
-        /// Index 0..6.
-        index: usize,
-        /// Offending value.
-        value: f64,
-    },
-    /// A coefficient is negative.
-    #[error("coefficient {index} must be >= 0, got {value}")]
-    NegativeCoefficient {
-        /// Index 0..6.
-        index: usize,
-        /// Offending value.
-        value: f64,
-    },
-    /// The first pulse (c0, c1, c2) is empty or near-empty: A1 would be infinite.
-    #[error(
-        "the first acceleration pulse (c0, c1, c2) is empty: normalized area {area:e} < {EMPTY_PULSE_TOL:e}"
-    )]
-    EmptyFirstPulse {
-        /// Normalized pulse area `P/Δt`.
-        area: f64,
-    },
-    /// The second pulse (c4, c5, c6) is empty or near-empty: A2 would be infinite.
-    #[error(
-        "the second acceleration pulse (c4, c5, c6) is empty: normalized area {area:e} < {EMPTY_PULSE_TOL:e}"
-    )]
-    EmptySecondPulse {
-        /// Normalized pulse area `Q/Δt`.
-        area: f64,
-    },
-    /// `t_b <= t_a`.
-    #[error("t_b must be greater than t_a, got t_a = {t_a}, t_b = {t_b}")]
-    IntervalNotIncreasing {
-        /// Segment start.
-        t_a: f64,
-        /// Segment end.
-        t_b: f64,
-    },
-    /// `Δt` is too small relative to `|t_a|, |t_b|` to place knots in f64.
-    #[error(
-        "t_b - t_a = {dt:e} is too short to resolve knots at this offset (must exceed {min:e})"
-    )]
-    IntervalTooShort {
-        /// `t_b - t_a`.
-        dt: f64,
-        /// Smallest accepted value.
-        min: f64,
-    },
-    /// A boundary value is NaN or infinite.
-    #[error("{name} must be finite, got {value}")]
-    NonFiniteBoundary {
-        /// Field name (`t_a`, ..., `a_b`).
-        name: &'static str,
-        /// Offending value.
-        value: f64,
-    },
-    /// A boundary value exceeds the accepted magnitude (spec §6 item 9).
-    #[error("|{name}| must be <= {limit:e}, got {value}")]
-    MagnitudeTooLarge {
-        /// Field name.
-        name: &'static str,
-        /// Offending value.
-        value: f64,
-        /// Accepted magnitude.
-        limit: f64,
-    },
-    /// A derived quantity (peak acceleration, knot velocity, jerk) overflows f64.
-    #[error("the law's {quantity} overflows f64 (interval too short for this rise or end rates)")]
-    Overflow {
-        /// Which quantity overflowed.
-        quantity: &'static str,
-    },
+/// A non-fatal finding about a law or a fit (spec §4); the response lists its code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LawNotice {
+    /// The coefficients did not sum to 1 and were renormalized.
+    CoefficientsRenormalized,
+    /// Δs = 0 with zero end rates: the law is flat and does not depend on the coefficients.
+    NonIdentifiable,
+    /// A pulse peak has the sign opposite to the usual one for this rise or fall.
+    PeakSignUnusual,
+    /// (fit only) a channel was derived by numerical differentiation.
+    DerivedChannelNoiseGain,
+    /// (fit only) a segment is shorter than the sample spacing next to a jump.
+    SegmentBelowResolution,
+    /// (fit only) the optimizer stopped on its budget.
+    BudgetExhausted,
 }
 
-impl From<LawError> for CalcFailure {
-    fn from(e: LawError) -> Self {
-        let (class, code) = match e {
-            LawError::EmptyFirstPulse { .. } | LawError::EmptySecondPulse { .. } => {
-                (ProblemClass::InvalidInput, "EMPTY_PULSE")
-            }
-            LawError::Overflow { .. } => (ProblemClass::TooLarge, "LAW_OVERFLOW"),
-            _ => (ProblemClass::InvalidInput, "INVALID_INPUT"),
+/// A law sampled at given abscissae: the quantities asked for, each at every abscissa.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampledCurves {
+    /// Abscissae, in the caller's order.
+    pub x: Vec<f64>,
+    /// Displacement, when asked for.
+    pub s: Option<Vec<f64>>,
+    /// Velocity, when asked for.
+    pub v: Option<Vec<f64>>,
+    /// Acceleration, when asked for.
+    pub a: Option<Vec<f64>>,
+    /// Jerk, when asked for.
+    pub j: Option<Vec<f64>>,
+}
+
+impl SampledCurves {
+    /// No quantity yet at the abscissae `xs`.
+    #[must_use]
+    pub fn at(xs: &[f64]) -> Self {
+        Self {
+            x: xs.to_vec(),
+            s: None,
+            v: None,
+            a: None,
+            j: None,
+        }
+    }
+
+    /// Store the samples of quantity `q`.
+    pub fn set(&mut self, q: Quantity, values: Vec<f64>) {
+        let slot = match q {
+            Quantity::S => &mut self.s,
+            Quantity::V => &mut self.v,
+            Quantity::A => &mut self.a,
+            Quantity::J => &mut self.j,
         };
-        Self::general(class, code, e.to_string())
+        *slot = Some(values);
     }
 }
 

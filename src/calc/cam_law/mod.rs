@@ -9,7 +9,8 @@
 //!   inner loop).
 //! * [`catalogue`]: the Appendix-A laws in closed form ([`catalogue::NamedLaw`]), their peak
 //!   factors, and the Table-3 vectors ([`catalogue::TABLE3`], [`catalogue::nearest`]).
-//! * [`wire`], [`input`], [`evaluate`]: the evaluate endpoint; the HTTP layer calls [`run`].
+//! * [`wire`] → [`input`] → [`compute`] → [`output`] (errors in [`error`]): the evaluate
+//!   endpoint; the HTTP layer calls [`run`].
 //!
 //! # Validity and accuracy
 //!
@@ -24,15 +25,35 @@
 //!   on s, v, a; ≤ 3.1e-10 relative on jerk); the class members of Appendix A match their
 //!   closed forms to 6e-16 (scaled); Cramer and centroid forms of `A1, A2` agree to 1e-12
 //!   relative (property tests).
-//! * Outside the range: a typed error ([`law::LawError`] → 422), never NaN; a law whose values
+//! * Outside the range: a typed error ([`LawError`], [`EvaluateError`] → 422), never NaN; a law whose values
 //!   would overflow f64 (e.g. a rise of 1e12 over 1e-300) is rejected with `LAW_OVERFLOW`.
 //!   Jerk in segments shorter than 1e-9·Δt is evaluated but excluded from
 //!   `jerk_max_abs_finite` (it acts as a jump, spec §6 item 2).
 
 pub mod catalogue;
-pub mod evaluate;
+pub mod compute;
+pub mod error;
 pub mod input;
 pub mod law;
+pub mod output;
 pub mod wire;
 
-pub use evaluate::run;
+pub use compute::{EvaluateOutput, compute};
+pub use error::{EvaluateError, LawError};
+pub use input::EvaluateInput;
+pub use wire::{EvaluateRequest, EvaluateResponse};
+
+use crate::calc::CalcFailure;
+use crate::numerics::Budget;
+
+/// Validate, compute and build the wire response of `POST /v1/cam-law/evaluate`.
+///
+/// # Errors
+/// [`CalcFailure`] with every offending field (JSON pointers into the request) for invalid input;
+/// `LAW_OVERFLOW` / `NON_FINITE_RESULT` when the law's values would overflow f64.
+pub fn run(req: EvaluateRequest, budget: &Budget) -> Result<EvaluateResponse, CalcFailure> {
+    let input = EvaluateInput::try_from(req)?;
+    output::response_size(&input).check(budget)?;
+    let out = compute(&input, budget)?;
+    Ok(output::respond(&input, out))
+}

@@ -6,21 +6,19 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::calc::cam_law::catalogue::{TABLE3, nearest};
-use crate::calc::cam_law::law::{BoundaryConditions, JUMP_REL_TOL, Quantity, SevenSegmentLaw};
-use crate::calc::cam_law::wire::{Curves, Warning};
+use crate::calc::cam_law::law::{
+    BoundaryConditions, JUMP_REL_TOL, Jump, Knot, LawNotice, Peaks, Quantity, SampledCurves,
+    SevenSegmentLaw,
+};
 use crate::numerics::{Budget, StopReason};
 
 use super::error::FitError;
-use super::input::{FitInput, channel_index, law_quantity};
+use super::input::{Channel, FitInput, MetricKind};
 use super::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
 use super::optim::cmaes::{self, CmaParams, default_lambda};
 use super::optim::ga::{self, GaParams};
 use super::optim::lsq::{self, MAX_EVALS_PER_START};
 use super::optim::{FreeGenes, de, normalized};
-use super::wire::{
-    ChannelErrors, Classification, ErrorTable, FitCamLawResponse, FitQuantity, Method, MetricName,
-    ObjectiveOut, OptimizerReport,
-};
 use crate::numerics::grid;
 
 /// Zero entries of a Table-3 start are replaced by this before renormalizing (spec §3.5.2 step 1).
@@ -64,11 +62,26 @@ impl CurveModel for LawModel<'_> {
     }
 }
 
+/// The optimizer of a fit (spec §3.5; the request's `optimizer.method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Algorithm {
+    /// Multi-start least squares with zero-snapping (+ CMA-ES polish and IPOP for DTW).
+    Auto,
+    /// The paper's elitist GA.
+    Ga,
+    /// Differential evolution DE/best/1/bin.
+    De,
+    /// CMA-ES from the initial solution.
+    Cmaes,
+    /// One least-squares run from the initial solution (Euclidean only).
+    Lsq,
+}
+
 /// Optimizer settings of one fit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
     /// Method.
-    pub method: Method,
+    pub method: Algorithm,
     /// RNG seed.
     pub seed: u64,
     /// GA settings.
@@ -351,7 +364,7 @@ pub fn fit<M: CurveModel>(ctx: &mut Ctx<'_, M>, s: &Settings) -> FitOutcome {
     let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
 
     let main_stop = match s.method {
-        Method::Auto => {
+        Algorithm::Auto => {
             let y_norm = euclidean(ctx.data(), &vec![0.0; ctx.data().len()]);
             let exact = EXACT_FIT_REL * y_norm;
             let mut best = EnBest {
@@ -452,7 +465,7 @@ pub fn fit<M: CurveModel>(ctx: &mut Ctx<'_, M>, s: &Settings) -> FitOutcome {
             }
             StopReason::Converged
         }
-        Method::Lsq => {
+        Algorithm::Lsq => {
             starts_used = 1;
             let end = lsq::run(ctx, &s.initial, &free, s.max_evaluations);
             if s.polish {
@@ -472,10 +485,10 @@ pub fn fit<M: CurveModel>(ctx: &mut Ctx<'_, M>, s: &Settings) -> FitOutcome {
             }
             end.stop
         }
-        Method::Ga | Method::De | Method::Cmaes => {
+        Algorithm::Ga | Algorithm::De | Algorithm::Cmaes => {
             let end = match s.method {
-                Method::Ga => ga::run(ctx, &s.ga, &s.initial, &s.fixed_zero, s.seed),
-                Method::De => de::run(ctx, &s.initial, &free, s.seed),
+                Algorithm::Ga => ga::run(ctx, &s.ga, &s.initial, &s.fixed_zero, s.seed),
+                Algorithm::De => de::run(ctx, &s.initial, &free, s.seed),
                 _ => {
                     let p = CmaParams {
                         sigma0: CMAES_SIGMA,
@@ -529,53 +542,113 @@ fn check_finite(values: &[f64], quantity: &'static str) -> Result<(), FitError> 
     }
 }
 
-/// Objective of `law` against the `fit_on` channel (uncounted; used for reporting).
+/// Objective of `law` against the fitted channel (uncounted; used for reporting).
 fn objective_of(law: &SevenSegmentLaw, input: &FitInput, data: &[f64], dtw: &mut Dtw) -> f64 {
     let mut model = vec![0.0; data.len()];
-    law.eval_quantity_into(&input.xs_model, law_quantity(input.fit_on), &mut model);
-    match input.metric {
-        MetricName::Euclidean => euclidean(&model, data),
-        MetricName::Dtw => dtw.distance(&model, data, input.dtw_window),
+    let xs = &input.data.xs_model;
+    law.eval_quantity_into(xs, input.objective.on.quantity(), &mut model);
+    match input.objective.metric {
+        MetricKind::Euclidean => euclidean(&model, data),
+        MetricKind::Dtw => dtw.distance(&model, data, input.objective.dtw_window),
     }
 }
 
-/// Validated input → response (spec §3.5–§4).
+/// Distances between the fitted law and one supplied channel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelErrors {
+    /// Euclidean norm.
+    pub euclidean: f64,
+    /// DTW at the request's band radius.
+    pub dtw: f64,
+}
+
+/// The objective at the initial and the reported law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObjectiveValues {
+    /// At the initial coefficients.
+    pub initial: f64,
+    /// At the reported coefficients.
+    pub final_value: f64,
+}
+
+/// What the optimizer did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunStats {
+    /// Objective evaluations.
+    pub evaluations: u64,
+    /// Optimizer iterations.
+    pub iterations: u64,
+    /// CPU time of the fit [ms].
+    pub cpu_ms: f64,
+    /// Why the pipeline stopped.
+    pub stop: StopReason,
+    /// Least-squares starts run.
+    pub starts_used: u32,
+    /// Segments set to zero by the snap.
+    pub snapped: Vec<usize>,
+}
+
+/// The fitted law and what was asked about it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitOutput {
+    /// Normalized coefficients of the reported law.
+    pub coefficients: Vec<f64>,
+    /// Segment durations.
+    pub durations: Vec<f64>,
+    /// The 8 knots.
+    pub knots: Vec<Knot>,
+    /// Exact peaks.
+    pub peaks: Peaks,
+    /// Acceleration jumps.
+    pub jumps: Vec<Jump>,
+    /// Objective values.
+    pub objective: ObjectiveValues,
+    /// Per supplied channel (s, v, a): distances to the law, when asked for.
+    pub error_table: Option<[Option<ChannelErrors>; 3]>,
+    /// The nearest Table-3 law (`id name`) and the largest coefficient difference, when asked for.
+    pub classification: Option<(String, f64)>,
+    /// Dense curves, when asked for.
+    pub curves: Option<SampledCurves>,
+    /// Best objective per iteration (finite values), when asked for.
+    pub history: Option<Vec<f64>>,
+    /// Optimizer statistics.
+    pub stats: RunStats,
+    /// Findings (validation findings first).
+    pub warnings: Vec<LawNotice>,
+}
+
+/// Validated input → the fitted law (spec §3.5–§4).
 ///
 /// # Errors
 /// [`FitError`] when the fitted law cannot be represented in f64 (not expected after
 /// validation; never a panic).
-pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, FitError> {
+pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitOutput, FitError> {
     let started = Instant::now();
     let cap = budget
         .max_evaluations()
-        .map_or(input.max_evaluations, |m| m.min(input.max_evaluations));
+        .map_or(input.settings.max_evaluations, |m| {
+            m.min(input.settings.max_evaluations)
+        });
     let run_budget = budget.clone().with_max_evaluations(cap);
-    let fit_idx = channel_index(input.fit_on);
+    let on = input.objective.on;
     // Validation guarantees the fit channel exists (supplied or derived).
-    let data: &[f64] = input.channels[fit_idx].as_deref().unwrap_or(&[]);
+    let data: &[f64] = input.data.channels[on.index()].as_deref().unwrap_or(&[]);
     let model = LawModel {
-        xs: &input.xs_model,
+        xs: &input.data.xs_model,
         bc: input.bc,
-        quantity: law_quantity(input.fit_on),
+        quantity: on.quantity(),
     };
-    let metric = match input.metric {
-        MetricName::Euclidean => Metric::Euclidean,
-        MetricName::Dtw => Metric::Dtw {
-            window: input.dtw_window,
+    let metric = match input.objective.metric {
+        MetricKind::Euclidean => Metric::Euclidean,
+        MetricKind::Dtw => Metric::Dtw {
+            window: input.objective.dtw_window,
         },
     };
     let settings = Settings {
-        method: input.method,
-        seed: input.seed,
-        ga: input.ga,
-        dtw_global_restarts: input.dtw_global_restarts,
-        polish: input.polish,
-        snap_tol: input.snap_tol,
-        initial: input.initial,
-        fixed_zero: input.fixed_zero,
         max_evaluations: cap,
+        ..input.settings.clone()
     };
-    let mut ctx = Ctx::new(&model, data, metric, run_budget, input.history);
+    let mut ctx = Ctx::new(&model, data, metric, run_budget, input.outputs.history);
     let out = fit(&mut ctx, &settings);
     let evaluations = ctx.evaluations();
     let iterations = ctx.iterations;
@@ -588,11 +661,12 @@ pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, F
     // The reported law is rebuilt from the normalized coefficients and its objective recomputed,
     // so that `coefficients` and `objective.final` agree exactly. Elitism: never report a law
     // worse than the initial one.
+    let initial = &input.settings.initial;
     let mut dtw = Dtw::new();
     let mut law = SevenSegmentLaw::try_new(&out.coefficients, &input.bc)
-        .or_else(|_| SevenSegmentLaw::try_new(&input.initial, &input.bc))?;
+        .or_else(|_| SevenSegmentLaw::try_new(initial, &input.bc))?;
     let mut final_value = objective_of(&law, input, data, &mut dtw);
-    let initial_law = SevenSegmentLaw::try_new(&input.initial, &input.bc)?;
+    let initial_law = SevenSegmentLaw::try_new(initial, &input.bc)?;
     let initial_value = objective_of(&initial_law, input, data, &mut dtw);
     if final_value.is_nan() || final_value > initial_value {
         law = initial_law;
@@ -620,95 +694,27 @@ pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, F
             .collect::<Vec<_>>(),
         "knots",
     )?;
-
-    // Warnings (spec §4).
-    let mut warnings = input.warnings.clone();
-    let bc = &input.bc;
-    let ds = bc.s_b - bc.s_a;
-    let a_tol = JUMP_REL_TOL * peaks.a_max_abs.max(bc.a_a.abs()).max(bc.a_b.abs());
-    if ds != 0.0 && (ds.signum() * law.a1() < -a_tol || ds.signum() * law.a2() > a_tol) {
-        warnings.push(Warning::PeakSignUnusual);
-    }
-    if segment_below_resolution(&law, &input.xs_model, &jumps) {
-        warnings.push(Warning::SegmentBelowResolution);
-    }
-    if matches!(out.stop, StopReason::Deadline | StopReason::MaxEvaluations) {
-        warnings.push(Warning::BudgetExhausted);
-    }
+    let warnings = warnings(input, &law, &jumps, out.stop);
 
     // Optional outputs, each computed only when requested.
-    let error_table = if input.error_table {
-        let mut table = ErrorTable {
-            displacement: None,
-            velocity: None,
-            acceleration: None,
-        };
-        for q in [
-            FitQuantity::Displacement,
-            FitQuantity::Velocity,
-            FitQuantity::Acceleration,
-        ] {
-            if let Some(d) = input.channels[channel_index(q)].as_deref() {
-                let mut m = vec![0.0; d.len()];
-                law.eval_quantity_into(&input.xs_model, law_quantity(q), &mut m);
-                let e = ChannelErrors {
-                    euclidean: euclidean(&m, d),
-                    dtw: dtw.distance(&m, d, input.dtw_window),
-                };
-                check_finite(&[e.euclidean, e.dtw], "error table")?;
-                match q {
-                    FitQuantity::Displacement => table.displacement = Some(e),
-                    FitQuantity::Velocity => table.velocity = Some(e),
-                    FitQuantity::Acceleration => table.acceleration = Some(e),
-                }
-            }
-        }
-        Some(table)
+    let error_table = if input.outputs.error_table {
+        Some(error_table(input, &law, &mut dtw)?)
     } else {
         None
     };
-    let classification = input.classify.then(|| {
+    let classification = input.outputs.classify.then(|| {
         let (entry, dist) = nearest(law.coefficients());
-        Classification {
-            nearest: format!("{} {}", entry.id, entry.name),
-            max_coef_diff: dist,
-        }
+        (format!("{} {}", entry.id, entry.name), dist)
     });
-    let curves = if input.curve_count > 0 {
-        let xs = grid::linspace(bc.t_a, bc.t_b, input.curve_count);
-        let mut c = Curves {
-            x: xs.clone(),
-            s: None,
-            v: None,
-            a: None,
-            j: None,
-        };
-        for &q in &input.curve_quantities {
-            let mut v = vec![0.0; xs.len()];
-            law.eval_quantity_into(&xs, q, &mut v);
-            check_finite(&v, "curves")?;
-            match q {
-                Quantity::S => c.s = Some(v),
-                Quantity::V => c.v = Some(v),
-                Quantity::A => c.a = Some(v),
-                Quantity::J => c.j = Some(v),
-            }
-        }
-        Some(c)
-    } else {
-        None
-    };
+    let curves = curves(input, &law)?;
 
-    Ok(FitCamLawResponse {
+    Ok(FitOutput {
         coefficients: law.coefficients().to_vec(),
         durations: law.durations().to_vec(),
         knots,
         peaks,
-        acceleration_jumps: jumps,
-        objective: ObjectiveOut {
-            metric: input.metric,
-            quantity: input.fit_on,
-            dtw_window: (input.metric == MetricName::Dtw).then_some(input.dtw_window as u64),
+        jumps,
+        objective: ObjectiveValues {
             initial: initial_value,
             final_value,
         },
@@ -716,30 +722,84 @@ pub fn compute(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, F
         classification,
         curves,
         history,
-        optimizer_report: OptimizerReport {
-            method: input.method,
-            seed: input.seed,
+        stats: RunStats {
             evaluations,
             iterations,
             cpu_ms,
-            wall_ms: budget.elapsed_ms(),
-            stop_reason: out.stop,
+            stop: out.stop,
             starts_used: out.starts_used,
-            snapped_segments: out.snapped,
+            snapped: out.snapped,
         },
         warnings,
-        units: input.units.clone(),
     })
+}
+
+/// The findings of spec §4 (validation findings first).
+fn warnings(
+    input: &FitInput,
+    law: &SevenSegmentLaw,
+    jumps: &[Jump],
+    stop: StopReason,
+) -> Vec<LawNotice> {
+    let mut warnings = input.warnings.clone();
+    let bc = &input.bc;
+    let ds = bc.s_b - bc.s_a;
+    let a_tol = JUMP_REL_TOL * law.peaks().a_max_abs.max(bc.a_a.abs()).max(bc.a_b.abs());
+    if ds != 0.0 && (ds.signum() * law.a1() < -a_tol || ds.signum() * law.a2() > a_tol) {
+        warnings.push(LawNotice::PeakSignUnusual);
+    }
+    if segment_below_resolution(law, &input.data.xs_model, jumps) {
+        warnings.push(LawNotice::SegmentBelowResolution);
+    }
+    if matches!(stop, StopReason::Deadline | StopReason::MaxEvaluations) {
+        warnings.push(LawNotice::BudgetExhausted);
+    }
+    warnings
+}
+
+/// Distances between the law and every supplied (or derived) channel, indexed s, v, a.
+fn error_table(
+    input: &FitInput,
+    law: &SevenSegmentLaw,
+    dtw: &mut Dtw,
+) -> Result<[Option<ChannelErrors>; 3], FitError> {
+    let mut table = [None; 3];
+    for q in Channel::ALL {
+        if let Some(d) = input.data.channels[q.index()].as_deref() {
+            let mut m = vec![0.0; d.len()];
+            law.eval_quantity_into(&input.data.xs_model, q.quantity(), &mut m);
+            let e = ChannelErrors {
+                euclidean: euclidean(&m, d),
+                dtw: dtw.distance(&m, d, input.objective.dtw_window),
+            };
+            check_finite(&[e.euclidean, e.dtw], "error table")?;
+            table[q.index()] = Some(e);
+        }
+    }
+    Ok(table)
+}
+
+/// The law on a uniform grid over `[t_a, t_b]`, when asked for.
+fn curves(input: &FitInput, law: &SevenSegmentLaw) -> Result<Option<SampledCurves>, FitError> {
+    let asked = &input.outputs;
+    if asked.curve_count == 0 {
+        return Ok(None);
+    }
+    let xs = grid::linspace(input.bc.t_a, input.bc.t_b, asked.curve_count);
+    let mut c = SampledCurves::at(&xs);
+    for &q in &asked.curve_quantities {
+        let mut v = vec![0.0; xs.len()];
+        law.eval_quantity_into(&xs, q, &mut v);
+        check_finite(&v, "curves")?;
+        c.set(q, v);
+    }
+    Ok(Some(c))
 }
 
 /// `segment_below_resolution` (spec §4, §6 item 4): a non-zero segment shorter than the local
 /// sample spacing that either touches an acceleration jump of the fitted law or is itself a
 /// transition segment (0, 2, 4, 6) whose acceleration change the samples cannot resolve.
-fn segment_below_resolution(
-    law: &SevenSegmentLaw,
-    xs: &[f64],
-    jumps: &[crate::calc::cam_law::law::Jump],
-) -> bool {
+fn segment_below_resolution(law: &SevenSegmentLaw, xs: &[f64], jumps: &[Jump]) -> bool {
     if xs.len() < 2 {
         return false;
     }

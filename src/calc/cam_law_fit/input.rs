@@ -1,15 +1,19 @@
 //! Validation of a fit request into a [`FitInput`] (spec §2 "Reject with 422", §3.3 data
 //! preparation). Every offending field is collected with its JSON pointer before failing once.
 
-use crate::calc::cam_law::law::{BoundaryConditions, K1, LawError, Quantity, SevenSegmentLaw};
-use crate::calc::cam_law::wire::{Units, Warning};
+use crate::calc::cam_law::law::{
+    BoundaryConditions, K1, LawError, LawNotice, Quantity, SevenSegmentLaw,
+};
+use crate::calc::cam_law::wire::Units;
 use crate::calc::common::TIME_LIMIT_MS;
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
+use super::compute::{Algorithm, Settings};
 use super::optim::ga::GaParams;
 use super::wire;
 use super::wire::{
-    FitCamLawRequest, FitQuantity, MAX_CURVE_COUNT, MAX_SAMPLES, MIN_SAMPLES, Method, MetricName,
+    Channels, FitCamLawRequest, FitQuantity, GaIn, MAX_CURVE_COUNT, MAX_SAMPLES, MIN_SAMPLES,
+    Method, MetricName, OptimizerIn,
 };
 use crate::numerics::grid;
 
@@ -33,40 +37,49 @@ pub const DEFAULT_DTW_RESTARTS: u32 = 3;
 /// A validated fit request (SI is not imposed: units are the caller's, spec §2).
 #[derive(Debug, Clone)]
 pub struct FitInput {
+    /// The samples.
+    pub data: FitData,
+    /// Boundary conditions.
+    pub bc: BoundaryConditions,
+    /// What is compared, and how.
+    pub objective: ObjectiveSpec,
+    /// Optimizer settings (the request's evaluation cap in `max_evaluations`).
+    pub settings: Settings,
+    /// Optional outputs asked for.
+    pub outputs: FitOutputs,
+    /// Unit labels to echo.
+    pub units: Option<Units>,
+    /// Findings of validation.
+    pub warnings: Vec<LawNotice>,
+}
+
+/// The samples of a fit.
+#[derive(Debug, Clone)]
+pub struct FitData {
     /// Sample abscissae as given (strictly increasing).
     pub xs: Vec<f64>,
     /// Abscissae clamped into `[t_a, t_b]` (where the model is sampled).
     pub xs_model: Vec<f64>,
-    /// Channels s, v, a (supplied or derived), indexed by [`channel_index`].
+    /// Channels s, v, a (supplied or derived), indexed by [`Channel::index`].
     pub channels: [Option<Vec<f64>>; 3],
     /// Which channels were derived numerically.
     pub derived: [bool; 3],
-    /// The quantity the objective compares.
-    pub fit_on: FitQuantity,
-    /// Boundary conditions.
-    pub bc: BoundaryConditions,
-    /// Objective metric.
-    pub metric: MetricName,
+}
+
+/// The objective of a fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ObjectiveSpec {
+    /// The channel compared.
+    pub on: Channel,
+    /// Distance.
+    pub metric: MetricKind,
     /// DTW band radius (the request's, or 1 for the error table of Euclidean fits).
     pub dtw_window: usize,
-    /// Optimizer.
-    pub method: Method,
-    /// RNG seed.
-    pub seed: u64,
-    /// Evaluation cap.
-    pub max_evaluations: u64,
-    /// GA settings.
-    pub ga: GaParams,
-    /// IPOP restarts (DTW, `auto`).
-    pub dtw_global_restarts: u32,
-    /// Least-squares + snap polish after the stochastic methods.
-    pub polish: bool,
-    /// Zero-snap threshold.
-    pub snap_tol: f64,
-    /// Initial coefficients, normalized, fixed genes zeroed.
-    pub initial: [f64; 7],
-    /// Segments held at zero length.
-    pub fixed_zero: [bool; 7],
+}
+
+/// The optional outputs of a fit.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FitOutputs {
     /// Dense-curve point count (0 = none).
     pub curve_count: usize,
     /// Dense-curve quantities.
@@ -77,47 +90,82 @@ pub struct FitInput {
     pub history: bool,
     /// Classify against the catalogue.
     pub classify: bool,
-    /// Unit labels to echo.
-    pub units: Option<Units>,
-    /// Warnings found during validation.
-    pub warnings: Vec<Warning>,
 }
 
-/// Index of a channel in [`FitInput::channels`]: s = 0, v = 1, a = 2.
-#[must_use]
-pub fn channel_index(q: FitQuantity) -> usize {
-    match q {
-        FitQuantity::Displacement => 0,
-        FitQuantity::Velocity => 1,
-        FitQuantity::Acceleration => 2,
+/// A measured channel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Channel {
+    /// Displacement `s`.
+    Displacement,
+    /// Velocity `v`.
+    Velocity,
+    /// Acceleration `a`.
+    Acceleration,
+}
+
+impl Channel {
+    /// s, v, a.
+    pub const ALL: [Self; 3] = [Self::Displacement, Self::Velocity, Self::Acceleration];
+
+    /// Index in [`FitData::channels`]: s = 0, v = 1, a = 2.
+    #[must_use]
+    pub const fn index(self) -> usize {
+        match self {
+            Self::Displacement => 0,
+            Self::Velocity => 1,
+            Self::Acceleration => 2,
+        }
+    }
+
+    /// The law quantity of the channel.
+    #[must_use]
+    pub const fn quantity(self) -> Quantity {
+        match self {
+            Self::Displacement => Quantity::S,
+            Self::Velocity => Quantity::V,
+            Self::Acceleration => Quantity::A,
+        }
+    }
+
+    /// Wire name of the channel.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Displacement => "displacement",
+            Self::Velocity => "velocity",
+            Self::Acceleration => "acceleration",
+        }
     }
 }
 
-/// The law quantity of a channel.
-#[must_use]
-pub fn law_quantity(q: FitQuantity) -> Quantity {
-    match q {
-        FitQuantity::Displacement => Quantity::S,
-        FitQuantity::Velocity => Quantity::V,
-        FitQuantity::Acceleration => Quantity::A,
+impl From<FitQuantity> for Channel {
+    fn from(q: FitQuantity) -> Self {
+        match q {
+            FitQuantity::Displacement => Self::Displacement,
+            FitQuantity::Velocity => Self::Velocity,
+            FitQuantity::Acceleration => Self::Acceleration,
+        }
     }
 }
 
-/// Wire name of a channel.
-#[must_use]
-pub fn channel_name(q: FitQuantity) -> &'static str {
-    match q {
-        FitQuantity::Displacement => "displacement",
-        FitQuantity::Velocity => "velocity",
-        FitQuantity::Acceleration => "acceleration",
-    }
+/// The distance between model and data.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MetricKind {
+    /// Euclidean norm (paper Eq. 7).
+    Euclidean,
+    /// The paper's DTW.
+    Dtw,
 }
 
-const CHANNELS: [FitQuantity; 3] = [
-    FitQuantity::Displacement,
-    FitQuantity::Velocity,
-    FitQuantity::Acceleration,
-];
+fn algorithm(m: Method) -> Algorithm {
+    match m {
+        Method::Auto => Algorithm::Auto,
+        Method::Ga => Algorithm::Ga,
+        Method::De => Algorithm::De,
+        Method::Cmaes => Algorithm::Cmaes,
+        Method::Lsq => Algorithm::Lsq,
+    }
+}
 
 fn check_magnitudes(v: &mut Validator, pointer: &str, values: &[f64]) {
     v.all_in(pointer, "value", values, super::wire::DATA_VALUE);
@@ -199,23 +247,19 @@ fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
     }
 }
 
-/// Validate a request into a [`FitInput`].
-///
-/// # Errors
-/// [`ProblemClass::InvalidInput`] listing every offending field; [`ProblemClass::TooLarge`]
-/// when the cost estimate exceeds [`MAX_COST`]; [`ProblemClass::Infeasible`] when the boundary
-/// conditions admit no representable law of this duration (the initial law overflows f64).
-pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
-    let mut v = Validator::new();
-    let xs = abscissa(&req, &mut v);
-    let n = xs.as_ref().map(Vec::len);
-
-    // Channels.
-    let supplied = [
+/// The supplied channels s, v, a.
+fn supplied(req: &FitCamLawRequest) -> [Option<&Vec<f64>>; 3] {
+    [
         req.channels.displacement.as_ref(),
         req.channels.velocity.as_ref(),
         req.channels.acceleration.as_ref(),
-    ];
+    ]
+}
+
+/// Channels: one value per abscissa, finite and bounded; the fitted channel supplied or
+/// derivable. Returns whether every supplied channel is valid, and the fitted channel.
+fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -> (bool, Channel) {
+    let supplied = supplied(req);
     if supplied.iter().all(Option::is_none) {
         v.push(
             "/channels",
@@ -223,9 +267,9 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         );
     }
     let mut channels_ok = true;
-    for (q, ch) in CHANNELS.iter().zip(supplied) {
+    for (q, ch) in Channel::ALL.iter().zip(supplied) {
         if let Some(values) = ch {
-            let p = format!("/channels/{}", channel_name(*q));
+            let p = format!("/channels/{}", q.name());
             if let Some(n) = n
                 && values.len() != n
             {
@@ -240,21 +284,21 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
                 continue;
             }
             if v.all_finite(&p, values) {
-                check_magnitudes(&mut v, &p, values);
+                check_magnitudes(v, &p, values);
             } else {
                 channels_ok = false;
             }
         }
     }
-    let fit_on = req.fit_on.unwrap_or(FitQuantity::Acceleration);
-    let fit_idx = channel_index(fit_on);
+    let fit_on = Channel::from(req.fit_on.unwrap_or(FitQuantity::Acceleration));
+    let fit_idx = fit_on.index();
     if supplied[fit_idx].is_none() && !supplied.iter().all(Option::is_none) {
         if !req.derive_missing {
             v.push(
                 "/fit_on",
                 format!(
                     "the {} channel is not supplied: supply it, fit on a supplied channel, or set derive_missing: true",
-                    channel_name(fit_on)
+                    fit_on.name()
                 ),
             );
         } else if supplied[..fit_idx].iter().all(Option::is_none) {
@@ -262,14 +306,24 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
                 "/fit_on",
                 format!(
                     "cannot derive {} from the supplied channels: only differentiation s → v → a is offered (no integration); fit on a supplied channel",
-                    channel_name(fit_on)
+                    fit_on.name()
                 ),
             );
         }
     }
 
-    // Constraints.
+    (channels_ok, fit_on)
+}
+
+/// Boundary conditions (given, or taken from the first and last samples) and every sample
+/// inside `[t_a, t_b]`.
+fn check_constraints(
+    req: &FitCamLawRequest,
+    xs: Option<&[f64]>,
+    v: &mut Validator,
+) -> Option<BoundaryConditions> {
     let c = req.constraints;
+    let supplied = supplied(req);
     let named = [
         ("t_a", c.t_a),
         ("t_b", c.t_b),
@@ -366,25 +420,11 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         }
     }
 
-    // Objective.
-    let metric = req.objective.metric;
-    let mut dtw_window = 1usize;
-    if let Some(w) = req.objective.dtw_window {
-        let max = n.unwrap_or(MAX_SAMPLES);
-        // The window is at most N ≤ 2e5, the number of samples (a cross-field rule); every i64
-        // converts to a whole f64, far outside the range when huge.
-        let range = wire::DTW_WINDOW.max(max as f64);
-        match usize::try_from(w) {
-            Ok(wu) if range.contains(w as f64) => dtw_window = wu,
-            _ => v.push(
-                "/objective/dtw_window",
-                format!("must be in [0, N = {max}] samples, got {w}"),
-            ),
-        }
-    }
+    bc
+}
 
-    // Optimizer.
-    let o = req.optimizer;
+/// The optimizer's budgets and settings: `(max_evaluations, dtw_global_restarts, snap_tol)`.
+fn check_optimizer(o: &OptimizerIn, metric: MetricName, v: &mut Validator) -> (u64, u32, f64) {
     let method = o.method;
     if metric == MetricName::Dtw && method == Method::Lsq {
         v.push(
@@ -411,51 +451,64 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     );
     let snap_tol = o.snap_tol.unwrap_or(DEFAULT_SNAP_TOL);
     v.range("/optimizer/snap_tol", "", snap_tol, wire::SNAP_TOL);
+    (max_evaluations, dtw_global_restarts, snap_tol)
+}
+
+/// The GA settings (spec §3.5.1 defaults for every field not given).
+fn check_ga(ga_in: Option<GaIn>, v: &mut Validator) -> GaParams {
     let mut ga = GaParams::default();
-    if let Some(g) = o.ga {
-        let pg = "/optimizer/ga";
-        if let Some(p) = g.population
-            && v.uint(&format!("{pg}/population"), "", p, wire::POPULATION)
+    let Some(g) = ga_in else {
+        return ga;
+    };
+    let pg = "/optimizer/ga";
+    if let Some(p) = g.population
+        && v.uint(&format!("{pg}/population"), "", p, wire::POPULATION)
+    {
+        ga.population = usize::try_from(p).unwrap_or(100);
+    }
+    if let Some(p) = g.generations
+        && v.uint(&format!("{pg}/generations"), "", p, wire::GENERATIONS)
+    {
+        ga.generations = p;
+    }
+    if let Some(p) = g.range_every
+        && v.uint(&format!("{pg}/range_every"), "", p, wire::GENERATIONS)
+    {
+        ga.range_every = p;
+    }
+    if let Some(p) = g.stall_generations
+        && v.uint(&format!("{pg}/stall_generations"), "", p, wire::GENERATIONS)
+    {
+        ga.stall_generations = p;
+    }
+    let probs = [
+        ("p_crossover", g.p_crossover, &mut ga.p_crossover),
+        ("p_inversion", g.p_inversion, &mut ga.p_inversion),
+        (
+            "p_range_mutation",
+            g.p_range_mutation,
+            &mut ga.p_range_mutation,
+        ),
+        ("range0", g.range0, &mut ga.range0),
+        ("range_factor", g.range_factor, &mut ga.range_factor),
+        ("p_mutation", g.p_mutation, &mut ga.p_mutation),
+    ];
+    for (name, value, slot) in probs {
+        if let Some(x) = value
+            && v.range(&format!("{pg}/{name}"), "", x, wire::PROBABILITY)
         {
-            ga.population = usize::try_from(p).unwrap_or(100);
-        }
-        if let Some(p) = g.generations
-            && v.uint(&format!("{pg}/generations"), "", p, wire::GENERATIONS)
-        {
-            ga.generations = p;
-        }
-        if let Some(p) = g.range_every
-            && v.uint(&format!("{pg}/range_every"), "", p, wire::GENERATIONS)
-        {
-            ga.range_every = p;
-        }
-        if let Some(p) = g.stall_generations
-            && v.uint(&format!("{pg}/stall_generations"), "", p, wire::GENERATIONS)
-        {
-            ga.stall_generations = p;
-        }
-        let probs = [
-            ("p_crossover", g.p_crossover, &mut ga.p_crossover),
-            ("p_inversion", g.p_inversion, &mut ga.p_inversion),
-            (
-                "p_range_mutation",
-                g.p_range_mutation,
-                &mut ga.p_range_mutation,
-            ),
-            ("range0", g.range0, &mut ga.range0),
-            ("range_factor", g.range_factor, &mut ga.range_factor),
-            ("p_mutation", g.p_mutation, &mut ga.p_mutation),
-        ];
-        for (name, value, slot) in probs {
-            if let Some(x) = value
-                && v.range(&format!("{pg}/{name}"), "", x, wire::PROBABILITY)
-            {
-                *slot = x;
-            }
+            *slot = x;
         }
     }
+    ga
+}
 
-    // Initial coefficients and fixed zeros.
+/// Initial coefficients (normalized, fixed genes zeroed), the fixed-zero mask, and the pointer
+/// of the field that gave the initial law.
+fn check_initial(
+    req: &FitCamLawRequest,
+    v: &mut Validator,
+) -> ([f64; 7], [bool; 7], Option<&'static str>) {
     let mut fixed_zero = [false; 7];
     if let Some(fz) = &req.fixed_zero {
         if fz.len() == 7 {
@@ -554,8 +607,12 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         );
     }
 
-    // Outputs.
-    let (curve_count, curve_quantities) = match &req.outputs.curves {
+    (initial, fixed_zero, initial_pointer)
+}
+
+/// Dense-curve point count and quantities (each once, in request order).
+fn check_curves(req: &FitCamLawRequest, v: &mut Validator) -> (usize, Vec<Quantity>) {
+    match &req.outputs.curves {
         Some(cv) => {
             v.uint("/outputs/curves/count", "", cv.count, wire::CURVE_COUNT);
             let mut qs: Vec<Quantity> = Vec::new();
@@ -574,7 +631,120 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
             )
         }
         None => (0, Vec::new()),
-    };
+    }
+}
+
+/// Infeasible boundary conditions: the initial law must exist in f64.
+fn check_feasible(
+    initial: &[f64; 7],
+    bc: &BoundaryConditions,
+    initial_pointer: Option<&'static str>,
+) -> Result<(), CalcFailure> {
+    match SevenSegmentLaw::try_new(initial, bc) {
+        Ok(_) => {}
+        Err(e @ (LawError::EmptyFirstPulse { .. } | LawError::EmptySecondPulse { .. })) => {
+            return Err(CalcFailure::field(
+                ProblemClass::InvalidInput,
+                "EMPTY_PULSE",
+                initial_pointer.unwrap_or("/fixed_zero"),
+                format!("{e}: give the segments of that pulse a longer initial duration"),
+            ));
+        }
+        Err(e) => {
+            let (class, code) = match e {
+                LawError::Overflow { .. } => (ProblemClass::Infeasible, "INFEASIBLE_CONSTRAINTS"),
+                _ => (ProblemClass::InvalidInput, "INVALID_INPUT"),
+            };
+            return Err(CalcFailure::field(
+                class,
+                code,
+                "/constraints",
+                format!(
+                    "no 7-segment law over Δt = {} can meet these end conditions in f64 ({e}): widen [t_a, t_b], reduce the end rates or rescale the units",
+                    bc.t_b - bc.t_a
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The channels s, v, a with the ones the fit needs derived (spec §3.3, s → v → a up to the
+/// fitted channel) when `derive_missing` is set, which of them were derived, and the findings.
+fn with_derived(
+    req_channels: Channels,
+    derive_missing: bool,
+    fit_idx: usize,
+    xs: &[f64],
+    bc: &BoundaryConditions,
+) -> ([Option<Vec<f64>>; 3], [bool; 3], Vec<LawNotice>) {
+    let mut channels: [Option<Vec<f64>>; 3] = [
+        req_channels.displacement,
+        req_channels.velocity,
+        req_channels.acceleration,
+    ];
+    let mut derived = [false; 3];
+    let mut warnings = Vec::new();
+    if derive_missing {
+        // Only the channels the fit needs are derived (s → v → a up to `fit_on`).
+        for k in 1..=fit_idx {
+            if channels[k].is_none()
+                && let Some(lower) = channels[k - 1].as_ref()
+            {
+                channels[k] = Some(grid::gradient(lower, xs));
+                derived[k] = true;
+            }
+        }
+        if derived[fit_idx] {
+            warnings.push(LawNotice::DerivedChannelNoiseGain);
+        }
+    }
+    if bc.s_b - bc.s_a == 0.0 && bc.zero_end_rates() {
+        warnings.push(LawNotice::NonIdentifiable);
+    }
+    (channels, derived, warnings)
+}
+
+/// Validate a request into a [`FitInput`].
+///
+/// # Errors
+/// [`ProblemClass::InvalidInput`] listing every offending field; [`ProblemClass::TooLarge`]
+/// when the cost estimate exceeds [`MAX_COST`]; [`ProblemClass::Infeasible`] when the boundary
+/// conditions admit no representable law of this duration (the initial law overflows f64).
+pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
+    let mut v = Validator::new();
+    let xs = abscissa(&req, &mut v);
+    let n = xs.as_ref().map(Vec::len);
+
+    let (channels_ok, fit_on) = check_channels(&req, n, &mut v);
+    let fit_idx = fit_on.index();
+    let bc = check_constraints(&req, xs.as_deref(), &mut v);
+
+    // Objective.
+    let metric = req.objective.metric;
+    let mut dtw_window = 1usize;
+    if let Some(w) = req.objective.dtw_window {
+        let max = n.unwrap_or(MAX_SAMPLES);
+        // The window is at most N ≤ 2e5, the number of samples (a cross-field rule); every i64
+        // converts to a whole f64, far outside the range when huge.
+        let range = wire::DTW_WINDOW.max(max as f64);
+        match usize::try_from(w) {
+            Ok(wu) if range.contains(w as f64) => dtw_window = wu,
+            _ => v.push(
+                "/objective/dtw_window",
+                format!("must be in [0, N = {max}] samples, got {w}"),
+            ),
+        }
+    }
+
+    // Optimizer.
+    let o = req.optimizer;
+    let method = o.method;
+    let (max_evaluations, dtw_global_restarts, snap_tol) = check_optimizer(&o, metric, &mut v);
+    let ga = check_ga(o.ga, &mut v);
+
+    let (initial, fixed_zero, initial_pointer) = check_initial(&req, &mut v);
+    let (curve_count, curve_quantities) = check_curves(&req, &mut v);
     if let Some(u) = &req.units {
         u.validate(&mut v);
     }
@@ -618,59 +788,10 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         ));
     }
 
-    // Infeasible boundary conditions: the initial law must exist in f64.
-    match SevenSegmentLaw::try_new(&initial, &bc) {
-        Ok(_) => {}
-        Err(e @ (LawError::EmptyFirstPulse { .. } | LawError::EmptySecondPulse { .. })) => {
-            return Err(CalcFailure::field(
-                ProblemClass::InvalidInput,
-                "EMPTY_PULSE",
-                initial_pointer.unwrap_or("/fixed_zero"),
-                format!("{e}: give the segments of that pulse a longer initial duration"),
-            ));
-        }
-        Err(e) => {
-            let (class, code) = match e {
-                LawError::Overflow { .. } => (ProblemClass::Infeasible, "INFEASIBLE_CONSTRAINTS"),
-                _ => (ProblemClass::InvalidInput, "INVALID_INPUT"),
-            };
-            return Err(CalcFailure::field(
-                class,
-                code,
-                "/constraints",
-                format!(
-                    "no 7-segment law over Δt = {} can meet these end conditions in f64 ({e}): widen [t_a, t_b], reduce the end rates or rescale the units",
-                    bc.t_b - bc.t_a
-                ),
-            ));
-        }
-    }
+    check_feasible(&initial, &bc, initial_pointer)?;
 
-    // Channels, derived ones included (spec §3.3).
-    let mut channels: [Option<Vec<f64>>; 3] = [
-        req.channels.displacement,
-        req.channels.velocity,
-        req.channels.acceleration,
-    ];
-    let mut derived = [false; 3];
-    let mut warnings = Vec::new();
-    if req.derive_missing {
-        // Only the channels the fit needs are derived (s → v → a up to `fit_on`).
-        for k in 1..=fit_idx {
-            if channels[k].is_none()
-                && let Some(lower) = channels[k - 1].as_ref()
-            {
-                channels[k] = Some(grid::gradient(lower, &xs));
-                derived[k] = true;
-            }
-        }
-        if derived[fit_idx] {
-            warnings.push(Warning::DerivedChannelNoiseGain);
-        }
-    }
-    if bc.s_b - bc.s_a == 0.0 && bc.zero_end_rates() {
-        warnings.push(Warning::NonIdentifiable);
-    }
+    let (channels, derived, warnings) =
+        with_derived(req.channels, req.derive_missing, fit_idx, &xs, &bc);
     let xs_model = xs.iter().map(|x| x.clamp(bc.t_a, bc.t_b)).collect();
     let dtw_window = if metric == MetricName::Dtw {
         dtw_window.min(n)
@@ -679,28 +800,39 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     };
 
     Ok(FitInput {
-        xs,
-        xs_model,
-        channels,
-        derived,
-        fit_on,
+        data: FitData {
+            xs,
+            xs_model,
+            channels,
+            derived,
+        },
         bc,
-        metric,
-        dtw_window,
-        method,
-        seed: o.seed.unwrap_or(0),
-        max_evaluations,
-        ga,
-        dtw_global_restarts,
-        polish: o.polish.unwrap_or(true),
-        snap_tol,
-        initial,
-        fixed_zero,
-        curve_count,
-        curve_quantities,
-        error_table: req.outputs.error_table.unwrap_or(true),
-        history: req.outputs.history.unwrap_or(false),
-        classify: req.outputs.classify.unwrap_or(true),
+        objective: ObjectiveSpec {
+            on: fit_on,
+            metric: match metric {
+                MetricName::Euclidean => MetricKind::Euclidean,
+                MetricName::Dtw => MetricKind::Dtw,
+            },
+            dtw_window,
+        },
+        settings: Settings {
+            method: algorithm(method),
+            seed: o.seed.unwrap_or(0),
+            ga,
+            dtw_global_restarts,
+            polish: o.polish.unwrap_or(true),
+            snap_tol,
+            initial,
+            fixed_zero,
+            max_evaluations,
+        },
+        outputs: FitOutputs {
+            curve_count,
+            curve_quantities,
+            error_table: req.outputs.error_table.unwrap_or(true),
+            history: req.outputs.history.unwrap_or(false),
+            classify: req.outputs.classify.unwrap_or(true),
+        },
         units: req.units,
         warnings,
     })

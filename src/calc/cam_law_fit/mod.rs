@@ -12,7 +12,9 @@
 //! * [`optim`]: least squares (`levenberg-marquardt` crate, x² parametrization), the paper's GA
 //!   (§3.5.1), scipy-style DE and a small CMA-ES with IPOP restarts.
 //! * [`compute`]: the `auto` pipeline (§3.5.2: multi-start least squares, zero-snap, DTW
-//!   CMA-ES polish + IPOP) and the response (§3.6, §4).
+//!   CMA-ES polish + IPOP) and the reported law (§3.6, §4); no wire types.
+//! * [`wire`] → [`input`] → [`compute`] → [`output`] (errors in [`error`]): the endpoint; the
+//!   HTTP layer calls [`run`].
 //!
 //! # Validity and accuracy
 //!
@@ -40,6 +42,7 @@ pub mod error;
 pub mod input;
 pub mod objective;
 pub mod optim;
+pub mod output;
 pub mod wire;
 
 use std::time::Duration;
@@ -47,7 +50,9 @@ use std::time::Duration;
 use crate::calc::CalcFailure;
 use crate::numerics::Budget;
 
+pub use compute::{FitOutput, compute};
 pub use error::FitError;
+pub use input::FitInput;
 pub use wire::{FitCamLawRequest, FitCamLawResponse};
 
 /// Validate, fit and build the response of `POST /v1/fit-cam-law`.
@@ -58,7 +63,8 @@ pub use wire::{FitCamLawRequest, FitCamLawResponse};
 /// meet in f64.
 pub fn run(req: FitCamLawRequest, budget: &Budget) -> Result<FitCamLawResponse, CalcFailure> {
     let input = input::validate(req)?;
-    Ok(compute::compute(&input, budget)?)
+    let out = compute(&input, budget)?;
+    Ok(output::respond(&input, out, budget))
 }
 
 /// The request's own wall-clock limit (`optimizer.time_limit_ms`, default 10 000 ms).

@@ -4,12 +4,11 @@
 use super::centrality;
 use super::error::{ComponentImportanceError, Work};
 use super::graph::Digraph;
-use super::input::{ComponentImportanceInput, WeightSpec};
+use super::input::{Betweenness, ComponentImportanceInput, Finding, Paths, WeightSpec};
 use super::propagation::{self, LengthSums};
 use super::reliability::{failure_probability, hazard_rate};
 use super::structure::{self, Structure};
 use super::weights::{entropy_weights, rank_descending, variable_weights};
-use super::wire::{BetweennessMode, PathMethod, Warning};
 use crate::numerics::Budget;
 
 /// Normalized indices must sum to 1 to this tolerance in the final check (n ≤ 2000 terms of
@@ -144,13 +143,13 @@ pub struct ComponentImportanceOutput {
     /// Optional centralities.
     pub centralities: Option<CentralityOutput>,
     /// Warnings (validation warnings first).
-    pub warnings: Vec<Warning>,
+    pub warnings: Vec<Finding>,
     /// Work done.
     pub work: Work,
 }
 
-fn warn(code: &str, detail: String, pointer: Option<String>) -> Warning {
-    Warning {
+fn warn(code: &str, detail: String, pointer: Option<String>) -> Finding {
+    Finding {
         code: code.to_owned(),
         detail,
         pointer,
@@ -206,12 +205,11 @@ pub fn compute_structure(
     let g = &input.graph;
     let need_bfs =
         input.efficiency_override.iter().any(Option::is_none) || input.outputs.centralities;
-    let brandes =
-        if input.betweenness == BetweennessMode::ShortestPaths || input.outputs.centralities {
-            Some(structure::shortest_path_betweenness(g, budget, work)?)
-        } else {
-            None
-        };
+    let brandes = if input.betweenness == Betweenness::ShortestPaths || input.outputs.centralities {
+        Some(structure::shortest_path_betweenness(g, budget, work)?)
+    } else {
+        None
+    };
     let reach = match &brandes {
         Some(b) => Some(b.reach.clone()),
         None if need_bfs => Some(structure::distances(g, budget, work)?),
@@ -226,7 +224,7 @@ pub fn compute_structure(
         .map(|(&c, o)| o.unwrap_or(c))
         .collect();
     let (betweenness, algorithm) = match (input.betweenness, is_dag, &brandes) {
-        (BetweennessMode::ShortestPaths, _, Some(b)) => {
+        (Betweenness::ShortestPaths, _, Some(b)) => {
             (b.edge.clone(), BetweennessAlgorithm::BrandesShortestPaths)
         }
         (_, true, _) => (
@@ -336,34 +334,169 @@ pub fn index(
     })
 }
 
-/// Run the whole method.
-///
-/// # Errors
-/// [`ComponentImportanceError`] for over-budget enumeration, an exhausted time budget, a hazard
-/// rate beyond f64, or a failed final consistency check.
-pub fn compute(
+/// F, λ [1/h] and RI [1/h] per component.
+type Rates = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// F, λ and RI of every component at time `t` (index `ti`), overrides applied.
+fn reliability_at(
     input: &ComponentImportanceInput,
+    ti: usize,
+    t: f64,
+) -> Result<Rates, ComponentImportanceError> {
+    let n = input.graph.n();
+    let mut f = vec![0.0; n];
+    let mut lambda = vec![0.0; n];
+    let mut ri = vec![0.0; n];
+    for i in 0..n {
+        let fo = input.f_override[ti].as_ref().and_then(|r| r[i]);
+        let ro = input.ri_override[ti].as_ref().and_then(|r| r[i]);
+        if let Some((eta, beta)) = input.weibull[i] {
+            lambda[i] = hazard_rate(t, eta, beta);
+            f[i] = failure_probability(t, eta, beta);
+        }
+        if let Some(x) = fo {
+            f[i] = x;
+        }
+        ri[i] = match ro {
+            Some(x) => x,
+            None => lambda[i] * input.mode_sum[i].unwrap_or(0.0),
+        };
+        if !lambda[i].is_finite() || !ri[i].is_finite() {
+            return Err(ComponentImportanceError::RateOverflow {
+                component: i,
+                id: input.ids[i].clone(),
+                time_index: ti,
+                time_h: t,
+                lambda: lambda[i],
+                ri: ri[i],
+            });
+        }
+    }
+    Ok((f, lambda, ri))
+}
+
+/// The findings about the two indices at time `t` (index `ti`).
+fn index_warnings(
+    warnings: &mut Vec<Finding>,
+    ti: usize,
+    t: f64,
+    probability: &IndexOutput,
+    risk: &IndexOutput,
+) {
+    for (name, ix) in [("probability", probability), ("risk", risk)] {
+        if ix.ln_raw.iter().all(|l| *l == f64::NEG_INFINITY) {
+            warnings.push(warn(
+                "ZERO_INDEX",
+                format!(
+                    "the {name} index is 0 for every component at t = {t} h (no component \
+                     with an out-edge has a positive {}); its normalized values are 0",
+                    if name == "risk" { "RI" } else { "F" }
+                ),
+                Some(format!("/times_h/{ti}")),
+            ));
+        } else if ix.tail_bound.is_none() {
+            warnings.push(warn(
+                "TRUNCATION_BOUND_VOID",
+                format!(
+                    "{name} index at t = {t} h: row-sum norm rho = {:.6e} >= 1, so the \
+                     truncation bound rho^K/(1-rho) of the path cap is void (the K-capped sum \
+                     is still finite)",
+                    ix.ln_rho.exp()
+                ),
+                Some(format!("/times_h/{ti}")),
+            ));
+        }
+        if ix.raw.is_none() {
+            warnings.push(warn(
+                "RAW_INDEX_OVERFLOW",
+                format!(
+                    "the raw {name} index at t = {t} h exceeds the f64 range and is omitted; \
+                     normalized values are computed in log space and exact"
+                ),
+                Some(format!("/times_h/{ti}")),
+            ));
+        }
+    }
+}
+
+/// The comparison centralities and their Kendall τ-b against CI at every time.
+fn centralities(
+    input: &ComponentImportanceInput,
+    node_betweenness: Option<Vec<f64>>,
+    reach: Option<&structure::Reach>,
+    times: &[TimeOutput],
     budget: &Budget,
-) -> Result<ComponentImportanceOutput, ComponentImportanceError> {
+    work: &mut Work,
+) -> Result<CentralityOutput, ComponentImportanceError> {
     let g = &input.graph;
     let n = g.n();
-    let mut work = Work::default();
-    let mut warnings = input.warnings.clone();
-    let topo = g.topological_order();
-    let is_dag = topo.is_some();
-    let StructureParts {
-        structure: st,
-        algorithm: betweenness_algorithm,
-        reach,
-        node_betweenness,
-    } = compute_structure(input, is_dag, budget, &mut work)?;
-    let k = input.path_cap;
-    let propagation_algorithm = match (input.path_method, is_dag) {
-        (_, true) => PropagationAlgorithm::DagWalks,
-        (PathMethod::Walks, false) => PropagationAlgorithm::Walks,
-        (PathMethod::Exact, false) if k <= 3 => PropagationAlgorithm::ClosedFormK3,
-        (PathMethod::Exact, false) => PropagationAlgorithm::SimplePathDfs,
+    let node_bc = match node_betweenness {
+        Some(b) => b,
+        None => structure::shortest_path_betweenness(g, budget, work)?.node,
     };
+    let pr = centrality::pagerank_reversed(g, budget, work)?;
+    let closeness = reach.map_or_else(|| vec![0.0; n], centrality::outward_closeness);
+    let out_degree: Vec<f64> = (0..n).map(|i| structure::to_f64(g.out_degree(i))).collect();
+    let in_degree: Vec<f64> = (0..n).map(|i| structure::to_f64(g.in_degree(i))).collect();
+    let betweenness = centrality::normalized_node_betweenness(&node_bc);
+    let tau_b = times
+        .iter()
+        .map(|t| {
+            [&out_degree, &in_degree, &betweenness, &closeness, &pr]
+                .map(|m| centrality::kendall_tau_b(m, &t.ci))
+        })
+        .collect();
+    Ok(CentralityOutput {
+        out_degree,
+        in_degree,
+        betweenness,
+        closeness_out: closeness,
+        pagerank_reversed: pr,
+        tau_b,
+    })
+}
+
+/// Per time: the variable weights, CI and the ranking, from reliability and the two indices.
+fn combine(per_time: Vec<PerTime>, constant_weights: [f64; 2], n: usize) -> Vec<TimeOutput> {
+    let mut times = Vec::with_capacity(per_time.len());
+    for (t, f, lambda, ri, probability, risk) in per_time {
+        let mut wp = vec![0.0; n];
+        let mut wr = vec![0.0; n];
+        let mut ci = vec![0.0; n];
+        for i in 0..n {
+            let (w, c) = variable_weights([probability.fp[i], risk.fp[i]], constant_weights);
+            wp[i] = w[0];
+            wr[i] = w[1];
+            ci[i] = c;
+        }
+        let rank = rank_descending(&ci);
+        times.push(TimeOutput {
+            time_h: t,
+            f,
+            lambda,
+            ri,
+            probability,
+            risk,
+            weights_probability: wp,
+            weights_risk: wr,
+            ci,
+            rank,
+        });
+    }
+    times
+}
+
+/// One time's reliability (F, λ, RI) and its two indices, before weighting.
+type PerTime = (f64, Vec<f64>, Vec<f64>, Vec<f64>, IndexOutput, IndexOutput);
+
+/// The findings about the graph as a whole: walks on a cyclic graph, isolated components.
+fn graph_warnings(
+    input: &ComponentImportanceInput,
+    propagation_algorithm: PropagationAlgorithm,
+    warnings: &mut Vec<Finding>,
+) {
+    let g = &input.graph;
+    let n = g.n();
     if propagation_algorithm == PropagationAlgorithm::Walks {
         warnings.push(warn(
             "WALKS_UPPER_BOUND",
@@ -388,39 +521,43 @@ pub fn compute(
             None,
         ));
     }
+}
+
+/// Run the whole method.
+///
+/// # Errors
+/// [`ComponentImportanceError`] for over-budget enumeration, an exhausted time budget, a hazard
+/// rate beyond f64, or a failed final consistency check.
+pub fn compute(
+    input: &ComponentImportanceInput,
+    budget: &Budget,
+) -> Result<ComponentImportanceOutput, ComponentImportanceError> {
+    let g = &input.graph;
+    let n = g.n();
+    let mut work = Work::default();
+    let mut warnings = input.warnings.clone();
+    let topo = g.topological_order();
+    let is_dag = topo.is_some();
+    let StructureParts {
+        structure: st,
+        algorithm: betweenness_algorithm,
+        reach,
+        node_betweenness,
+    } = compute_structure(input, is_dag, budget, &mut work)?;
+    let k = input.path_cap;
+    let propagation_algorithm = match (input.path_method, is_dag) {
+        (_, true) => PropagationAlgorithm::DagWalks,
+        (Paths::Walks, false) => PropagationAlgorithm::Walks,
+        (Paths::Exact, false) if k <= 3 => PropagationAlgorithm::ClosedFormK3,
+        (Paths::Exact, false) => PropagationAlgorithm::SimplePathDfs,
+    };
+    graph_warnings(input, propagation_algorithm, &mut warnings);
 
     // Per time: reliability and the two indices.
     let mut per_time = Vec::with_capacity(input.times_h.len());
     for (ti, &t) in input.times_h.iter().enumerate() {
         work.check(budget, "per-time indices")?;
-        let mut f = vec![0.0; n];
-        let mut lambda = vec![0.0; n];
-        let mut ri = vec![0.0; n];
-        for i in 0..n {
-            let fo = input.f_override[ti].as_ref().and_then(|r| r[i]);
-            let ro = input.ri_override[ti].as_ref().and_then(|r| r[i]);
-            if let Some((eta, beta)) = input.weibull[i] {
-                lambda[i] = hazard_rate(t, eta, beta);
-                f[i] = failure_probability(t, eta, beta);
-            }
-            if let Some(x) = fo {
-                f[i] = x;
-            }
-            ri[i] = match ro {
-                Some(x) => x,
-                None => lambda[i] * input.mode_sum[i].unwrap_or(0.0),
-            };
-            if !lambda[i].is_finite() || !ri[i].is_finite() {
-                return Err(ComponentImportanceError::RateOverflow {
-                    component: i,
-                    id: input.ids[i].clone(),
-                    time_index: ti,
-                    time_h: t,
-                    lambda: lambda[i],
-                    ri: ri[i],
-                });
-            }
-        }
+        let (f, lambda, ri) = reliability_at(input, ti, t)?;
         let probability = index(
             g,
             &st.he,
@@ -443,40 +580,7 @@ pub fn compute(
             budget,
             &mut work,
         )?;
-        for (name, ix) in [("probability", &probability), ("risk", &risk)] {
-            if ix.ln_raw.iter().all(|l| *l == f64::NEG_INFINITY) {
-                warnings.push(warn(
-                    "ZERO_INDEX",
-                    format!(
-                        "the {name} index is 0 for every component at t = {t} h (no component \
-                         with an out-edge has a positive {}); its normalized values are 0",
-                        if name == "risk" { "RI" } else { "F" }
-                    ),
-                    Some(format!("/times_h/{ti}")),
-                ));
-            } else if ix.tail_bound.is_none() {
-                warnings.push(warn(
-                    "TRUNCATION_BOUND_VOID",
-                    format!(
-                        "{name} index at t = {t} h: row-sum norm rho = {:.6e} >= 1, so the \
-                         truncation bound rho^K/(1-rho) of the path cap is void (the K-capped sum \
-                         is still finite)",
-                        ix.ln_rho.exp()
-                    ),
-                    Some(format!("/times_h/{ti}")),
-                ));
-            }
-            if ix.raw.is_none() {
-                warnings.push(warn(
-                    "RAW_INDEX_OVERFLOW",
-                    format!(
-                        "the raw {name} index at t = {t} h exceeds the f64 range and is omitted; \
-                         normalized values are computed in log space and exact"
-                    ),
-                    Some(format!("/times_h/{ti}")),
-                ));
-            }
-        }
+        index_warnings(&mut warnings, ti, t, &probability, &risk);
         per_time.push((t, f, lambda, ri, probability, risk));
     }
 
@@ -503,59 +607,17 @@ pub fn compute(
         }
     };
 
-    let mut times = Vec::with_capacity(per_time.len());
-    for (t, f, lambda, ri, probability, risk) in per_time {
-        let mut wp = vec![0.0; n];
-        let mut wr = vec![0.0; n];
-        let mut ci = vec![0.0; n];
-        for i in 0..n {
-            let (w, c) = variable_weights([probability.fp[i], risk.fp[i]], constant_weights);
-            wp[i] = w[0];
-            wr[i] = w[1];
-            ci[i] = c;
-        }
-        let rank = rank_descending(&ci);
-        times.push(TimeOutput {
-            time_h: t,
-            f,
-            lambda,
-            ri,
-            probability,
-            risk,
-            weights_probability: wp,
-            weights_risk: wr,
-            ci,
-            rank,
-        });
-    }
+    let times = combine(per_time, constant_weights, n);
 
     let centralities = if input.outputs.centralities {
-        let node_bc = match node_betweenness {
-            Some(b) => b,
-            None => structure::shortest_path_betweenness(g, budget, &mut work)?.node,
-        };
-        let pr = centrality::pagerank_reversed(g, budget, &mut work)?;
-        let closeness = reach
-            .as_ref()
-            .map_or_else(|| vec![0.0; n], centrality::outward_closeness);
-        let out_degree: Vec<f64> = (0..n).map(|i| structure::to_f64(g.out_degree(i))).collect();
-        let in_degree: Vec<f64> = (0..n).map(|i| structure::to_f64(g.in_degree(i))).collect();
-        let betweenness = centrality::normalized_node_betweenness(&node_bc);
-        let tau_b = times
-            .iter()
-            .map(|t| {
-                [&out_degree, &in_degree, &betweenness, &closeness, &pr]
-                    .map(|m| centrality::kendall_tau_b(m, &t.ci))
-            })
-            .collect();
-        Some(CentralityOutput {
-            out_degree,
-            in_degree,
-            betweenness,
-            closeness_out: closeness,
-            pagerank_reversed: pr,
-            tau_b,
-        })
+        Some(centralities(
+            input,
+            node_betweenness,
+            reach.as_ref(),
+            &times,
+            budget,
+            &mut work,
+        )?)
     } else {
         None
     };

@@ -7,9 +7,8 @@ use std::collections::HashMap;
 use super::graph::Digraph;
 use super::structure::LevelMode;
 use super::wire::{
-    BETA, BetweennessMode, ComponentImportanceRequest, ConstantWeights, ETA_H, LEVEL,
+    BETA, BetweennessMode, ComponentImportanceRequest, ConstantWeights, ETA_H, LEVEL, LevelsMode,
     MAX_SIMPLE_PATHS, NON_NEGATIVE, Outputs, PATH_CAP, PROBABILITY, PathMethod, TIME_H, WEIGHT,
-    Warning,
 };
 use crate::calc::{CalcFailure, Validator};
 
@@ -75,17 +74,70 @@ pub struct ComponentImportanceInput {
     /// K.
     pub path_cap: usize,
     /// Simple paths or walks.
-    pub path_method: PathMethod,
+    pub path_method: Paths,
     /// Level mode.
     pub levels: LevelMode,
     /// Betweenness definition.
-    pub betweenness: BetweennessMode,
+    pub betweenness: Betweenness,
     /// Enumeration budget.
     pub max_simple_paths: u64,
     /// Output flags.
-    pub outputs: Outputs,
+    pub outputs: OutputFlags,
     /// Warnings found during validation.
-    pub warnings: Vec<Warning>,
+    pub warnings: Vec<Finding>,
+}
+
+/// Which paths the propagation sum runs over (the request's `options.path_method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Paths {
+    /// Simple paths only (paper); exact.
+    Exact,
+    /// Walks (matrix powers): equal to `Exact` on a DAG, an upper bound with cycles.
+    Walks,
+}
+
+/// Which edge betweenness is used (the request's `options.betweenness`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Betweenness {
+    /// All simple paths, own pair excluded (paper Table 1).
+    AllSimplePaths,
+    /// Brandes shortest-path edge betweenness.
+    ShortestPaths,
+}
+
+/// The optional output groups asked for (the request's `outputs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputFlags {
+    /// Time-independent matrices.
+    pub matrices: bool,
+    /// The indices and their weights per time.
+    pub indices: bool,
+    /// F, λ and RI per time.
+    pub reliability: bool,
+    /// The five centralities and their Kendall τ-b against CI.
+    pub centralities: bool,
+}
+
+impl From<Outputs> for OutputFlags {
+    fn from(o: Outputs) -> Self {
+        Self {
+            matrices: o.matrices,
+            indices: o.indices,
+            reliability: o.reliability,
+            centralities: o.centralities,
+        }
+    }
+}
+
+/// A non-fatal finding of validation or computation (a response warning).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Finding {
+    /// Stable code, e.g. `ALPHA_SUM`.
+    pub code: String,
+    /// Human-readable explanation.
+    pub detail: String,
+    /// JSON pointer into the request, where the finding is tied to a field.
+    pub pointer: Option<String>,
 }
 
 /// Escape a string for use as a JSON-pointer token (RFC 6901).
@@ -300,7 +352,7 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
                     if ok {
                         mode_sum[i] = Some(s);
                         if (sum_alpha - 1.0).abs() > ALPHA_SUM_WARN_TOL {
-                            warnings.push(Warning {
+                            warnings.push(Finding {
                                 code: "ALPHA_SUM".to_owned(),
                                 detail: format!(
                                     "failure-mode shares of \"{}\" sum to {sum_alpha:.6}, not 1",
@@ -476,14 +528,20 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
             o_out: o.o_out,
             weights,
             path_cap: o.path_cap as usize,
-            path_method: o.path_method,
-            levels: match o.levels {
-                super::wire::LevelsMode::Paper => LevelMode::Paper,
-                super::wire::LevelsMode::Ism => LevelMode::Ism,
+            path_method: match o.path_method {
+                PathMethod::Exact => Paths::Exact,
+                PathMethod::Walks => Paths::Walks,
             },
-            betweenness: o.betweenness,
+            levels: match o.levels {
+                LevelsMode::Paper => LevelMode::Paper,
+                LevelsMode::Ism => LevelMode::Ism,
+            },
+            betweenness: match o.betweenness {
+                BetweennessMode::AllSimplePaths => Betweenness::AllSimplePaths,
+                BetweennessMode::ShortestPaths => Betweenness::ShortestPaths,
+            },
             max_simple_paths,
-            outputs: req.outputs,
+            outputs: req.outputs.into(),
             warnings,
         })
     }

@@ -1,52 +1,80 @@
 //! The `/v1/cam-law/evaluate` computation (spec §8b): build the law, its exact peaks, knots and
-//! jumps, and the requested curves.
+//! jumps, and the requested curves. No wire types.
 
-use super::catalogue::NamedLaw;
+use super::catalogue::{NamedLaw, PeakFactors};
+use super::error::EvaluateError;
 use super::input::{EvaluateInput, LawChoice};
-use super::law::{BoundaryConditions, JUMP_REL_TOL, Jump, Quantity, SevenSegmentLaw};
-use super::wire::{Curves, EvaluateRequest, EvaluateResponse, PeaksOut, Warning};
-use crate::calc::common::ResponseSize;
-use crate::calc::{CalcFailure, ProblemClass};
+use super::law::{
+    BoundaryConditions, JUMP_REL_TOL, Jump, Knot, LawNotice, Quantity, SampledCurves,
+    SevenSegmentLaw,
+};
 use crate::numerics::Budget;
 
-/// Validate, compute and build the wire response of `POST /v1/cam-law/evaluate`.
-///
-/// The work is `O(N)` in the number of abscissae (≤ 200 000 points, a few ms), so the budget's
-/// clock is not polled; its response limit is checked before evaluating.
-///
-/// # Errors
-/// [`CalcFailure`] with every offending field (JSON pointers into the request) for invalid input;
-/// `LAW_OVERFLOW` / `NON_FINITE_RESULT` when the law's values would overflow f64.
-pub fn run(req: EvaluateRequest, budget: &Budget) -> Result<EvaluateResponse, CalcFailure> {
-    let input = EvaluateInput::try_from(req)?;
-    response_size(&input).check(budget)?;
-    let response = compute(&input)?;
-    ensure_finite(&response)?;
-    Ok(response)
+/// Peaks of the evaluated law in physical units (`a1`, `a2` only for the 7-segment class;
+/// `a_max_abs` and `jerk_max_abs_finite` absent when infinite).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EvaluatedPeaks {
+    /// Peak of the first acceleration pulse `A1`.
+    pub a1: Option<f64>,
+    /// Peak of the second acceleration pulse `A2`.
+    pub a2: Option<f64>,
+    /// Largest |a|.
+    pub a_max_abs: Option<f64>,
+    /// Largest |v|.
+    pub v_max_abs: f64,
+    /// First abscissa where |v| is largest.
+    pub x_at_v_max: f64,
+    /// Largest finite |jerk|.
+    pub jerk_max_abs_finite: Option<f64>,
+    /// Appendix-A factors of a named law (zero end rates only).
+    pub peak_factors: Option<PeakFactors>,
 }
 
-/// Upper estimate of the answer's size from the validated request (checked before computing):
-/// fixed fields (law, peaks, knots, jumps) and the curves, one number per abscissa for `x` and
-/// each requested quantity.
-#[must_use]
-pub fn response_size(input: &EvaluateInput) -> ResponseSize {
-    let n = input.xs.as_ref().map_or(0, Vec::len) as u64;
-    let series = 1 + input.quantities.len() as u64;
-    ResponseSize::fixed(8 * 1024).numbers("/abscissa", n * series)
+/// The 7-segment description of a law of the class: normalized coefficients, segment
+/// durations and the 8 knots.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClassLaw {
+    /// Normalized coefficients `ĉ0..ĉ6`.
+    pub coefficients: Vec<f64>,
+    /// Segment durations `ĉ_k·Δt`.
+    pub durations: Vec<f64>,
+    /// Knots `t_0..t_7`.
+    pub knots: Vec<Knot>,
+}
+
+/// The evaluated law.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EvaluateOutput {
+    /// The named law evaluated, when the request named one.
+    pub law: Option<NamedLaw>,
+    /// Coefficients, durations and knots; `None` for a named law outside the class.
+    pub class: Option<ClassLaw>,
+    /// Exact peaks.
+    pub peaks: EvaluatedPeaks,
+    /// Acceleration jumps in abscissa order.
+    pub jumps: Vec<Jump>,
+    /// Curves at the requested abscissae.
+    pub curves: Option<SampledCurves>,
+    /// Findings (validation findings first).
+    pub warnings: Vec<LawNotice>,
 }
 
 /// Evaluate a validated request.
 ///
+/// The work is `O(N)` in the number of abscissae (≤ 200 000 points, a few ms), so the budget is
+/// not polled.
+///
 /// # Errors
-/// `LAW_OVERFLOW` when the law's peaks overflow f64.
-pub fn compute(input: &EvaluateInput) -> Result<EvaluateResponse, CalcFailure> {
+/// [`EvaluateError::Law`] (`LAW_OVERFLOW`) when the law's peaks overflow f64,
+/// [`EvaluateError::NonFiniteResult`] when a reported number would not be finite.
+pub fn compute(input: &EvaluateInput, _budget: &Budget) -> Result<EvaluateOutput, EvaluateError> {
     let bc = &input.bc;
     let mut warnings = input.warnings.clone();
     let ds = bc.s_b - bc.s_a;
     if ds == 0.0 && bc.zero_end_rates() {
-        warnings.push(Warning::NonIdentifiable);
+        warnings.push(LawNotice::NonIdentifiable);
     }
-    match input.law {
+    let out = match input.law {
         LawChoice::SevenSegment {
             coefficients,
             named,
@@ -55,23 +83,25 @@ pub fn compute(input: &EvaluateInput) -> Result<EvaluateResponse, CalcFailure> {
             let p = law.peaks();
             let a_tol = JUMP_REL_TOL * p.a_max_abs.max(bc.a_a.abs()).max(bc.a_b.abs());
             if ds != 0.0 && (ds.signum() * law.a1() < -a_tol || ds.signum() * law.a2() > a_tol) {
-                warnings.push(Warning::PeakSignUnusual);
+                warnings.push(LawNotice::PeakSignUnusual);
             }
             let curves = input.xs.as_ref().map(|xs| {
-                let mut c = empty_curves(xs);
+                let mut c = SampledCurves::at(xs);
                 for &q in &input.quantities {
                     let mut out = vec![0.0; xs.len()];
                     law.eval_quantity_into(xs, q, &mut out);
-                    set(&mut c, q, out);
+                    c.set(q, out);
                 }
                 c
             });
-            Ok(EvaluateResponse {
+            EvaluateOutput {
                 law: named,
-                coefficients: Some(law.coefficients().to_vec()),
-                durations: Some(law.durations().to_vec()),
-                knots: Some(law.knots().to_vec()),
-                peaks: PeaksOut {
+                class: Some(ClassLaw {
+                    coefficients: law.coefficients().to_vec(),
+                    durations: law.durations().to_vec(),
+                    knots: law.knots().to_vec(),
+                }),
+                peaks: EvaluatedPeaks {
                     a1: Some(p.a1),
                     a2: Some(p.a2),
                     a_max_abs: Some(p.a_max_abs),
@@ -82,14 +112,15 @@ pub fn compute(input: &EvaluateInput) -> Result<EvaluateResponse, CalcFailure> {
                         .filter(|_| bc.zero_end_rates())
                         .map(NamedLaw::peak_factors),
                 },
-                acceleration_jumps: law.jumps(),
+                jumps: law.jumps(),
                 curves,
                 warnings,
-                units: input.units.clone(),
-            })
+            }
         }
-        LawChoice::ClosedForm(named) => Ok(closed_form(named, input, warnings)),
-    }
+        LawChoice::ClosedForm(named) => closed_form(named, input, warnings),
+    };
+    ensure_finite(&out)?;
+    Ok(out)
 }
 
 /// Physical scales `(Δt, Δs, Δs/Δt, Δs/Δt², Δs/Δt³)`.
@@ -100,11 +131,11 @@ fn scales(bc: &BoundaryConditions) -> [f64; 5] {
 }
 
 /// A named law outside the 7-segment class, from its closed form (zero end rates).
-fn closed_form(named: NamedLaw, input: &EvaluateInput, warnings: Vec<Warning>) -> EvaluateResponse {
+fn closed_form(named: NamedLaw, input: &EvaluateInput, warnings: Vec<LawNotice>) -> EvaluateOutput {
     let bc = &input.bc;
     let [dt, ds, kv, ka, kj] = scales(bc);
     let f = named.peak_factors();
-    let peaks = PeaksOut {
+    let peaks = EvaluatedPeaks {
         a1: None,
         a2: None,
         a_max_abs: f.ca.map(|ca| ca * ka.abs()),
@@ -132,7 +163,7 @@ fn closed_form(named: NamedLaw, input: &EvaluateInput, warnings: Vec<Warning>) -
         });
     }
     let curves = input.xs.as_ref().map(|xs| {
-        let mut c = empty_curves(xs);
+        let mut c = SampledCurves::at(xs);
         for &q in &input.quantities {
             let out = xs
                 .iter()
@@ -146,55 +177,35 @@ fn closed_form(named: NamedLaw, input: &EvaluateInput, warnings: Vec<Warning>) -
                     }
                 })
                 .collect();
-            set(&mut c, q, out);
+            c.set(q, out);
         }
         c
     });
-    EvaluateResponse {
+    EvaluateOutput {
         law: Some(named),
-        coefficients: None,
-        durations: None,
-        knots: None,
+        class: None,
         peaks,
-        acceleration_jumps: jumps,
+        jumps,
         curves,
         warnings,
-        units: input.units.clone(),
     }
 }
 
-fn empty_curves(xs: &[f64]) -> Curves {
-    Curves {
-        x: xs.to_vec(),
-        s: None,
-        v: None,
-        a: None,
-        j: None,
-    }
-}
-
-fn set(c: &mut Curves, q: Quantity, values: Vec<f64>) {
-    let slot = match q {
-        Quantity::S => &mut c.s,
-        Quantity::V => &mut c.v,
-        Quantity::A => &mut c.a,
-        Quantity::J => &mut c.j,
-    };
-    *slot = Some(values);
-}
-
-/// Every f64 of the response must be finite (JSON cannot carry NaN/Inf, and a silent NaN is a bug).
-fn ensure_finite(r: &EvaluateResponse) -> Result<(), CalcFailure> {
+/// Every reported number must be finite (JSON cannot carry NaN/Inf, and a silent NaN is a bug);
+/// the first offending group, in response order, names the error.
+fn ensure_finite(r: &EvaluateOutput) -> Result<(), EvaluateError> {
     let mut bad: Option<&'static str> = None;
     let mut check = |name: &'static str, xs: &[f64]| {
         if bad.is_none() && !xs.iter().all(|x| x.is_finite()) {
             bad = Some(name);
         }
     };
-    check("coefficients", r.coefficients.as_deref().unwrap_or(&[]));
-    check("durations", r.durations.as_deref().unwrap_or(&[]));
-    for k in r.knots.as_deref().unwrap_or(&[]) {
-        check("knots", &[k.x, k.s, k.v, k.a_left, k.a_right]);
+    if let Some(class) = &r.class {
+        check("coefficients", &class.coefficients);
+        check("durations", &class.durations);
+        for k in &class.knots {
+            check("knots", &[k.x, k.s, k.v, k.a_left, k.a_right]);
+        }
     }
     let p = &r.peaks;
     let opt = |o: Option<f64>| o.unwrap_or(0.0);
@@ -209,7 +220,7 @@ fn ensure_finite(r: &EvaluateResponse) -> Result<(), CalcFailure> {
             opt(p.jerk_max_abs_finite),
         ],
     );
-    for j in &r.acceleration_jumps {
+    for j in &r.jumps {
         check("acceleration_jumps", &[j.x, j.a_left, j.a_right]);
     }
     if let Some(c) = &r.curves {
@@ -223,14 +234,5 @@ fn ensure_finite(r: &EvaluateResponse) -> Result<(), CalcFailure> {
             check(name, q.as_deref().unwrap_or(&[]));
         }
     }
-    match bad {
-        None => Ok(()),
-        Some(name) => Err(CalcFailure::general(
-            ProblemClass::TooLarge,
-            "NON_FINITE_RESULT",
-            format!(
-                "the law's {name} overflow f64 for these boundary conditions (interval too short for this rise or these end rates)"
-            ),
-        )),
-    }
+    bad.map_or(Ok(()), |name| Err(EvaluateError::NonFiniteResult { name }))
 }
