@@ -65,7 +65,7 @@ pub struct ServiceConfig {
     pub max_time_budget_ms: u64,
 
     /// Time a client has to send a complete request head, and the longest an idle keep-alive
-    /// connection is kept open [ms].
+    /// connection is kept open \[ms\].
     #[arg(
         long = "header-timeout-ms",
         env = "MECHCALC_HEADER_TIMEOUT_MS",
@@ -73,7 +73,7 @@ pub struct ServiceConfig {
     )]
     pub header_timeout_ms: u64,
 
-    /// Time a client has to send the whole request body [ms] (408 after it).
+    /// Time a client has to send the whole request body \[ms\] (408 after it).
     #[arg(
         long = "body-timeout-ms",
         env = "MECHCALC_BODY_TIMEOUT_MS",
@@ -81,7 +81,7 @@ pub struct ServiceConfig {
     )]
     pub body_timeout_ms: u64,
 
-    /// Longest a single write of a response may stall on a client that does not read [ms]; the
+    /// Longest a single write of a response may stall on a client that does not read \[ms\]; the
     /// connection is closed after it.
     #[arg(
         long = "write-timeout-ms",
@@ -99,7 +99,7 @@ pub struct ServiceConfig {
     )]
     pub max_connections: usize,
 
-    /// After SIGTERM/SIGINT, time in-flight requests get to finish [ms]; then running jobs are
+    /// After SIGTERM/SIGINT, time in-flight requests get to finish \[ms\]; then running jobs are
     /// cancelled and the process exits.
     #[arg(
         long = "shutdown-grace-ms",
@@ -108,7 +108,7 @@ pub struct ServiceConfig {
     )]
     pub shutdown_grace_ms: u64,
 
-    /// Largest response body [bytes]; a request whose answer would be larger is refused with a
+    /// Largest response body \[bytes\]; a request whose answer would be larger is refused with a
     /// 422 naming the option to change (before computing where the size is known in advance).
     #[arg(
         long = "max-response-bytes",

@@ -8,10 +8,6 @@
 //! * [`plot`]: SVG pictures of answers (`Accept: image/svg+xml`).
 //! * [`cli`]: `mechcalc run`, one calculation from the command line without a server.
 
-// Units are written in brackets in doc comments ("time [s]", "displacement [U]"), as the style
-// guide asks; rustdoc would read them as intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod calc;
 pub mod cli;
 pub mod config;

@@ -23,7 +23,7 @@ use super::bounds::Range;
 use super::problem::{CalcFailure, FieldIssue, ProblemClass, Validator};
 use crate::numerics::Budget;
 
-/// Bound of every request's `time_limit_ms` [ms]: from 1 ms to 10 minutes.
+/// Bound of every request's `time_limit_ms` \[ms\]: from 1 ms to 10 minutes.
 pub const TIME_LIMIT_MS: Range = Range::int(1, 600_000);
 
 /// Something the caller should know about an answer that is nevertheless returned.
@@ -220,7 +220,7 @@ pub fn with_issues<T>(v: Validator, parsed: Result<T, CalcFailure>) -> Result<T,
     parsed
 }
 
-/// Conservative size of one number in a JSON answer [bytes]: the longest shortest-round-trip
+/// Conservative size of one number in a JSON answer \[bytes\]: the longest shortest-round-trip
 /// f64 (`-2.2250738585072014e-308`, 24 characters) plus its separator.
 pub const BYTES_PER_NUMBER: u64 = 25;
 
@@ -260,7 +260,7 @@ impl ResponseSize {
         self.bytes(pointer, count.saturating_mul(BYTES_PER_NUMBER))
     }
 
-    /// The estimate [bytes].
+    /// The estimate \[bytes\].
     #[must_use]
     pub fn total(&self) -> u64 {
         self.parts

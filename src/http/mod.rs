@@ -168,7 +168,7 @@ fn api_parts() -> (utoipa::openapi::OpenApi, Vec<String>) {
 }
 
 /// The OpenAPI document of the service (generated from the handlers and wire types, completed
-/// from the bounds tables; see [`openapi`]).
+/// from the bounds tables; see [`openapi`](mod@openapi)).
 #[must_use]
 pub fn openapi() -> utoipa::openapi::OpenApi {
     serde_json::from_value(openapi::document().clone()).unwrap_or_else(|_| api_parts().0)

@@ -81,7 +81,7 @@ tokio::task_local! {
 pub struct RequestInfo {
     /// The matched route (e.g. `/v1/cognates`), or empty.
     pub route: String,
-    /// Declared body size [bytes], if known.
+    /// Declared body size \[bytes\], if known.
     pub body_bytes: usize,
     /// Progress sink of a streaming request (`Accept: text/event-stream`).
     pub progress: Option<Arc<crate::numerics::budget::ProgressSink>>,

@@ -3,7 +3,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-/// Wraps an angle [rad] to (−π, π]. Angles already inside are returned unchanged (bit for bit).
+/// Wraps an angle \[rad\] to (−π, π]. Angles already inside are returned unchanged (bit for bit).
 #[must_use]
 pub fn wrap_pi(theta: f64) -> f64 {
     if theta > -PI && theta <= PI {
@@ -13,7 +13,7 @@ pub fn wrap_pi(theta: f64) -> f64 {
     if t <= -PI { t + TAU } else { t }
 }
 
-/// Wraps an angle [rad] to [0, 2π). Angles already inside are returned unchanged.
+/// Wraps an angle \[rad\] to [0, 2π). Angles already inside are returned unchanged.
 #[must_use]
 pub fn wrap_2pi(theta: f64) -> f64 {
     if (0.0..TAU).contains(&theta) {
@@ -24,14 +24,14 @@ pub fn wrap_2pi(theta: f64) -> f64 {
     if t >= TAU { 0.0 } else { t }
 }
 
-/// Wraps an angle [rad] to (−180°, 180°] and converts it to degrees.
+/// Wraps an angle \[rad\] to (−180°, 180°] and converts it to degrees.
 #[must_use]
 pub fn wrap_deg(theta: f64) -> f64 {
     let d = wrap_pi(theta).to_degrees();
     if d <= -180.0 { d + 360.0 } else { d }
 }
 
-/// Unwraps samples of an angle [rad] in place: each step is moved by a multiple of 2π so that it
+/// Unwraps samples of an angle \[rad\] in place: each step is moved by a multiple of 2π so that it
 /// differs from the previous sample by at most π (the continuous branch along a sweep).
 pub fn unwrap_in_place(angles: &mut [f64]) {
     let mut offset = 0.0;

@@ -49,7 +49,7 @@ pub struct Progress {
     /// Best objective so far, when the job is an optimisation.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub best: Option<f64>,
-    /// Wall-clock time since the request arrived [ms].
+    /// Wall-clock time since the request arrived \[ms\].
     pub elapsed_ms: f64,
 }
 
@@ -190,7 +190,7 @@ impl Budget {
         self
     }
 
-    /// The same budget, with the service's limit on the size of the answer [bytes]: modules
+    /// The same budget, with the service's limit on the size of the answer \[bytes\]: modules
     /// that can estimate their answer's size refuse a request over it before computing
     /// ([`crate::calc::common::ResponseSize::check`]).
     #[must_use]
@@ -199,7 +199,7 @@ impl Budget {
         self
     }
 
-    /// The limit on the size of the answer [bytes], if the service sets one.
+    /// The limit on the size of the answer \[bytes\], if the service sets one.
     #[must_use]
     pub fn max_response_bytes(&self) -> Option<u64> {
         self.max_response_bytes
@@ -306,7 +306,7 @@ pub struct SolverReport {
     pub iterations: u64,
     /// Model/objective evaluations performed.
     pub evaluations: u64,
-    /// Wall-clock time spent in the solver [ms].
+    /// Wall-clock time spent in the solver \[ms\].
     pub elapsed_ms: f64,
 }
 

@@ -24,7 +24,7 @@ pub fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
-/// Picture size [px].
+/// Picture size \[px\].
 pub const SIZE: (u32, u32) = (900, 620);
 
 /// A padded range covering `values` (a unit range around a constant; finite values only).

@@ -22,13 +22,13 @@ pub const GAMMA_WARN: f64 = 10.0;
 pub struct Residual {
     /// `x(T) = [ψ(T), ψ'(T)]`.
     pub x: [f64; 2],
-    /// `E(T)` [J].
+    /// `E(T)` \[J\].
     pub energy: f64,
     /// `Q = (ωd/z)² (ψ'² + ωn²ψ²)` (ξ < 1).
     pub q: Option<f64>,
-    /// Residual amplitude R [rad] (ξ < 1).
+    /// Residual amplitude R \[rad\] (ξ < 1).
     pub amplitude: Option<f64>,
-    /// Round-off floor of E [J].
+    /// Round-off floor of E \[J\].
     pub floor: f64,
 }
 

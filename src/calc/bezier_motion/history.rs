@@ -16,7 +16,7 @@ pub const RHO_MAX_HISTORY: f64 = 1.6e6;
 pub struct HistorySpec {
     /// Uniform samples on [0, T], both ends included (0: none).
     pub n_samples: usize,
-    /// Length of the window after T [s].
+    /// Length of the window after T \[s\].
     pub t_after: f64,
     /// Samples in (T, T + t_after].
     pub n_after: usize,
@@ -25,23 +25,23 @@ pub struct HistorySpec {
 /// Sampled response, one entry per sample in every vector.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct History {
-    /// Time [s].
+    /// Time \[s\].
     pub t: Vec<f64>,
-    /// Motor angle φ [rad].
+    /// Motor angle φ \[rad\].
     pub phi: Vec<f64>,
     /// Motor speed φ' [rad/s].
     pub dphi: Vec<f64>,
     /// Motor acceleration φ'' [rad/s²].
     pub ddphi: Vec<f64>,
-    /// Rigid-joint output angle α = zφ [rad].
+    /// Rigid-joint output angle α = zφ \[rad\].
     pub alpha: Vec<f64>,
-    /// Platform angle β = zφ + ψ [rad].
+    /// Platform angle β = zφ + ψ \[rad\].
     pub beta: Vec<f64>,
     /// Platform speed β' [rad/s].
     pub dbeta: Vec<f64>,
     /// Platform acceleration β'' [rad/s²].
     pub ddbeta: Vec<f64>,
-    /// Platform lag ψ = β − zφ [rad].
+    /// Platform lag ψ = β − zφ \[rad\].
     pub psi: Vec<f64>,
     /// Joint torque on the platform τ_j = J_eq β'' [N m].
     pub torque: Vec<f64>,

@@ -19,15 +19,15 @@ pub struct BezierInput {
     pub mode: Mode,
     /// The drive.
     pub plant: Plant,
-    /// Total motor rotation [rad].
+    /// Total motor rotation \[rad\].
     pub phi: f64,
-    /// Motion time [s].
+    /// Motion time \[s\].
     pub t: f64,
     /// Order of vanishing end derivatives.
     pub m: usize,
     /// Free interior ordinates.
     pub p: usize,
-    /// γ [rad]: the law (simulate) or the reference law (optimize).
+    /// γ \[rad\]: the law (simulate) or the reference law (optimize).
     pub gamma: Vec<f64>,
     /// Secondary objective.
     pub objective: Objective,

@@ -11,13 +11,13 @@ pub const REVERSAL_REL: f64 = 1e-9;
 /// Peaks and checks of one law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Kinematics {
-    /// Peak |φ'| [rad/s] and its time [s].
+    /// Peak |φ'| [rad/s] and its time \[s\].
     pub peak_velocity: (f64, f64),
-    /// Peak |φ''| [rad/s²] and its time [s].
+    /// Peak |φ''| [rad/s²] and its time \[s\].
     pub peak_accel: (f64, f64),
-    /// Peak |φ'''| [rad/s³] and its time [s].
+    /// Peak |φ'''| [rad/s³] and its time \[s\].
     pub peak_jerk: (f64, f64),
-    /// Least velocity in the direction of Phi, `min sign(Phi)·φ'` [rad/s], and its time [s].
+    /// Least velocity in the direction of Phi, `min sign(Phi)·φ'` [rad/s], and its time \[s\].
     pub min_velocity: (f64, f64),
     /// The motor reverses: `min sign(Phi)·φ' < −1e-9 · peak |φ'|`.
     pub motion_reversal: bool,

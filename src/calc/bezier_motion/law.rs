@@ -22,9 +22,9 @@ pub fn binomial(n: usize, k: usize) -> f64 {
 pub struct BezierLaw {
     /// Order of the derivatives forced to zero at both ends, `m`.
     pub m: usize,
-    /// Motion time `T` [s].
+    /// Motion time `T` \[s\].
     pub t: f64,
-    /// Displacement control ordinates `S_0..S_{n_s}` [rad].
+    /// Displacement control ordinates `S_0..S_{n_s}` \[rad\].
     pub s: Vec<f64>,
     /// Velocity control ordinates `V_0..V_{n_s−1}` [rad/s].
     pub v: Vec<f64>,

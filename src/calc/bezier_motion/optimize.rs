@@ -28,9 +28,9 @@ pub struct LawShape {
     pub m: usize,
     /// Free interior ordinates.
     pub p: usize,
-    /// Total motor rotation [rad].
+    /// Total motor rotation \[rad\].
     pub phi: f64,
-    /// Motion time [s].
+    /// Motion time \[s\].
     pub t: f64,
 }
 
@@ -135,7 +135,7 @@ pub fn objective_terms(
 /// The solution of the equality-constrained quadratic program.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Solution {
-    /// Optimal free ordinates γ* [rad].
+    /// Optimal free ordinates γ* \[rad\].
     pub gamma: Vec<f64>,
     /// Lagrange multipliers μ (stationarity: `Hq γ* + f + Rᵀ μ = 0` on the kept constraints).
     pub mu: Vec<f64>,

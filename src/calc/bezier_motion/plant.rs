@@ -134,14 +134,14 @@ impl Plant {
         ]
     }
 
-    /// Vibration energy `½ J_eq (ψ'² + ωn² ψ²)` [J] (paper Eq. 24), with `ωn ψ` formed first.
+    /// Vibration energy `½ J_eq (ψ'² + ωn² ψ²)` \[J\] (paper Eq. 24), with `ωn ψ` formed first.
     #[must_use]
     pub fn energy(&self, x: [f64; 2]) -> f64 {
         let a = self.wn * x[0];
         0.5 * self.j_eq * (x[1] * x[1] + a * a)
     }
 
-    /// Residual amplitude `R` [rad] of the free vibration from state `x` (ξ < 1, spec §3.6).
+    /// Residual amplitude `R` \[rad\] of the free vibration from state `x` (ξ < 1, spec §3.6).
     #[must_use]
     pub fn amplitude(&self, x: [f64; 2]) -> Option<f64> {
         let wd = self.omega_d()?;

@@ -19,9 +19,9 @@ pub const STIFFNESS: Range = Range::FINITE.gt(0.0).max(1e15);
 pub const DAMPING: Range = Range::closed(0.0, 1e15);
 /// Reducer ratio `z` (≠ 0 is checked too).
 pub const RATIO: Range = Range::closed(-1e3, 1e3);
-/// Total motor rotation (`Phi_rad` [rad] or `Phi_rev` [rev]; ≠ 0 is checked too).
+/// Total motor rotation (`Phi_rad` \[rad\] or `Phi_rev` \[rev\]; ≠ 0 is checked too).
 pub const PHI: Range = Range::closed(-1e9, 1e9);
-/// Motion time `T` [s].
+/// Motion time `T` \[s\].
 pub const MOTION_TIME: Range = Range::closed(1e-6, 1e4);
 /// Order `m` of the vanishing end derivatives.
 pub const ORDER_M: Range = Range::int(1, 6);
@@ -29,7 +29,7 @@ pub const ORDER_M: Range = Range::int(1, 6);
 pub const FREE_P: Range = Range::int(1, 20);
 /// Largest degree `N = 2m + p − 1` of φ'' (Bernstein conditioning, spec §6).
 pub const MAX_ACCEL_DEGREE: usize = 30;
-/// An interior ordinate γ_j [rad] (also `|γ_j| ≤ 1e3·|Phi|`).
+/// An interior ordinate γ_j \[rad\] (also `|γ_j| ≤ 1e3·|Phi|`).
 pub const GAMMA: Range = Range::closed(-1e12, 1e12);
 /// `|γ_j| / |Phi|` must not exceed this.
 pub const GAMMA_OVER_PHI_MAX: f64 = 1e3;
@@ -37,7 +37,7 @@ pub const GAMMA_OVER_PHI_MAX: f64 = 1e3;
 pub const ROBUST_REL: Range = Range::FINITE.gt(0.0).max(0.5);
 /// Samples of the time history (each window).
 pub const HISTORY_SAMPLES: Range = Range::int(0, 20_000);
-/// Free-vibration window after T [s].
+/// Free-vibration window after T \[s\].
 pub const WINDOW_AFTER: Range = Range::closed(0.0, 1e4);
 /// Stiffness factor of the sensitivity sweep.
 pub const STIFFNESS_FACTOR: Range = Range::FINITE.gt(0.0).max(100.0);
@@ -65,7 +65,7 @@ pub struct BezierMotionRequest {
     /// Optional outputs.
     #[serde(default)]
     pub outputs: OutputsIn,
-    /// Wall-clock budget of this request [ms] (optional).
+    /// Wall-clock budget of this request \[ms\] (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,
@@ -121,16 +121,16 @@ pub struct SystemIn {
 #[schema(as = bezier_motion::MotionIn)]
 #[serde(deny_unknown_fields)]
 pub struct MotionIn {
-    /// Total motor rotation `Phi` [rad], ≠ 0. Exactly one of this and `Phi_rev`.
+    /// Total motor rotation `Phi` \[rad\], ≠ 0. Exactly one of this and `Phi_rev`.
     #[serde(rename = "Phi_rad", default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 125.66370614359172)]
     pub phi_rad: Option<f64>,
-    /// Total motor rotation [rev] (`Phi_rad = 2π·Phi_rev`), ≠ 0. Exactly one of this and
+    /// Total motor rotation \[rev\] (`Phi_rad = 2π·Phi_rev`), ≠ 0. Exactly one of this and
     /// `Phi_rad`.
     #[serde(rename = "Phi_rev", default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 20.0)]
     pub phi_rev: Option<f64>,
-    /// Motion time `T` [s].
+    /// Motion time `T` \[s\].
     #[serde(rename = "T_s")]
     #[schema(example = 1.0)]
     pub t_s: f64,
@@ -142,7 +142,7 @@ pub struct MotionIn {
     #[serde(default = "default_p")]
     #[schema(example = 3)]
     pub p: u64,
-    /// The p interior ordinates γ_j [rad]: the law itself in `simulate`, the reference law in
+    /// The p interior ordinates γ_j \[rad\]: the law itself in `simulate`, the reference law in
     /// `optimize`; each `|γ_j| ≤ 1e3·|Phi|`. Default: the linear ramp `Phi·j/(p+1)`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
@@ -238,7 +238,7 @@ pub struct TimeHistoryIn {
     #[serde(default)]
     #[schema(example = 200)]
     pub n_samples: u64,
-    /// Length of the free-vibration window after T [s].
+    /// Length of the free-vibration window after T \[s\].
     #[serde(default)]
     #[schema(example = 0.5)]
     pub t_after_s: f64,
@@ -321,7 +321,7 @@ pub struct SystemOut {
     /// Damped frequency `ωd` [rad/s] (absent for ξ ≥ 1).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub omega_d_rad_s: Option<f64>,
-    /// Natural frequency `f_n = ωn/2π` [Hz].
+    /// Natural frequency `f_n = ωn/2π` \[Hz\].
     pub f_n_hz: f64,
     /// `η = ½ J_eq (z/ωd)²` [kg m² s²] of paper Eq. 29 (absent for ξ ≥ 1).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -365,12 +365,12 @@ pub struct MethodOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bezier_motion::LawOut)]
 pub struct LawOut {
-    /// Free interior ordinates γ [rad].
+    /// Free interior ordinates γ \[rad\].
     pub gamma_rad: Vec<f64>,
     /// γ / Phi.
     #[serde(rename = "gamma_over_Phi")]
     pub gamma_over_phi: Vec<f64>,
-    /// Displacement ordinates `S_0..S_{n_s}` [rad].
+    /// Displacement ordinates `S_0..S_{n_s}` \[rad\].
     #[serde(rename = "S_rad")]
     pub s_rad: Vec<f64>,
     /// Velocity ordinates `V_i` [rad/s].
@@ -390,25 +390,25 @@ pub struct LawOut {
 #[derive(Debug, Clone, Copy, Serialize, ToSchema)]
 #[schema(as = bezier_motion::ResidualOut)]
 pub struct ResidualOut {
-    /// Platform lag ψ(T) [rad].
+    /// Platform lag ψ(T) \[rad\].
     #[serde(rename = "psi_T_rad")]
     pub psi_t_rad: f64,
     /// ψ'(T) [rad/s] (= β'(T), since φ'(T) = 0).
     #[serde(rename = "dpsi_T_rad_s")]
     pub dpsi_t_rad_s: f64,
-    /// Residual vibration energy `E(T) = ½ J_eq (ψ'² + ωn² ψ²)` [J] (paper Eq. 24).
+    /// Residual vibration energy `E(T) = ½ J_eq (ψ'² + ωn² ψ²)` \[J\] (paper Eq. 24).
     #[serde(rename = "E_T_J")]
     pub e_t_j: f64,
     /// `Q = G² + ωn² F²` of paper Eq. 29 (absent for ξ ≥ 1).
     #[serde(rename = "Q", skip_serializing_if = "Option::is_none")]
     pub q: Option<f64>,
-    /// Residual amplitude R of the platform [rad] (absent for ξ ≥ 1).
+    /// Residual amplitude R of the platform \[rad\] (absent for ξ ≥ 1).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_amplitude_rad: Option<f64>,
     /// Acceleration envelope `ωn² R` [rad/s²] (absent for ξ ≥ 1).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_accel_envelope_rad_s2: Option<f64>,
-    /// Round-off floor `E_floor = ½ J_eq (64 ε s_x)²` [J].
+    /// Round-off floor `E_floor = ½ J_eq (64 ε s_x)²` \[J\].
     #[serde(rename = "E_floor_J")]
     pub e_floor_j: f64,
     /// `E(T) ≤ E_floor`: numerically zero.
@@ -419,7 +419,7 @@ pub struct ResidualOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bezier_motion::ReferenceOut)]
 pub struct ReferenceOut {
-    /// Reference ordinates γ_ref [rad].
+    /// Reference ordinates γ_ref \[rad\].
     pub gamma_rad: Vec<f64>,
     /// Its residual vibration.
     pub residual: ResidualOut,
@@ -442,7 +442,7 @@ pub struct OptimizerOut {
     /// `E / E_ref` (absent when E_ref = 0).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub energy_ratio_to_reference: Option<f64>,
-    /// `10 log10(E_ref / max(E, E_floor))` [dB] (absent when E_ref = 0).
+    /// `10 log10(E_ref / max(E, E_floor))` \[dB\] (absent when E_ref = 0).
     #[serde(rename = "reduction_dB", skip_serializing_if = "Option::is_none")]
     pub reduction_db: Option<f64>,
     /// `max |γ_j| / |Phi|` of the optimum (> 10: fragile polygon, warned).
@@ -456,19 +456,19 @@ pub struct OptimizerOut {
 pub struct KinematicsOut {
     /// Peak |φ'| [rad/s].
     pub peak_velocity_rad_s: f64,
-    /// Its time [s].
+    /// Its time \[s\].
     pub t_peak_velocity_s: f64,
     /// Peak |φ''| [rad/s²].
     pub peak_accel_rad_s2: f64,
-    /// Its time [s].
+    /// Its time \[s\].
     pub t_peak_accel_s: f64,
     /// Peak |φ'''| [rad/s³].
     pub peak_jerk_rad_s3: f64,
-    /// Its time [s].
+    /// Its time \[s\].
     pub t_peak_jerk_s: f64,
     /// Least velocity in the direction of Phi, `min sign(Phi)·φ'` [rad/s] (0 at the ends).
     pub min_velocity_rad_s: f64,
-    /// Its time [s].
+    /// Its time \[s\].
     pub t_min_velocity_s: f64,
     /// The motor reverses (`min_velocity < −1e-9·peak`).
     pub motion_reversal: bool,
@@ -490,10 +490,10 @@ pub struct SensitivityRow {
     pub omega_n_rad_s: f64,
     /// ξ of that system.
     pub xi: f64,
-    /// Residual energy E(T) [J].
+    /// Residual energy E(T) \[J\].
     #[serde(rename = "E_T_J")]
     pub e_t_j: f64,
-    /// Residual amplitude [rad] (absent for ξ ≥ 1).
+    /// Residual amplitude \[rad\] (absent for ξ ≥ 1).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_amplitude_rad: Option<f64>,
 }
@@ -502,23 +502,23 @@ pub struct SensitivityRow {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bezier_motion::HistoryOut)]
 pub struct HistoryOut {
-    /// Time [s].
+    /// Time \[s\].
     pub t_s: Vec<f64>,
-    /// Motor angle φ [rad].
+    /// Motor angle φ \[rad\].
     pub phi_rad: Vec<f64>,
     /// Motor speed φ' [rad/s].
     pub dphi_rad_s: Vec<f64>,
     /// Motor acceleration φ'' [rad/s²].
     pub ddphi_rad_s2: Vec<f64>,
-    /// Rigid-joint output α = zφ [rad] (the paper's Figs. 5–6 plot this).
+    /// Rigid-joint output α = zφ \[rad\] (the paper's Figs. 5–6 plot this).
     pub alpha_rad: Vec<f64>,
-    /// Platform angle β [rad].
+    /// Platform angle β \[rad\].
     pub beta_rad: Vec<f64>,
     /// Platform speed β' [rad/s].
     pub dbeta_rad_s: Vec<f64>,
     /// Platform acceleration β'' [rad/s²].
     pub ddbeta_rad_s2: Vec<f64>,
-    /// Platform lag ψ = β − zφ [rad].
+    /// Platform lag ψ = β − zφ \[rad\].
     pub psi_rad: Vec<f64>,
     /// Joint torque on the platform τ_j = J_eq β'' [N m].
     #[serde(rename = "joint_torque_Nm")]

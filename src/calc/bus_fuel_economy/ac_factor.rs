@@ -76,15 +76,15 @@ pub fn dowell_f2(xi: f64) -> f64 {
 /// Dowell parameters in SI units.
 #[derive(Debug, Clone, Copy)]
 pub struct Dowell {
-    /// Conductor height h [m].
+    /// Conductor height h \[m\].
     pub conductor_height_m: f64,
     /// Layers m.
     pub layers: f64,
     /// Porosity factor.
     pub porosity: f64,
-    /// Slot (active) length [m].
+    /// Slot (active) length \[m\].
     pub stack_length_m: f64,
-    /// End-winding length [m].
+    /// End-winding length \[m\].
     pub end_length_m: f64,
 }
 
@@ -95,7 +95,7 @@ pub enum AcFactor {
     None,
     /// Table k_AC(f): linear in f, clamped at the ends.
     Table {
-        /// Frequencies [Hz], strictly increasing.
+        /// Frequencies \[Hz\], strictly increasing.
         freq_hz: Vec<f64>,
         /// k_AC values.
         k_ac: Vec<f64>,

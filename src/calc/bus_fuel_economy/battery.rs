@@ -24,21 +24,21 @@ pub enum Battery {
 pub struct Ecm {
     /// SOC points of the OCV table (strictly increasing in [0, 1]).
     pub ocv_soc: Vec<f64>,
-    /// OCV at `ocv_soc` [V].
+    /// OCV at `ocv_soc` \[V\].
     pub ocv_v: Vec<f64>,
-    /// Series resistance R0 [Ω] (> 0).
+    /// Series resistance R0 \[Ω\] (> 0).
     pub r0: f64,
-    /// R1 [Ω].
+    /// R1 \[Ω\].
     pub r1: f64,
-    /// C1 [F].
+    /// C1 \[F\].
     pub c1: f64,
-    /// R2 [Ω].
+    /// R2 \[Ω\].
     pub r2: f64,
-    /// C2 [F].
+    /// C2 \[F\].
     pub c2: f64,
     /// Initial SOC.
     pub soc0: f64,
-    /// Charge capacity Q = capacity_kwh·3.6e6/nominal_voltage [C].
+    /// Charge capacity Q = capacity_kwh·3.6e6/nominal_voltage \[C\].
     pub q_coulomb: f64,
 }
 
@@ -47,9 +47,9 @@ pub struct Ecm {
 pub struct EcmState {
     /// State of charge.
     pub soc: f64,
-    /// Voltage over the first RC branch [V].
+    /// Voltage over the first RC branch \[V\].
     pub v1: f64,
-    /// Voltage over the second RC branch [V].
+    /// Voltage over the second RC branch \[V\].
     pub v2: f64,
     /// Intervals whose power exceeded e²/(4 R0) (clamped to the maximum-power current).
     pub n_power_infeasible: u64,
@@ -70,8 +70,8 @@ impl Ecm {
         }
     }
 
-    /// Advance one interval of length `dt` at DC power `p_dc` [W]; returns the internal
-    /// (chemical) power P_in = OCV·i [W].
+    /// Advance one interval of length `dt` at DC power `p_dc` \[W\]; returns the internal
+    /// (chemical) power P_in = OCV·i \[W\].
     pub fn step(&self, st: &mut EcmState, p_dc: f64, dt: f64) -> f64 {
         let ocv = interp_clamped(&self.ocv_soc, &self.ocv_v, st.soc);
         let e = ocv - st.v1 - st.v2;

@@ -40,9 +40,9 @@ pub mod paper {
 
     /// Rated torque of the initial motor [N·m] (Table 1).
     pub const RATED_TORQUE_NM: f64 = 800.0;
-    /// Maximum power [W] (Table 1).
+    /// Maximum power \[W\] (Table 1).
     pub const MAX_POWER_W: f64 = 130_000.0;
-    /// Maximum speed [rpm] (Table 1).
+    /// Maximum speed \[rpm\] (Table 1).
     pub const MAX_SPEED_RPM: f64 = 5200.0;
     /// Torque at maximum speed as printed in the paper [N·m] (exact 130 kW / 5200 rpm = 238.73).
     pub const TORQUE_AT_MAX_SPEED_NM: f64 = 238.9;
@@ -73,7 +73,7 @@ pub mod paper {
         (n_d + 1) * (n_d + 2) / 2
     }
 
-    /// Vehicle speed [km/h] at a motor speed [rpm] through gear ratio i_g and wheel radius r [m].
+    /// Vehicle speed [km/h] at a motor speed \[rpm\] through gear ratio i_g and wheel radius r \[m\].
     #[must_use]
     pub fn vehicle_speed_kmh(rpm: f64, gear_ratio: f64, wheel_radius_m: f64) -> f64 {
         rpm * PI / 30.0 / gear_ratio * wheel_radius_m * 3.6

@@ -34,9 +34,9 @@ pub struct RunResult {
     pub cycle: usize,
     /// The simulation outcome.
     pub sim: SimOutcome,
-    /// Trace distance (of the cycle, not achieved) [m].
+    /// Trace distance (of the cycle, not achieved) \[m\].
     pub trace_distance_m: f64,
-    /// Duration [s].
+    /// Duration \[s\].
     pub duration_s: f64,
     /// Highest trace speed [m/s].
     pub max_trace_speed: f64,
@@ -47,7 +47,7 @@ pub struct RunResult {
 /// Operating-point histogram.
 #[derive(Debug, Clone)]
 pub struct Histogram {
-    /// Speed edges [rpm].
+    /// Speed edges \[rpm\].
     pub speed_edges: Vec<f64>,
     /// Torque edges [N·m].
     pub torque_edges: Vec<f64>,
@@ -63,7 +63,7 @@ pub type PartsGrid = Vec<Vec<Option<(LossSplit, Currents)>>>;
 /// A motor map on a grid.
 #[derive(Debug, Clone)]
 pub struct MapData {
-    /// Speeds [rpm].
+    /// Speeds \[rpm\].
     pub speed_rpm: Vec<f64>,
     /// Speeds [rad/s].
     pub speed: Vec<f64>,
@@ -71,7 +71,7 @@ pub struct MapData {
     pub torque: Vec<f64>,
     /// T_max at the speeds [N·m].
     pub t_max: Vec<f64>,
-    /// Loss [W] (None outside the envelope).
+    /// Loss \[W\] (None outside the envelope).
     pub loss: Vec<Vec<Option<f64>>>,
     /// Efficiency (None outside the envelope; 0 at zero power).
     pub eff: Vec<Vec<Option<f64>>>,
@@ -86,9 +86,9 @@ pub struct MapData {
 /// Comparison of motors.
 #[derive(Debug, Clone)]
 pub struct ComparisonData {
-    /// fe_change[motor][cycle] [%] (None where an FE is undefined); index 0 is the reference.
+    /// fe_change\[motor\]\[cycle\] [%] (None where an FE is undefined); index 0 is the reference.
     pub fe_change_pct: Vec<Vec<Option<f64>>>,
-    /// d[motor][cycle].
+    /// d\[motor\]\[cycle\].
     pub d: Vec<Vec<f64>>,
     /// Overall D per motor.
     pub overall: Vec<f64>,
@@ -112,7 +112,7 @@ pub struct BusFuelEconomyOutput {
     pub evaluations: u64,
 }
 
-/// FE [km/kWh] from distance [m] and energy [J]; None when E ≤ 0 (spec §8 item 9).
+/// FE [km/kWh] from distance \[m\] and energy \[J\]; None when E ≤ 0 (spec §8 item 9).
 #[must_use]
 pub fn fuel_economy(distance_m: f64, e_in_j: f64) -> Option<f64> {
     (e_in_j > 0.0).then(|| (distance_m / 1000.0) / (e_in_j / 3.6e6))
@@ -454,7 +454,7 @@ fn run_result(
 }
 
 /// FE change relative to the first motor and desirability per cycle (spec §5.7), from the fuel
-/// economy [km/kWh] and the energy drawn [kWh] of every motor × cycle pair (motor-major) — the
+/// economy [km/kWh] and the energy drawn \[kWh\] of every motor × cycle pair (motor-major) — the
 /// `fe_km_per_kwh` and `energy_in_kwh` of the results, so that merged shards can recompute it.
 #[must_use]
 pub fn compare(

@@ -21,7 +21,7 @@ const HDUDDS_CSV: &str = include_str!("../../../data/bus_fuel_economy/hdudds.csv
 pub struct Cycle {
     /// Cycle name (unique within a request).
     pub name: String,
-    /// Sample times [s].
+    /// Sample times \[s\].
     pub time_s: Vec<f64>,
     /// Sample speeds [m/s].
     pub speed_mps: Vec<f64>,
@@ -30,7 +30,7 @@ pub struct Cycle {
 }
 
 impl Cycle {
-    /// Duration [s].
+    /// Duration \[s\].
     #[must_use]
     pub fn duration_s(&self) -> f64 {
         match (self.time_s.first(), self.time_s.last()) {
@@ -39,7 +39,7 @@ impl Cycle {
         }
     }
 
-    /// Distance by the interval-mean rule of §5.1, Σ ½(v_j + v_{j+1}) Δt_j [m].
+    /// Distance by the interval-mean rule of §5.1, Σ ½(v_j + v_{j+1}) Δt_j \[m\].
     #[must_use]
     pub fn distance_m(&self) -> f64 {
         let mut s = 0.0;
@@ -101,9 +101,9 @@ pub fn builtin(name: &str) -> Option<Cycle> {
 /// One simulation interval of §5.1 (after sub-stepping).
 #[derive(Debug, Clone, Copy)]
 pub struct Interval {
-    /// Start time [s].
+    /// Start time \[s\].
     pub t0: f64,
-    /// Δt_j [s].
+    /// Δt_j \[s\].
     pub dt: f64,
     /// Trace speed at the start v_j [m/s].
     pub v0: f64,

@@ -8,7 +8,7 @@ pub enum BusFuelEconomyError {
     /// The time budget ran out.
     #[error("time budget exhausted after {elapsed_ms:.0} ms")]
     Deadline {
-        /// Elapsed time [ms].
+        /// Elapsed time \[ms\].
         elapsed_ms: f64,
     },
     /// An ipmsm cannot produce torque at a speed the cycle needs (finite maximum speed,
@@ -23,9 +23,9 @@ pub enum BusFuelEconomyError {
         motor: String,
         /// Cycle name.
         cycle: String,
-        /// Speed needed [rpm].
+        /// Speed needed \[rpm\].
         rpm: f64,
-        /// Highest speed with positive torque found [rpm].
+        /// Highest speed with positive torque found \[rpm\].
         limit_rpm: f64,
     },
     /// The operating-point histogram would have too many bins.

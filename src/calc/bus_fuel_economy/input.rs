@@ -22,9 +22,9 @@ pub const MAX_CYCLES: usize = 16;
 pub const MAX_CYCLE_SAMPLES: usize = 200_000;
 /// Most intervals over all cycles after sub-stepping (spec §3.7, §8 item 10).
 pub const MAX_TOTAL_INTERVALS: usize = 1_000_000;
-/// Largest custom-cycle time step [s] (spec §3.4).
+/// Largest custom-cycle time step \[s\] (spec §3.4).
 pub const MAX_TIME_STEP_S: f64 = 60.0;
-/// Smallest custom-cycle time step [s] (1 kHz sampling): a service limit that bounds the
+/// Smallest custom-cycle time step \[s\] (1 kHz sampling): a service limit that bounds the
 /// acceleration (≤ 2·10⁵ m/s²) and so keeps every force, torque and power finite.
 pub const MIN_TIME_STEP_S: f64 = 1e-3;
 /// Smallest efficiency of the gear, inverter, battery and a constant motor [-]: a service limit
@@ -36,7 +36,7 @@ pub const MIN_MAP_EFFICIENCY: f64 = w::MAP_EFFICIENCY.lo;
 pub const MIN_GEAR_RATIO: f64 = w::GEAR_RATIO.lo;
 /// Largest trace speed [m/s] (720 km/h): a service limit that keeps v² and the road load finite.
 pub const MAX_SPEED_MPS: f64 = w::SPEED_MPS.hi;
-/// Largest |time| of a custom trace [s] (about 30 years): keeps Δt well resolved.
+/// Largest |time| of a custom trace \[s\] (about 30 years): keeps Δt well resolved.
 pub const MAX_TIME_S: f64 = w::TIME_S.hi;
 /// Relative slack of the cycle-speed vs n_max check (rounding of the rpm conversion).
 const SPEED_CHECK_SLACK: f64 = 1e-12;
@@ -63,7 +63,7 @@ pub struct Options {
     pub regen_limit: bool,
     /// ipmsm evaluation.
     pub motor_eval: MotorEval,
-    /// Map grid: speed step [rpm], torque step [N·m].
+    /// Map grid: speed step \[rpm\], torque step [N·m].
     pub grid: (f64, f64),
     /// Loss breakdown requested.
     pub breakdown: bool,
@@ -73,7 +73,7 @@ pub struct Options {
     pub traces: bool,
     /// Efficiency maps requested.
     pub efficiency_map: bool,
-    /// Histogram bins: speed [rpm], torque [N·m].
+    /// Histogram bins: speed \[rpm\], torque [N·m].
     pub hist_bins: (f64, f64),
     /// Normalised desirability weights per cycle.
     pub weights: Vec<f64>,

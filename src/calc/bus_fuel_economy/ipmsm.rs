@@ -63,7 +63,7 @@ pub struct Currents {
     pub mode: OpMode,
 }
 
-/// Losses at an operating point [W].
+/// Losses at an operating point \[W\].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct LossSplit {
     /// AC resistance factor k_AC at the electrical frequency.
@@ -93,7 +93,7 @@ impl LossSplit {
 pub struct EnvelopePoint {
     /// Maximum torque from the current and voltage limits, before caps [N·m].
     pub torque: f64,
-    /// Current angle β from +q toward −d [rad].
+    /// Current angle β from +q toward −d \[rad\].
     pub beta: f64,
     /// Current amplitude s* [A peak].
     pub current: f64,
@@ -106,23 +106,23 @@ pub struct Ipmsm {
     pub p: f64,
     /// PM flux linkage ψ_m [Wb peak].
     pub psi: f64,
-    /// L_d [H].
+    /// L_d \[H\].
     pub ld: f64,
-    /// L_q [H] (≥ L_d).
+    /// L_q \[H\] (≥ L_d).
     pub lq: f64,
-    /// Phase resistance at the winding temperature R(T_w) [Ω].
+    /// Phase resistance at the winding temperature R(T_w) \[Ω\].
     pub r: f64,
     /// Winding temperature [°C] (for the Dowell skin depth).
     pub temp_c: f64,
-    /// Peak current limit I_pk = √2 I_rms [A].
+    /// Peak current limit I_pk = √2 I_rms \[A\].
     pub i_pk: f64,
-    /// Peak phase voltage limit V_max = utilisation·V_dc/√3 [V].
+    /// Peak phase voltage limit V_max = utilisation·V_dc/√3 \[V\].
     pub v_max: f64,
     /// Maximum mechanical speed [rad/s].
     pub omega_max: f64,
     /// Torque cap [N·m] (∞ if none).
     pub t_cap: f64,
-    /// Power cap [W] (∞ if none).
+    /// Power cap \[W\] (∞ if none).
     pub p_cap: f64,
     /// AC factor model.
     pub ac: AcFactor,
@@ -145,25 +145,25 @@ pub struct IpmsmParams {
     pub pole_pairs: f64,
     /// ψ_m [Wb peak].
     pub psi_m_wb: f64,
-    /// L_d [H].
+    /// L_d \[H\].
     pub ld_h: f64,
-    /// L_q [H].
+    /// L_q \[H\].
     pub lq_h: f64,
-    /// R at 20 °C [Ω].
+    /// R at 20 °C \[Ω\].
     pub r_20_ohm: f64,
     /// Winding temperature [°C].
     pub winding_temp_c: f64,
     /// Current limit [A rms].
     pub i_max_arms: f64,
-    /// DC link voltage [V].
+    /// DC link voltage \[V\].
     pub v_dc: f64,
     /// Voltage utilisation.
     pub voltage_utilization: f64,
-    /// Maximum speed [rpm].
+    /// Maximum speed \[rpm\].
     pub n_max_rpm: f64,
     /// Torque cap [N·m] (∞ if none).
     pub t_cap_nm: f64,
-    /// Power cap [W] (∞ if none).
+    /// Power cap \[W\] (∞ if none).
     pub p_cap_w: f64,
     /// AC factor.
     pub ac: AcFactor,

@@ -12,7 +12,7 @@ pub struct Grid2 {
     pub speed: Vec<f64>,
     /// Torque axis [N·m], strictly increasing.
     pub torque: Vec<f64>,
-    /// values[i * torque.len() + j] at (speed[i], torque[j]).
+    /// values[i * torque.len() + j] at (speed\[i\], torque\[j\]).
     pub values: Vec<f64>,
 }
 
@@ -59,7 +59,7 @@ impl Grid2 {
 /// Result of converting an efficiency map into a loss map.
 #[derive(Debug, Clone)]
 pub struct ConvertedMap {
-    /// The loss map [W] on a signed torque axis with a T = 0 column and an n = 0 row.
+    /// The loss map \[W\] on a signed torque axis with a T = 0 column and an n = 0 row.
     pub loss: Grid2,
     /// Warnings (extrapolated T = 0 losses, ignored η at T = 0 or n = 0).
     pub warnings: Vec<String>,
@@ -69,7 +69,7 @@ pub struct ConvertedMap {
 /// L = |P_m|(1/η − 1) at T > 0, n > 0; a T = 0 column by linear extrapolation from the first two
 /// positive torque columns (clipped at 0; constant if only one exists); an n = 0 row equal to the
 /// first positive-speed row; mirrored for T < 0 unless a generating table is given (then the T = 0
-/// column is the mean of both extrapolations). Speeds in rad/s, `eff[i][j]` at (speed[i], torque[j]).
+/// column is the mean of both extrapolations). Speeds in rad/s, `eff[i][j]` at (speed\[i\], torque\[j\]).
 #[must_use]
 pub fn efficiency_to_loss(
     speed: &[f64],
@@ -172,7 +172,7 @@ pub enum Envelope {
     TorquePower {
         /// Peak torque [N·m].
         t_peak: f64,
-        /// Peak power [W].
+        /// Peak power \[W\].
         p_peak: f64,
     },
     /// Table, linear in speed, held constant outside.

@@ -35,7 +35,7 @@ pub enum MotorKind {
     },
     /// Loss map (given, or converted from an efficiency map) with an envelope.
     Map {
-        /// Total loss [W].
+        /// Total loss \[W\].
         loss: Grid2,
         /// Envelope.
         envelope: Envelope,
@@ -47,11 +47,11 @@ pub enum MotorKind {
 /// Loss at one evaluated operating point.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct LossEval {
-    /// Total motor loss P_loss [W].
+    /// Total motor loss P_loss \[W\].
     pub loss: f64,
     /// Constant efficiency of a `constant` motor (used directly by the paper convention).
     pub eta_const: Option<f64>,
-    /// DC copper, extra AC copper, iron, mechanical [W] (ipmsm only).
+    /// DC copper, extra AC copper, iron, mechanical \[W\] (ipmsm only).
     pub parts: Option<[f64; 4]>,
     /// The ipmsm operating point could not be solved and the envelope point was used.
     pub fallback: bool,
@@ -64,9 +64,9 @@ fn parts_of(s: &LossSplit) -> [f64; 4] {
 /// A precomputed ipmsm loss map (total and the four parts) with its envelope on the grid speeds.
 #[derive(Debug, Clone)]
 pub struct IpmsmMap {
-    /// Total loss [W].
+    /// Total loss \[W\].
     pub total: Grid2,
-    /// DC copper, extra AC copper, iron, mechanical loss maps [W].
+    /// DC copper, extra AC copper, iron, mechanical loss maps \[W\].
     pub parts: [Grid2; 4],
     /// Envelope at the grid speeds (linear in between); informational: the simulation evaluates
     /// T_max exactly per distinct speed, as the spec's reference does.
@@ -77,7 +77,7 @@ pub struct IpmsmMap {
     pub evaluations: u64,
 }
 
-/// Grid axes of a map: speeds 0, Δn, 2Δn, … plus n_max itself [rpm]; torques ±kΔT covering
+/// Grid axes of a map: speeds 0, Δn, 2Δn, … plus n_max itself \[rpm\]; torques ±kΔT covering
 /// ±t_top [N·m].
 #[must_use]
 pub fn grid_axes(

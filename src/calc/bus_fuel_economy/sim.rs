@@ -13,7 +13,7 @@ use crate::numerics::Budget;
 
 /// Torque margin above T_max before an interval counts as over the envelope (spec §5.4).
 pub const OVER_ENVELOPE_TOL: f64 = 1e-9;
-/// Below this |P_m| the paper convention charges nothing (0/0 efficiency, spec §8 item 1) [W].
+/// Below this |P_m| the paper convention charges nothing (0/0 efficiency, spec §8 item 1) \[W\].
 pub const ZERO_POWER_W: f64 = 1e-9;
 /// Convergence of the forward-mode end speed (spec §5.4) [m/s].
 pub const FORWARD_TOL: f64 = 1e-10;
@@ -25,9 +25,9 @@ const BUDGET_STRIDE: usize = 4096;
 /// Vehicle in SI units (spec §3.1).
 #[derive(Debug, Clone, Copy)]
 pub struct Vehicle {
-    /// Total mass m [kg].
+    /// Total mass m \[kg\].
     pub mass: f64,
-    /// Effective (inertial) mass m(1+δ) [kg].
+    /// Effective (inertial) mass m(1+δ) \[kg\].
     pub mass_eff: f64,
     /// g [m/s²].
     pub gravity: f64,
@@ -35,18 +35,18 @@ pub struct Vehicle {
     pub rolling: f64,
     /// ½ ρ C_d A_F [kg/m].
     pub aero: f64,
-    /// Wheel radius r [m].
+    /// Wheel radius r \[m\].
     pub wheel_radius: f64,
     /// Gear ratio i_g.
     pub gear_ratio: f64,
     /// Gear efficiency η_T.
     pub gear_eff: f64,
-    /// Auxiliary power [W].
+    /// Auxiliary power \[W\].
     pub aux_w: f64,
 }
 
 impl Vehicle {
-    /// Road resistance F_roll + F_aero + F_grade at mean speed v̄ on slope `grade` (eq. 4) [N].
+    /// Road resistance F_roll + F_aero + F_grade at mean speed v̄ on slope `grade` (eq. 4) \[N\].
     #[must_use]
     pub fn resistance(&self, vbar: f64, grade: f64) -> f64 {
         let sec = grade.hypot(1.0);
@@ -125,7 +125,7 @@ impl Kahan {
     }
 }
 
-/// Energy sums of the loss breakdown [J].
+/// Energy sums of the loss breakdown \[J\].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BreakdownSums {
     /// Delivered wheel energy.
@@ -155,7 +155,7 @@ pub struct BreakdownSums {
 /// Per-interval traces.
 #[derive(Debug, Clone, Default)]
 pub struct TraceData {
-    /// Interval start [s].
+    /// Interval start \[s\].
     pub t: Vec<f64>,
     /// v̄ [m/s].
     pub v: Vec<f64>,
@@ -165,26 +165,26 @@ pub struct TraceData {
     pub t_demand: Vec<f64>,
     /// Delivered motor torque [N·m].
     pub t_motor: Vec<f64>,
-    /// P_m [W].
+    /// P_m \[W\].
     pub p_m: Vec<f64>,
-    /// P_loss [W].
+    /// P_loss \[W\].
     pub p_loss: Vec<f64>,
-    /// P_in [W].
+    /// P_in \[W\].
     pub p_in: Vec<f64>,
 }
 
 /// Outcome of one motor over one cycle.
 #[derive(Debug, Clone, Default)]
 pub struct SimOutcome {
-    /// Distance (achieved) [m].
+    /// Distance (achieved) \[m\].
     pub distance_m: f64,
-    /// Net battery energy E_in [J].
+    /// Net battery energy E_in \[J\].
     pub e_in: f64,
-    /// Σ positive P_in Δt [J].
+    /// Σ positive P_in Δt \[J\].
     pub e_pos: f64,
-    /// Σ negative P_in Δt [J].
+    /// Σ negative P_in Δt \[J\].
     pub e_neg: f64,
-    /// Friction-brake energy at the wheel [J].
+    /// Friction-brake energy at the wheel \[J\].
     pub brake: f64,
     /// Intervals.
     pub n_intervals: u64,
@@ -207,7 +207,7 @@ pub struct SimOutcome {
     pub ecm: Option<EcmState>,
     /// Loss breakdown sums.
     pub sums: BreakdownSums,
-    /// (motor speed [rad/s], torque demand [N·m], Δt [s]) of moving intervals.
+    /// (motor speed [rad/s], torque demand [N·m], Δt \[s\]) of moving intervals.
     pub hist_samples: Vec<(f64, f64, f64)>,
     /// Traces.
     pub traces: Option<TraceData>,

@@ -52,16 +52,16 @@ pub struct BusFuelEconomyRequest {
 #[schema(as = bus_fuel_economy::VehicleSpec)]
 #[serde(deny_unknown_fields, default)]
 pub struct VehicleSpec {
-    /// Curb mass [kg].
+    /// Curb mass \[kg\].
     #[schema(example = 12500.0)]
     pub curb_mass_kg: f64,
     /// Number of passengers [-] (0..500).
     #[schema(example = 40)]
     pub passengers: u32,
-    /// Mass per passenger [kg].
+    /// Mass per passenger \[kg\].
     #[schema(example = 65.0)]
     pub mass_per_passenger_kg: f64,
-    /// Frontal area A_F [m²].
+    /// Frontal area A_F \[m²\].
     #[schema(example = 6.72)]
     pub frontal_area_m2: f64,
     /// Aerodynamic drag coefficient C_d [-].
@@ -76,7 +76,7 @@ pub struct VehicleSpec {
     /// Gravitational acceleration g [m/s²].
     #[schema(example = 9.81)]
     pub gravity: f64,
-    /// Wheel radius r [m].
+    /// Wheel radius r \[m\].
     #[schema(example = 0.48)]
     pub wheel_radius_m: f64,
     /// Single fixed reduction ratio i_g [-] (service minimum 0.01).
@@ -91,7 +91,7 @@ pub struct VehicleSpec {
     /// Constant road slope tanθ [-] (a custom cycle's own `grade` array replaces it).
     #[schema(example = 0.0)]
     pub grade: f64,
-    /// Constant auxiliary DC load [W].
+    /// Constant auxiliary DC load \[W\].
     #[schema(example = 0.0)]
     pub aux_power_w: f64,
 }
@@ -157,10 +157,10 @@ pub struct BatterySpec {
     /// constant: battery efficiency η_Bat [-] (default 1.0, service minimum 0.01).
     #[schema(example = 1.0)]
     pub efficiency: Option<f64>,
-    /// ecm_2rc: nominal voltage [V] (default 360), used for the charge capacity Q.
+    /// ecm_2rc: nominal voltage \[V\] (default 360), used for the charge capacity Q.
     #[schema(example = 360.0)]
     pub nominal_voltage: Option<f64>,
-    /// ecm_2rc: energy capacity [kWh] (default 256).
+    /// ecm_2rc: energy capacity \[kWh\] (default 256).
     #[schema(example = 256.0)]
     pub capacity_kwh: Option<f64>,
     /// ecm_2rc: initial state of charge (0, 1] [-].
@@ -168,21 +168,21 @@ pub struct BatterySpec {
     pub soc_initial: Option<f64>,
     /// ecm_2rc: SOC points of the open-circuit-voltage table, strictly increasing in [0, 1].
     pub ocv_soc: Option<Vec<f64>>,
-    /// ecm_2rc: open-circuit voltage at `ocv_soc` [V] (> 0).
+    /// ecm_2rc: open-circuit voltage at `ocv_soc` \[V\] (> 0).
     pub ocv_v: Option<Vec<f64>>,
-    /// ecm_2rc: series resistance R0 [Ω] (> 0).
+    /// ecm_2rc: series resistance R0 \[Ω\] (> 0).
     #[schema(example = 0.03)]
     pub r0_ohm: Option<f64>,
-    /// ecm_2rc: first RC branch resistance R1 [Ω] (≥ 0).
+    /// ecm_2rc: first RC branch resistance R1 \[Ω\] (≥ 0).
     #[schema(example = 0.01)]
     pub r1_ohm: Option<f64>,
-    /// ecm_2rc: first RC branch capacitance C1 [F] (> 0).
+    /// ecm_2rc: first RC branch capacitance C1 \[F\] (> 0).
     #[schema(example = 3000.0)]
     pub c1_f: Option<f64>,
-    /// ecm_2rc: second RC branch resistance R2 [Ω] (≥ 0).
+    /// ecm_2rc: second RC branch resistance R2 \[Ω\] (≥ 0).
     #[schema(example = 0.01)]
     pub r2_ohm: Option<f64>,
-    /// ecm_2rc: second RC branch capacitance C2 [F] (> 0).
+    /// ecm_2rc: second RC branch capacitance C2 \[F\] (> 0).
     #[schema(example = 30000.0)]
     pub c2_f: Option<f64>,
 }
@@ -206,7 +206,7 @@ pub enum CycleSpec {
 pub struct CustomCycle {
     /// Cycle name (unique in the request, 1..64 characters).
     pub name: String,
-    /// Sample times [s].
+    /// Sample times \[s\].
     pub time_s: Vec<f64>,
     /// Sample speeds [km/h].
     pub speed_kmh: Option<Vec<f64>>,
@@ -221,7 +221,7 @@ pub struct CustomCycle {
 #[schema(as = bus_fuel_economy::EnvelopeTable)]
 #[serde(deny_unknown_fields)]
 pub struct EnvelopeTable {
-    /// Speeds [rpm], strictly increasing, first ≥ 0.
+    /// Speeds \[rpm\], strictly increasing, first ≥ 0.
     pub speed_rpm: Vec<f64>,
     /// Maximum motor torque at `speed_rpm` [N·m] (> 0).
     pub t_max_nm: Vec<f64>,
@@ -268,10 +268,10 @@ pub struct ConstantMotor {
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
     #[schema(example = 800.0)]
     pub t_peak_nm: Option<f64>,
-    /// Peak power [W] (default 130 000; ignored when `envelope` is given).
+    /// Peak power \[W\] (default 130 000; ignored when `envelope` is given).
     #[schema(example = 130000.0)]
     pub p_peak_w: Option<f64>,
-    /// Maximum speed [rpm] (default 5200); a cycle needing more is rejected.
+    /// Maximum speed \[rpm\] (default 5200); a cycle needing more is rejected.
     #[schema(example = 5200.0)]
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope (replaces `t_peak_nm` / `p_peak_w`).
@@ -286,19 +286,19 @@ pub struct ConstantMotor {
 pub struct EfficiencyMapMotor {
     /// Motor name (unique in the request, 1..64 characters).
     pub id: String,
-    /// Speed axis [rpm]: strictly increasing, ≥ 2 points, first ≥ 0.
+    /// Speed axis \[rpm\]: strictly increasing, ≥ 2 points, first ≥ 0.
     pub speed_rpm: Vec<f64>,
     /// Torque axis [N·m]: strictly increasing, ≥ 2 points, first ≥ 0.
     pub torque_nm: Vec<f64>,
-    /// Efficiency η[speed][torque] in [1e-6, 1] (motoring).
+    /// Efficiency η\[speed\]\[torque\] in [1e-6, 1] (motoring).
     pub efficiency: Vec<Vec<f64>>,
     /// Generating efficiency at −torque_nm, same shape (default: mirror of `efficiency`).
     pub efficiency_gen: Option<Vec<Vec<f64>>>,
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
     pub t_peak_nm: Option<f64>,
-    /// Peak power [W] (default 130 000; ignored when `envelope` is given).
+    /// Peak power \[W\] (default 130 000; ignored when `envelope` is given).
     pub p_peak_w: Option<f64>,
-    /// Maximum speed [rpm] (default 5200).
+    /// Maximum speed \[rpm\] (default 5200).
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope.
     #[schema(nullable = false)]
@@ -312,17 +312,17 @@ pub struct EfficiencyMapMotor {
 pub struct LossMapMotor {
     /// Motor name (unique in the request, 1..64 characters).
     pub id: String,
-    /// Speed axis [rpm]: strictly increasing, ≥ 2 points, first ≥ 0.
+    /// Speed axis \[rpm\]: strictly increasing, ≥ 2 points, first ≥ 0.
     pub speed_rpm: Vec<f64>,
     /// Signed torque axis [N·m]: strictly increasing, ≥ 2 points, must contain 0.
     pub torque_nm: Vec<f64>,
-    /// Total motor loss P_loss[speed][torque] [W] (≥ 0).
+    /// Total motor loss P_loss\[speed\]\[torque\] \[W\] (≥ 0).
     pub loss_w: Vec<Vec<f64>>,
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
     pub t_peak_nm: Option<f64>,
-    /// Peak power [W] (default 130 000; ignored when `envelope` is given).
+    /// Peak power \[W\] (default 130 000; ignored when `envelope` is given).
     pub p_peak_w: Option<f64>,
-    /// Maximum speed [rpm] (default 5200).
+    /// Maximum speed \[rpm\] (default 5200).
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope.
     #[schema(nullable = false)]
@@ -334,10 +334,10 @@ pub struct LossMapMotor {
 #[schema(as = bus_fuel_economy::BackEmf)]
 #[serde(deny_unknown_fields)]
 pub struct BackEmf {
-    /// Peak phase back-EMF [V].
+    /// Peak phase back-EMF \[V\].
     #[schema(example = 83.3)]
     pub v_peak_phase: f64,
-    /// Speed of the measurement [rpm].
+    /// Speed of the measurement \[rpm\].
     #[schema(example = 1000.0)]
     pub at_rpm: f64,
 }
@@ -367,7 +367,7 @@ pub struct NoAcFactor {}
 #[schema(as = bus_fuel_economy::AcFactorTable)]
 #[serde(deny_unknown_fields)]
 pub struct AcFactorTable {
-    /// Electrical frequencies [Hz], strictly increasing, ≥ 0.
+    /// Electrical frequencies \[Hz\], strictly increasing, ≥ 0.
     pub freq_hz: Vec<f64>,
     /// k_AC at `freq_hz` [-] (≥ 1).
     pub k_ac: Vec<f64>,
@@ -378,7 +378,7 @@ pub struct AcFactorTable {
 #[schema(as = bus_fuel_economy::DowellSpec)]
 #[serde(deny_unknown_fields)]
 pub struct DowellSpec {
-    /// Conductor height h in the slot-depth direction [m].
+    /// Conductor height h in the slot-depth direction \[m\].
     #[schema(example = 0.0035)]
     pub conductor_height_m: f64,
     /// Number of conductor layers m in the slot [-] (1..100).
@@ -387,10 +387,10 @@ pub struct DowellSpec {
     /// Layer porosity factor (0, 1] [-].
     #[schema(example = 0.9)]
     pub porosity: f64,
-    /// Active (slot) length of the winding per side L_stack [m].
+    /// Active (slot) length of the winding per side L_stack \[m\].
     #[schema(example = 0.083)]
     pub stack_length_m: f64,
-    /// End-winding length per side L_end [m] (≥ 0).
+    /// End-winding length per side L_end \[m\] (≥ 0).
     #[schema(example = 0.05)]
     pub end_length_m: f64,
 }
@@ -431,19 +431,19 @@ pub struct IpmsmMotor {
     /// Pole pairs p (1..32).
     #[schema(example = 4)]
     pub pole_pairs: u32,
-    /// Peak phase PM flux linkage ψ_m [Wb] (give this or `back_emf`).
+    /// Peak phase PM flux linkage ψ_m \[Wb\] (give this or `back_emf`).
     #[schema(example = 0.198864)]
     pub psi_m_wb: Option<f64>,
     /// Back-EMF from which ψ_m is derived (give this or `psi_m_wb`).
     #[schema(nullable = false)]
     pub back_emf: Option<BackEmf>,
-    /// d-axis inductance L_d [H] (> 0).
+    /// d-axis inductance L_d \[H\] (> 0).
     #[schema(example = 0.00035)]
     pub ld_h: f64,
-    /// q-axis inductance L_q [H] (≥ L_d).
+    /// q-axis inductance L_q \[H\] (≥ L_d).
     #[schema(example = 0.00055)]
     pub lq_h: f64,
-    /// Phase resistance at 20 °C R_20 [Ω] (> 0).
+    /// Phase resistance at 20 °C R_20 \[Ω\] (> 0).
     #[schema(example = 0.006)]
     pub r_phase_20c_ohm: f64,
     /// Winding temperature T_w [°C] (default 100).
@@ -452,19 +452,19 @@ pub struct IpmsmMotor {
     /// Current limit [A rms] (I_pk = √2·i_max_arms).
     #[schema(example = 500.0)]
     pub i_max_arms: f64,
-    /// DC-link voltage V_dc [V].
+    /// DC-link voltage V_dc \[V\].
     #[schema(example = 360.0)]
     pub v_dc: f64,
     /// Voltage utilisation (0, 1.155] [-] (default 1.0 → V_max = V_dc/√3).
     #[schema(example = 1.0)]
     pub voltage_utilization: Option<f64>,
-    /// Maximum speed [rpm]; a cycle needing more is rejected.
+    /// Maximum speed \[rpm\]; a cycle needing more is rejected.
     #[schema(example = 5200.0)]
     pub n_max_rpm: f64,
     /// Torque cap [N·m] (default none).
     #[schema(example = 800.0)]
     pub t_cap_nm: Option<f64>,
-    /// Power cap [W] (default none).
+    /// Power cap \[W\] (default none).
     #[schema(example = 130000.0)]
     pub p_cap_w: Option<f64>,
     /// AC resistance factor model (default `none`).
@@ -539,7 +539,7 @@ pub enum OutputKind {
 #[schema(as = bus_fuel_economy::GridSpec)]
 #[serde(deny_unknown_fields)]
 pub struct GridSpec {
-    /// Speed step [rpm].
+    /// Speed step \[rpm\].
     #[schema(example = 250.0)]
     pub speed_step_rpm: f64,
     /// Torque step [N·m].
@@ -561,7 +561,7 @@ impl Default for GridSpec {
 #[schema(as = bus_fuel_economy::HistogramSpec)]
 #[serde(deny_unknown_fields)]
 pub struct HistogramSpec {
-    /// Speed bin width [rpm].
+    /// Speed bin width \[rpm\].
     #[schema(example = 500.0)]
     pub speed_bin_rpm: f64,
     /// Torque bin width [N·m].
@@ -685,19 +685,19 @@ pub struct CycleResult {
     pub motor: String,
     /// Cycle name.
     pub cycle: String,
-    /// Distance driven D [km] (achieved distance in `forward` mode).
+    /// Distance driven D \[km\] (achieved distance in `forward` mode).
     pub distance_km: f64,
-    /// Cycle duration [s].
+    /// Cycle duration \[s\].
     pub duration_s: f64,
     /// Highest trace speed [km/h].
     pub max_speed_kmh: f64,
     /// Number of simulated intervals (after sub-stepping).
     pub n_intervals: u64,
-    /// Energy drawn from the battery E_in (net; chemical side for `ecm_2rc`) [kWh].
+    /// Energy drawn from the battery E_in (net; chemical side for `ecm_2rc`) \[kWh\].
     pub energy_in_kwh: f64,
-    /// Σ of positive battery power × Δt [kWh].
+    /// Σ of positive battery power × Δt \[kWh\].
     pub energy_traction_kwh: f64,
-    /// Σ of negative battery power × Δt (≤ 0) [kWh].
+    /// Σ of negative battery power × Δt (≤ 0) \[kWh\].
     pub energy_regen_kwh: f64,
     /// Fuel economy FE = D / E_in [km/kWh] (paper eq. 1); null when E_in ≤ 0.
     pub fe_km_per_kwh: Option<f64>,
@@ -718,11 +718,11 @@ pub struct CycleResult {
     pub n_loss_clamped: u64,
     /// Largest motor torque demand T_M [N·m].
     pub max_motor_torque_demand_nm: f64,
-    /// Largest motor speed over the (achieved) samples [rpm].
+    /// Largest motor speed over the (achieved) samples \[rpm\].
     pub max_motor_speed_rpm: f64,
-    /// Energy dissipated in the friction brakes, at the wheel [kWh].
+    /// Energy dissipated in the friction brakes, at the wheel \[kWh\].
     pub friction_brake_kwh: f64,
-    /// Cycle distance − achieved distance [km] (`forward` mode only).
+    /// Cycle distance − achieved distance \[km\] (`forward` mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub trace_miss_km: Option<f64>,
     /// State of charge at the end (`ecm_2rc` only).
@@ -747,37 +747,37 @@ pub struct CycleResult {
     pub warnings: Vec<String>,
 }
 
-/// Energy per mechanism over the cycle [kWh]. Closure: energy_in = wheel + gear + friction brakes
+/// Energy per mechanism over the cycle \[kWh\]. Closure: energy_in = wheel + gear + friction brakes
 /// + motor_charged + inverter + battery + aux (to rounding).
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bus_fuel_economy::LossBreakdown)]
 pub struct LossBreakdown {
-    /// Net energy at the wheels Σ F·v̄·Δt (road load plus net kinetic/potential change) [kWh].
+    /// Net energy at the wheels Σ F·v̄·Δt (road load plus net kinetic/potential change) \[kWh\].
     pub wheel_kwh: f64,
-    /// Gear loss [kWh].
+    /// Gear loss \[kWh\].
     pub gear_kwh: f64,
-    /// Friction-brake energy at the wheel [kWh].
+    /// Friction-brake energy at the wheel \[kWh\].
     pub friction_brake_kwh: f64,
-    /// Motor loss charged by the power convention Σ(P_el − P_m)Δt [kWh].
+    /// Motor loss charged by the power convention Σ(P_el − P_m)Δt \[kWh\].
     pub motor_charged_kwh: f64,
-    /// Motor model loss at the evaluated operating points Σ P_loss Δt [kWh] (equals
+    /// Motor model loss at the evaluated operating points Σ P_loss Δt \[kWh\] (equals
     /// `motor_charged_kwh` for the `loss` convention).
     pub motor_model_kwh: f64,
-    /// DC copper loss part of the model loss (ipmsm only) [kWh].
+    /// DC copper loss part of the model loss (ipmsm only) \[kWh\].
     pub motor_cu_dc_kwh: Option<f64>,
-    /// Extra AC copper loss (k_AC − 1)·P_cu,DC (ipmsm only) [kWh].
+    /// Extra AC copper loss (k_AC − 1)·P_cu,DC (ipmsm only) \[kWh\].
     pub motor_cu_ac_extra_kwh: Option<f64>,
-    /// Iron loss (ipmsm only) [kWh].
+    /// Iron loss (ipmsm only) \[kWh\].
     pub motor_iron_kwh: Option<f64>,
-    /// Mechanical loss (ipmsm only) [kWh].
+    /// Mechanical loss (ipmsm only) \[kWh\].
     pub motor_mech_kwh: Option<f64>,
-    /// Inverter loss [kWh].
+    /// Inverter loss \[kWh\].
     pub inverter_kwh: f64,
-    /// Battery loss (P_in − P_dc) [kWh].
+    /// Battery loss (P_in − P_dc) \[kWh\].
     pub battery_kwh: f64,
-    /// Auxiliary load [kWh].
+    /// Auxiliary load \[kWh\].
     pub aux_kwh: f64,
-    /// Wheel traction demanded but dropped by `mode: clip` [kWh] (not part of the closure).
+    /// Wheel traction demanded but dropped by `mode: clip` \[kWh\] (not part of the closure).
     pub clipped_traction_kwh: f64,
     /// Energy-weighted mean motor efficiency Σ|P_m|Δt / Σ(|P_m| + P_loss)Δt [-].
     pub mean_motor_efficiency: Option<f64>,
@@ -787,7 +787,7 @@ pub struct LossBreakdown {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bus_fuel_economy::OpHistogram)]
 pub struct OpHistogram {
-    /// Speed bin edges [rpm] (from 0).
+    /// Speed bin edges \[rpm\] (from 0).
     pub speed_edges_rpm: Vec<f64>,
     /// Torque bin edges [N·m] (multiples of the bin width).
     pub torque_edges_nm: Vec<f64>,
@@ -803,7 +803,7 @@ pub struct OpHistogram {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bus_fuel_economy::ModalBin)]
 pub struct ModalBin {
-    /// Speed range [rpm].
+    /// Speed range \[rpm\].
     pub rpm: [f64; 2],
     /// Torque range [N·m].
     pub nm: [f64; 2],
@@ -815,7 +815,7 @@ pub struct ModalBin {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bus_fuel_economy::Traces)]
 pub struct Traces {
-    /// Interval start time [s].
+    /// Interval start time \[s\].
     pub t_s: Vec<f64>,
     /// Mean (achieved) speed v̄ [m/s].
     pub v_mps: Vec<f64>,
@@ -825,11 +825,11 @@ pub struct Traces {
     pub torque_demand_nm: Vec<f64>,
     /// Motor torque delivered (after clip / regen limit) [N·m].
     pub torque_motor_nm: Vec<f64>,
-    /// Motor shaft power P_m [W].
+    /// Motor shaft power P_m \[W\].
     pub p_mech_w: Vec<f64>,
-    /// Motor model loss P_loss [W].
+    /// Motor model loss P_loss \[W\].
     pub p_loss_w: Vec<f64>,
-    /// Battery internal power P_in [W].
+    /// Battery internal power P_in \[W\].
     pub p_in_w: Vec<f64>,
 }
 
@@ -839,13 +839,13 @@ pub struct Traces {
 pub struct MotorMapData {
     /// Motor id.
     pub motor: String,
-    /// Speed axis [rpm].
+    /// Speed axis \[rpm\].
     pub speed_rpm: Vec<f64>,
     /// Torque axis [N·m].
     pub torque_nm: Vec<f64>,
     /// Envelope T_max at `speed_rpm` [N·m].
     pub t_max_nm: Vec<f64>,
-    /// η[speed][torque] [-].
+    /// η\[speed\]\[torque\] [-].
     pub efficiency: Vec<Vec<Option<f64>>>,
 }
 
@@ -920,13 +920,13 @@ pub struct MotorMapRequest {
 pub struct MotorMapResponse {
     /// Motor id.
     pub motor: String,
-    /// Speed axis [rpm].
+    /// Speed axis \[rpm\].
     pub speed_rpm: Vec<f64>,
     /// Torque axis [N·m] (signed, contains 0).
     pub torque_nm: Vec<f64>,
     /// Envelope T_max at `speed_rpm` [N·m].
     pub t_max_nm: Vec<f64>,
-    /// Total motor loss [W], loss_w[speed][torque].
+    /// Total motor loss \[W\], loss_w\[speed\]\[torque\].
     pub loss_w: Vec<Vec<Option<f64>>>,
     /// Efficiency |P_m| / (|P_m| + P_loss) [-] (0 at zero power, spec §5.5).
     pub efficiency: Vec<Vec<Option<f64>>>,
@@ -940,7 +940,7 @@ pub struct MotorMapResponse {
     pub report: SolverReport,
 }
 
-/// ipmsm loss components on the grid [W] (null outside the envelope).
+/// ipmsm loss components on the grid \[W\] (null outside the envelope).
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = bus_fuel_economy::LossComponentMaps)]
 pub struct LossComponentMaps {
@@ -960,13 +960,13 @@ pub struct LossComponentMaps {
     pub mode: Vec<Vec<Option<String>>>,
 }
 
-/// Curb mass [kg].
+/// Curb mass \[kg\].
 pub const CURB_MASS_KG: Range = Range::FINITE.gt(0.0).max(1e5);
 /// Passengers [–].
 pub const PASSENGERS: Range = Range::int(0, 500);
-/// Mass per passenger [kg].
+/// Mass per passenger \[kg\].
 pub const MASS_PER_PASSENGER_KG: Range = Range::closed(0.0, 200.0);
-/// Frontal area [m²].
+/// Frontal area \[m²\].
 pub const FRONTAL_AREA_M2: Range = Range::FINITE.gt(0.0).max(30.0);
 /// Drag coefficient [–].
 pub const DRAG_COEFF: Range = Range::FINITE.gt(0.0).max(3.0);
@@ -976,7 +976,7 @@ pub const ROLLING_COEFF: Range = Range::closed(0.0, 0.1);
 pub const AIR_DENSITY: Range = Range::FINITE.gt(0.0).max(2.0);
 /// Gravity [m/s²].
 pub const GRAVITY: Range = Range::FINITE.gt(9.0).max(10.5);
-/// Wheel radius [m].
+/// Wheel radius \[m\].
 pub const WHEEL_RADIUS_M: Range = Range::FINITE.gt(0.1).max(2.0);
 /// Final-drive gear ratio [–].
 pub const GEAR_RATIO: Range = Range::closed(0.01, 50.0);
@@ -986,63 +986,63 @@ pub const EFFICIENCY: Range = Range::closed(0.01, 1.0);
 pub const FRACTION: Range = Range::closed(0.0, 1.0);
 /// Road grade (rise over run) [–].
 pub const GRADE: Range = Range::closed(-0.3, 0.3);
-/// Auxiliary power [W].
+/// Auxiliary power \[W\].
 pub const AUX_POWER_W: Range = Range::closed(0.0, 1e5);
-/// Battery nominal voltage [V].
+/// Battery nominal voltage \[V\].
 pub const NOMINAL_VOLTAGE: Range = Range::FINITE.gt(0.0).max(5000.0);
-/// Battery capacity [kWh].
+/// Battery capacity \[kWh\].
 pub const CAPACITY_KWH: Range = Range::FINITE.gt(0.0).max(1e4);
 /// Initial state of charge [–]: (0, 1] (spec §2).
 pub const SOC_INITIAL: Range = Range::FINITE.gt(0.0).max(1.0);
-/// Series resistance R0 [Ω]: > 0 (spec §2).
+/// Series resistance R0 \[Ω\]: > 0 (spec §2).
 pub const R0_OHM: Range = Range::FINITE.gt(0.0).max(100.0);
-/// RC-branch resistance R1, R2 [Ω]: ≥ 0 (spec §2).
+/// RC-branch resistance R1, R2 \[Ω\]: ≥ 0 (spec §2).
 pub const RC_OHM: Range = Range::closed(0.0, 100.0);
-/// RC-branch capacitance C1, C2 [F]: > 0 (spec §2).
+/// RC-branch capacitance C1, C2 \[F\]: > 0 (spec §2).
 pub const RC_F: Range = Range::FINITE.gt(0.0).max(1e9);
 /// Torque [N·m] (peak, cap, envelope values): positive.
 pub const TORQUE_NM: Range = Range::FINITE.gt(0.0).max(1e6);
-/// Power [W] (peak, cap): positive.
+/// Power \[W\] (peak, cap): positive.
 pub const POWER_W: Range = Range::FINITE.gt(0.0).max(1e9);
-/// Motor top speed [rpm].
+/// Motor top speed \[rpm\].
 pub const N_MAX_RPM: Range = Range::FINITE.gt(0.0).max(1e5);
 /// Pole pairs [–].
 pub const POLE_PAIRS: Range = Range::int(1, 32);
-/// Permanent-magnet flux linkage ψ_m [Wb].
+/// Permanent-magnet flux linkage ψ_m \[Wb\].
 pub const PSI_M_WB: Range = Range::FINITE.gt(0.0).max(100.0);
-/// Back-EMF peak phase voltage [V] and its speed [rpm].
+/// Back-EMF peak phase voltage \[V\] and its speed \[rpm\].
 pub const BACK_EMF: Range = Range::FINITE.gt(0.0).max(1e5);
-/// d- and q-axis inductance [H].
+/// d- and q-axis inductance \[H\].
 pub const INDUCTANCE_H: Range = Range::FINITE.gt(0.0).max(1.0);
-/// Phase resistance at 20 °C [Ω].
+/// Phase resistance at 20 °C \[Ω\].
 pub const R_PHASE_OHM: Range = Range::FINITE.gt(0.0).max(100.0);
 /// Winding temperature [°C] (spec §2).
 pub const WINDING_TEMP_C: Range = Range::closed(-40.0, 250.0);
-/// Current limit [A rms] and DC-link voltage [V].
+/// Current limit [A rms] and DC-link voltage \[V\].
 pub const ELECTRIC_LIMIT: Range = Range::FINITE.gt(0.0).max(1e5);
 /// Voltage utilisation [–] (≤ 2/√3 with space-vector modulation).
 pub const VOLTAGE_UTILIZATION: Range = Range::FINITE.gt(0.0).max(1.155);
 /// Stack scale [–].
 pub const STACK_SCALE: Range = Range::FINITE.gt(0.0).max(10.0);
-/// Dowell conductor height [m].
+/// Dowell conductor height \[m\].
 pub const CONDUCTOR_HEIGHT_M: Range = Range::FINITE.gt(0.0).max(0.1);
 /// Dowell conductor layers [–].
 pub const LAYERS: Range = Range::int(1, 100);
 /// Dowell porosity [–].
 pub const POROSITY: Range = Range::FINITE.gt(0.0).max(1.0);
-/// Stack length [m].
+/// Stack length \[m\].
 pub const STACK_LENGTH_M: Range = Range::FINITE.gt(0.0).max(10.0);
-/// End-winding length [m].
+/// End-winding length \[m\].
 pub const END_LENGTH_M: Range = Range::closed(0.0, 10.0);
 /// Iron and mechanical loss coefficients (k_h, k_e, c_fric, c_wind): ≥ 0 (spec §2).
 pub const LOSS_COEFF: Range = Range::closed(0.0, 1e6);
 /// AC resistance factor k_AC [–].
 pub const K_AC: Range = Range::closed(1.0, 1000.0);
-/// Loss-map grid speed step [rpm].
+/// Loss-map grid speed step \[rpm\].
 pub const SPEED_STEP_RPM: Range = Range::closed(1.0, 1e4);
 /// Loss-map grid torque step [N·m].
 pub const TORQUE_STEP_NM: Range = Range::closed(0.1, 1e4);
-/// Operating-point histogram speed bin [rpm].
+/// Operating-point histogram speed bin \[rpm\].
 pub const SPEED_BIN_RPM: Range = Range::closed(1.0, 1e5);
 /// Operating-point histogram torque bin [N·m].
 pub const TORQUE_BIN_NM: Range = Range::closed(0.1, 1e5);
@@ -1050,21 +1050,21 @@ pub const TORQUE_BIN_NM: Range = Range::closed(0.1, 1e5);
 pub const SUBSTEPS: Range = Range::int(1, 32);
 /// Desirability weight of a cycle [–] (normalised to sum 1; not all 0).
 pub const DESIRABILITY_WEIGHT: Range = Range::closed(0.0, 1e6);
-/// Open-circuit voltage table values [V].
+/// Open-circuit voltage table values \[V\].
 pub const OCV_V: Range = Range::FINITE.gt(0.0).max(1e5);
-/// A motor speed axis [rpm] (strictly increasing).
+/// A motor speed axis \[rpm\] (strictly increasing).
 pub const SPEED_AXIS_RPM: Range = Range::closed(0.0, 1e5);
 /// A motoring torque axis [N·m] (strictly increasing).
 pub const TORQUE_AXIS_NM: Range = Range::closed(0.0, 1e6);
 /// A signed torque axis of a loss map [N·m] (strictly increasing, containing 0).
 pub const SIGNED_TORQUE_AXIS_NM: Range = Range::closed(-1e6, 1e6);
-/// A frequency axis of a k_AC table [Hz] (strictly increasing).
+/// A frequency axis of a k_AC table \[Hz\] (strictly increasing).
 pub const FREQ_HZ: Range = Range::closed(0.0, 1e7);
 /// An efficiency-map value [–]: the floor keeps the converted loss |P|(1/η − 1) finite.
 pub const MAP_EFFICIENCY: Range = Range::closed(1e-6, 1.0);
-/// A loss-map value [W].
+/// A loss-map value \[W\].
 pub const LOSS_W: Range = Range::closed(0.0, 1e9);
-/// Custom-cycle time [s] (about ±30 years: keeps Δt well resolved; strictly increasing, steps
+/// Custom-cycle time \[s\] (about ±30 years: keeps Δt well resolved; strictly increasing, steps
 /// of 1 ms to 60 s).
 pub const TIME_S: Range = Range::closed(-1e9, 1e9);
 /// Custom-cycle speed [m/s]: a service limit (720 km/h) that keeps v² and the road load finite.

@@ -55,13 +55,13 @@ pub const JUMP_REL_TOL: f64 = 1e-12;
 /// Boundary conditions of one motion segment (spec §2, the paper's constraint vector λ).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundaryConditions {
-    /// Segment start `t_a` [x].
+    /// Segment start `t_a` \[x\].
     pub t_a: f64,
-    /// Segment end `t_b` [x], `t_b > t_a`.
+    /// Segment end `t_b` \[x\], `t_b > t_a`.
     pub t_b: f64,
-    /// Displacement at the start `s_a` [U].
+    /// Displacement at the start `s_a` \[U\].
     pub s_a: f64,
-    /// Displacement at the end `s_b` [U].
+    /// Displacement at the end `s_b` \[U\].
     pub s_b: f64,
     /// Velocity at the start `v_a` [U/x].
     pub v_a: f64,
@@ -146,7 +146,7 @@ impl BoundaryConditions {
 #[schema(as = cam_law::Quantity)]
 #[serde(rename_all = "lowercase")]
 pub enum Quantity {
-    /// Displacement `s` [U].
+    /// Displacement `s` \[U\].
     S,
     /// Velocity `v = ds/dx` [U/x].
     V,
@@ -164,7 +164,7 @@ impl Quantity {
 /// The law's value at one abscissa.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
-    /// Displacement [U].
+    /// Displacement \[U\].
     pub s: f64,
     /// Velocity [U/x].
     pub v: f64,
@@ -191,9 +191,9 @@ impl Sample {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
 #[schema(as = cam_law::Knot)]
 pub struct Knot {
-    /// Knot abscissa `t_k` [x].
+    /// Knot abscissa `t_k` \[x\].
     pub x: f64,
-    /// Displacement `s_k` [U].
+    /// Displacement `s_k` \[U\].
     pub s: f64,
     /// Velocity `v_k` [U/x].
     pub v: f64,
@@ -215,7 +215,7 @@ pub struct Peaks {
     pub a_max_abs: f64,
     /// Largest |v| [U/x] (knots and interior stationary points of segments 0 and 6).
     pub v_max_abs: f64,
-    /// First abscissa where |v| reaches `v_max_abs` [x].
+    /// First abscissa where |v| reaches `v_max_abs` \[x\].
     pub x_at_v_max: f64,
     /// Largest finite |jerk| [U/x³] over segments of at least 1e-9·Δt (0 if none; impulses at
     /// acceleration jumps excluded).
@@ -226,7 +226,7 @@ pub struct Peaks {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
 #[schema(as = cam_law::Jump)]
 pub struct Jump {
-    /// Abscissa of the jump [x].
+    /// Abscissa of the jump \[x\].
     pub x: f64,
     /// Acceleration just left of `x` [U/x²].
     pub a_left: f64,
@@ -709,13 +709,13 @@ impl SevenSegmentLaw {
         &self.hat
     }
 
-    /// Absolute segment durations `c_k = ĉ_k·Δt` [x].
+    /// Absolute segment durations `c_k = ĉ_k·Δt` \[x\].
     #[must_use]
     pub fn durations(&self) -> &[f64; 7] {
         &self.dur
     }
 
-    /// Knot abscissae `t_0..t_7` [x] (`t_7 = t_b` exactly).
+    /// Knot abscissae `t_0..t_7` \[x\] (`t_7 = t_b` exactly).
     #[must_use]
     pub fn knot_times(&self) -> &[f64; 8] {
         &self.t

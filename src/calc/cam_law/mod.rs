@@ -9,7 +9,7 @@
 //!   inner loop).
 //! * [`catalogue`]: the Appendix-A laws in closed form ([`catalogue::NamedLaw`]), their peak
 //!   factors, and the Table-3 vectors ([`catalogue::TABLE3`], [`catalogue::nearest`]).
-//! * [`wire`] → [`input`] → [`compute`] → [`output`] (errors in [`error`]): the evaluate
+//! * [`wire`] → [`input`] → [`compute`](mod@compute) → [`output`] (errors in [`error`]): the evaluate
 //!   endpoint; the HTTP layer calls [`run`].
 //!
 //! # Validity and accuracy

@@ -63,16 +63,16 @@ pub struct EvaluateRequest {
 #[schema(as = cam_law::ConstraintsIn)]
 #[serde(deny_unknown_fields)]
 pub struct ConstraintsIn {
-    /// Segment start `t_a` [x]. Default: first abscissa (0 without an abscissa).
+    /// Segment start `t_a` \[x\]. Default: first abscissa (0 without an abscissa).
     #[schema(example = 0.0)]
     pub t_a: Option<f64>,
-    /// Segment end `t_b` [x], `> t_a`. Default: last abscissa (1 without an abscissa).
+    /// Segment end `t_b` \[x\], `> t_a`. Default: last abscissa (1 without an abscissa).
     #[schema(example = 1.0)]
     pub t_b: Option<f64>,
-    /// Displacement at the start `s_a` [U]. Default 0.
+    /// Displacement at the start `s_a` \[U\]. Default 0.
     #[schema(example = 0.0)]
     pub s_a: Option<f64>,
-    /// Displacement at the end `s_b` [U]. Default 1 (unit rise).
+    /// Displacement at the end `s_b` \[U\]. Default 1 (unit rise).
     #[schema(example = 1.0)]
     pub s_b: Option<f64>,
     /// Velocity at the start `v_a` [U/x]. Default 0.
@@ -94,7 +94,7 @@ pub struct ConstraintsIn {
 #[schema(as = cam_law::AbscissaIn)]
 #[serde(deny_unknown_fields)]
 pub struct AbscissaIn {
-    /// Explicit abscissae [x], strictly increasing, 1..200 000 values, all inside
+    /// Explicit abscissae \[x\], strictly increasing, 1..200 000 values, all inside
     /// `[t_a − 1e-9·Δt, t_b + 1e-9·Δt]` (values within that tolerance are clamped).
     #[serde(default)]
     #[schema(min_items = 1, max_items = 200000, example = json!([0.0, 0.25, 0.5, 0.75, 1.0]))]
@@ -110,10 +110,10 @@ pub struct AbscissaIn {
 #[schema(as = cam_law::GridIn)]
 #[serde(deny_unknown_fields)]
 pub struct GridIn {
-    /// First abscissa [x].
+    /// First abscissa \[x\].
     #[schema(example = 0.0)]
     pub start: f64,
-    /// Last abscissa [x], `> start`.
+    /// Last abscissa \[x\], `> start`.
     #[schema(example = 1.0)]
     pub end: f64,
     /// Number of points, 2..200 000.
@@ -194,7 +194,7 @@ pub struct PeaksOut {
     pub a_max_abs: Option<f64>,
     /// Largest |v| [U/x].
     pub v_max_abs: f64,
-    /// First abscissa where |v| is largest [x].
+    /// First abscissa where |v| is largest \[x\].
     pub x_at_v_max: f64,
     /// Largest finite |jerk| [U/x³] (impulses at jumps excluded); absent when the Appendix-A
     /// table gives Cj = ∞ for a named law outside the class.
@@ -210,9 +210,9 @@ pub struct PeaksOut {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cam_law::Curves)]
 pub struct Curves {
-    /// Abscissae as given [x].
+    /// Abscissae as given \[x\].
     pub x: Vec<f64>,
-    /// Displacement [U] (when requested).
+    /// Displacement \[U\] (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub s: Option<Vec<f64>>,
     /// Velocity [U/x] (when requested).
@@ -237,7 +237,7 @@ pub struct EvaluateResponse {
     /// Normalized coefficients `ĉ0..ĉ6` (Σ = 1); absent for named laws outside the class.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coefficients: Option<Vec<f64>>,
-    /// Segment durations `c_k = ĉ_k·Δt` [x]; absent for named laws outside the class.
+    /// Segment durations `c_k = ĉ_k·Δt` \[x\]; absent for named laws outside the class.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub durations: Option<Vec<f64>>,
     /// The 8 knots `t_0..t_7` with s, v and one-sided accelerations; absent for named laws

@@ -578,7 +578,7 @@ pub struct RunStats {
     pub evaluations: u64,
     /// Optimizer iterations.
     pub iterations: u64,
-    /// CPU time of the fit [ms].
+    /// CPU time of the fit \[ms\].
     pub cpu_ms: f64,
     /// Why the pipeline stopped.
     pub stop: StopReason,

@@ -24,9 +24,9 @@ pub const ABSCISSA_TOL: f64 = 1e-9;
 pub const MAX_COST: f64 = 2e10;
 /// Default evaluation cap (spec §2).
 pub const DEFAULT_MAX_EVALUATIONS: u64 = 50_000;
-/// Default time limit [ms] (spec §2).
+/// Default time limit \[ms\] (spec §2).
 pub const DEFAULT_TIME_LIMIT_MS: u64 = 10_000;
-/// Largest accepted time limit [ms] (spec §2; the end of the shared `time_limit_ms` bound, a whole
+/// Largest accepted time limit \[ms\] (spec §2; the end of the shared `time_limit_ms` bound, a whole
 /// number: the conversion is exact).
 pub const MAX_TIME_LIMIT_MS: u64 = crate::calc::common::TIME_LIMIT_MS.hi as u64;
 /// Default zero-snap threshold (spec §3.5.2 step 4).

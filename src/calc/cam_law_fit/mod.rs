@@ -5,15 +5,16 @@
 //! Algorithms", Electronics 2021, 10, 3073. Spec: `shared/specs/cam_law_fit.md` (errata of §3.7
 //! applied; the law itself is [`crate::calc::cam_law::law::SevenSegmentLaw`]).
 //!
-//! * [`prep`]: abscissa grid and the numpy-equivalent derivative for a missing channel (§3.3).
+//! * [`crate::numerics::grid`]: abscissa grid and the numpy-equivalent derivative for a missing
+//!   channel (§3.3).
 //! * [`objective`]: the paper's Euclidean norm (Eq. 7) and its DTW as the spec pins it (L1
 //!   local cost, Sakoe–Chiba band w, no normalization; §3.4), and the evaluation context that
 //!   counts evaluations and enforces the budget.
 //! * [`optim`]: least squares (`levenberg-marquardt` crate, x² parametrization), the paper's GA
 //!   (§3.5.1), scipy-style DE and a small CMA-ES with IPOP restarts.
-//! * [`compute`]: the `auto` pipeline (§3.5.2: multi-start least squares, zero-snap, DTW
+//! * [`compute`](mod@compute): the `auto` pipeline (§3.5.2: multi-start least squares, zero-snap, DTW
 //!   CMA-ES polish + IPOP) and the reported law (§3.6, §4); no wire types.
-//! * [`wire`] → [`input`] → [`compute`] → [`output`] (errors in [`error`]): the endpoint; the
+//! * [`wire`] → [`input`] → [`compute`](mod@compute) → [`output`] (errors in [`error`]): the endpoint; the
 //!   HTTP layer calls [`run`].
 //!
 //! # Validity and accuracy

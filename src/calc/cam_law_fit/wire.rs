@@ -83,12 +83,12 @@ pub struct FitCamLawRequest {
     pub units: Option<Units>,
 }
 
-/// Sample abscissae [x]: exactly one of `values` or `grid`.
+/// Sample abscissae \[x\]: exactly one of `values` or `grid`.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema)]
 #[schema(as = cam_law_fit::FitAbscissa)]
 #[serde(deny_unknown_fields)]
 pub struct FitAbscissa {
-    /// Explicit abscissae [x]: strictly increasing, finite, 8..200 000 values, inside
+    /// Explicit abscissae \[x\]: strictly increasing, finite, 8..200 000 values, inside
     /// `[t_a − 1e-9·Δt, t_b + 1e-9·Δt]`.
     #[serde(default)]
     #[schema(min_items = 8, max_items = 200000)]
@@ -104,10 +104,10 @@ pub struct FitAbscissa {
 #[schema(as = cam_law_fit::FitGrid)]
 #[serde(deny_unknown_fields)]
 pub struct FitGrid {
-    /// First abscissa [x].
+    /// First abscissa \[x\].
     #[schema(example = 0.0)]
     pub start: f64,
-    /// Last abscissa [x], `> start`.
+    /// Last abscissa \[x\], `> start`.
     #[schema(example = 1.0)]
     pub end: f64,
     /// Number of samples N, 8..200 000.
@@ -120,7 +120,7 @@ pub struct FitGrid {
 #[schema(as = cam_law_fit::Channels)]
 #[serde(deny_unknown_fields)]
 pub struct Channels {
-    /// Displacement samples `s_k` [U].
+    /// Displacement samples `s_k` \[U\].
     #[serde(default)]
     pub displacement: Option<Vec<f64>>,
     /// Velocity samples `v_k = ds/dx` [U/x].
@@ -136,7 +136,7 @@ pub struct Channels {
 #[schema(as = cam_law_fit::FitQuantity)]
 #[serde(rename_all = "snake_case")]
 pub enum FitQuantity {
-    /// Displacement `s` [U].
+    /// Displacement `s` \[U\].
     Displacement,
     /// Velocity `v` [U/x].
     Velocity,
@@ -149,17 +149,17 @@ pub enum FitQuantity {
 #[schema(as = cam_law_fit::FitConstraints)]
 #[serde(deny_unknown_fields)]
 pub struct FitConstraints {
-    /// Segment start `t_a` [x]. Default: first abscissa.
+    /// Segment start `t_a` \[x\]. Default: first abscissa.
     #[schema(example = 0.0)]
     pub t_a: Option<f64>,
-    /// Segment end `t_b` [x], `> t_a`. Default: last abscissa.
+    /// Segment end `t_b` \[x\], `> t_a`. Default: last abscissa.
     #[schema(example = 1.0)]
     pub t_b: Option<f64>,
-    /// Displacement at the start `s_a` [U]. Default: first displacement sample; required
+    /// Displacement at the start `s_a` \[U\]. Default: first displacement sample; required
     /// without a displacement channel.
     #[schema(example = 0.0)]
     pub s_a: Option<f64>,
-    /// Displacement at the end `s_b` [U]. Default: last displacement sample; required without
+    /// Displacement at the end `s_b` \[U\]. Default: last displacement sample; required without
     /// a displacement channel.
     #[schema(example = 1.0)]
     pub s_b: Option<f64>,
@@ -198,7 +198,7 @@ pub struct ObjectiveIn {
     /// `euclidean` (default) or `dtw`.
     #[serde(default)]
     pub metric: MetricName,
-    /// DTW band radius `w` [samples], `0 ≤ w ≤ N`; default 1 (reproduces the paper). Ignored
+    /// DTW band radius `w` \[samples\], `0 ≤ w ≤ N`; default 1 (reproduces the paper). Ignored
     /// for `euclidean`.
     #[serde(default)]
     #[schema(example = 1)]
@@ -240,7 +240,7 @@ pub struct OptimizerIn {
     #[serde(default)]
     #[schema(example = 50000)]
     pub max_evaluations: Option<u64>,
-    /// Wall-clock cap [ms], 1..600 000 (default 10 000); the best-so-far is returned with
+    /// Wall-clock cap \[ms\], 1..600 000 (default 10 000); the best-so-far is returned with
     /// `stop_reason: "deadline"` when it ends.
     #[serde(default)]
     #[schema(example = 10000)]
@@ -283,7 +283,7 @@ pub struct GaIn {
     /// Probability per gene of mutation around the range, 0..1 (paper 0.1).
     #[schema(example = 0.1)]
     pub p_range_mutation: Option<f64>,
-    /// Initial mutation range (absolute, genes in [0,1]), 0..1 (paper 0.10).
+    /// Initial mutation range (absolute, genes in \[0,1\]), 0..1 (paper 0.10).
     #[schema(example = 0.1)]
     pub range0: Option<f64>,
     /// Range factor applied every `range_every` generations, 0..1 (spec 0.25: "reduced by 75 %").
@@ -341,7 +341,7 @@ pub struct CurvesIn {
 pub struct FitCamLawResponse {
     /// Identified normalized coefficients `ĉ0..ĉ6` (Σ = 1; paper c1..c7).
     pub coefficients: Vec<f64>,
-    /// Segment durations `c_k = ĉ_k·Δt` [x].
+    /// Segment durations `c_k = ĉ_k·Δt` \[x\].
     pub durations: Vec<f64>,
     /// The 8 knots `t_0..t_7` with displacement, velocity and one-sided accelerations.
     pub knots: Vec<Knot>,
@@ -384,7 +384,7 @@ pub struct ObjectiveOut {
     pub metric: MetricName,
     /// Quantity compared.
     pub quantity: FitQuantity,
-    /// DTW band radius [samples]; null for `euclidean`.
+    /// DTW band radius \[samples\]; null for `euclidean`.
     pub dtw_window: Option<u64>,
     /// Objective at the initial coefficients [channel unit].
     pub initial: f64,
@@ -407,7 +407,7 @@ pub struct ChannelErrors {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
 #[schema(as = cam_law_fit::ErrorTable)]
 pub struct ErrorTable {
-    /// Displacement errors [U] (when the channel was supplied).
+    /// Displacement errors \[U\] (when the channel was supplied).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub displacement: Option<ChannelErrors>,
@@ -444,10 +444,10 @@ pub struct OptimizerReport {
     pub evaluations: u64,
     /// Iterations: GA/DE/CMA-ES generations plus least-squares (Jacobian) iterations.
     pub iterations: u64,
-    /// Time spent in the optimizer [ms] (single-threaded; measured by the monotonic clock, so it
+    /// Time spent in the optimizer \[ms\] (single-threaded; measured by the monotonic clock, so it
     /// equals CPU time unless the machine is oversubscribed).
     pub cpu_ms: f64,
-    /// Wall-clock time of the whole request computation, including validation and outputs [ms].
+    /// Wall-clock time of the whole request computation, including validation and outputs \[ms\].
     pub wall_ms: f64,
     /// Why the optimizer stopped: `converged`, `max_iterations`, `max_evaluations`, `deadline`
     /// (the time limit), `stall`, `completed`. A budget stop returns the best-so-far.
@@ -466,7 +466,7 @@ pub const DATA_VALUE: Range = crate::calc::cam_law::wire::BOUNDARY_VALUE;
 
 /// Samples of a generated abscissa grid [–] (spec §2: 7 unknowns need at least 8).
 pub const GRID_COUNT: Range = Range::int(MIN_SAMPLES as i64, MAX_SAMPLES as i64);
-/// DTW window [samples]; at most N, the number of samples (a cross-field rule).
+/// DTW window \[samples\]; at most N, the number of samples (a cross-field rule).
 pub const DTW_WINDOW: Range = Range::int(0, MAX_SAMPLES as i64);
 /// Objective evaluations of the optimizer [–].
 pub const MAX_EVALUATIONS: Range = Range::int(1, 10_000_000);

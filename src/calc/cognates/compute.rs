@@ -42,13 +42,13 @@ pub enum SnapStatus {
 pub struct SnapshotResult {
     /// Status of the mechanism's own input at this pose.
     pub status: SnapStatus,
-    /// Own absolute input angle [rad], if determined.
+    /// Own absolute input angle \[rad\], if determined.
     pub theta: Option<f64>,
     /// Own branch, if determined.
     pub branch: Option<Sign>,
     /// Crank joint, rocker joint, coupler point.
     pub joints: Option<(C64, C64, C64)>,
-    /// Transmission angle [rad].
+    /// Transmission angle \[rad\].
     pub mu: Option<f64>,
 }
 
@@ -59,7 +59,7 @@ pub struct Curve {
     pub closed: bool,
     /// Coupler points.
     pub points: Vec<C64>,
-    /// Absolute input angles [rad], wrapped to (−π, π].
+    /// Absolute input angles \[rad\], wrapped to (−π, π].
     pub theta: Vec<f64>,
     /// Branches.
     pub branch: Vec<Sign>,
@@ -74,9 +74,9 @@ pub struct Metrics {
     pub min: C64,
     /// Upper-right corner.
     pub max: C64,
-    /// Smallest transmission angle [rad].
+    /// Smallest transmission angle \[rad\].
     pub mu_min: f64,
-    /// Largest transmission angle [rad].
+    /// Largest transmission angle \[rad\].
     pub mu_max: f64,
     /// Samples.
     pub n: usize,
@@ -130,7 +130,7 @@ pub struct FiveBar {
     pub from: [&'static str; 2],
     /// Crank lengths.
     pub cranks: [f64; 2],
-    /// Phase ψ [rad].
+    /// Phase ψ \[rad\].
     pub phase: f64,
     /// Dyad lengths (crank tip to P).
     pub dyads: [f64; 2],

@@ -43,7 +43,7 @@ pub fn mag(z: C64) -> f64 {
     z.norm_sqr().sqrt()
 }
 
-/// Unit vector at angle `theta` [rad].
+/// Unit vector at angle `theta` \[rad\].
 #[must_use]
 pub fn cis(theta: f64) -> C64 {
     let (s, c) = theta.sin_cos();
@@ -237,9 +237,9 @@ pub struct Grashof {
 /// Feasible input range relative to the ground line (spec §4.3): `φ_min ≤ |φ| ≤ φ_max`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InputRange {
-    /// `φ_min` [rad], 0 when the crank tip can pass the output pivot's near side.
+    /// `φ_min` \[rad\], 0 when the crank tip can pass the output pivot's near side.
     pub phi_min: f64,
-    /// `φ_max` [rad], π when the crank can pass the far side.
+    /// `φ_max` \[rad\], π when the crank can pass the far side.
     pub phi_max: f64,
 }
 
@@ -264,7 +264,7 @@ impl InputRange {
         self.phi_min <= 0.0 && self.phi_max >= PI
     }
 
-    /// Feasible intervals of `φ` [rad]; case 3 runs through π and may end above π.
+    /// Feasible intervals of `φ` \[rad\]; case 3 runs through π and may end above π.
     #[must_use]
     pub fn intervals(&self) -> Vec<(f64, f64)> {
         if self.full_rotation() {
@@ -278,7 +278,7 @@ impl InputRange {
         }
     }
 
-    /// Toggle (dead-centre) input angles relative to the ground line [rad], wrapped to (−π, π].
+    /// Toggle (dead-centre) input angles relative to the ground line \[rad\], wrapped to (−π, π].
     #[must_use]
     pub fn toggles(&self) -> Vec<f64> {
         if self.full_rotation() {
@@ -347,7 +347,7 @@ impl FourBar {
             .min(self.rocker_joint_to_p())
     }
 
-    /// Direction of the ground line `arg(O_out − O_in)` [rad].
+    /// Direction of the ground line `arg(O_out − O_in)` \[rad\].
     #[must_use]
     pub fn ground_angle(&self) -> f64 {
         (self.output_pivot - self.input_pivot).arg()
@@ -461,7 +461,7 @@ impl FourBar {
         }
     }
 
-    /// Crank tip at absolute input angle `theta` [rad].
+    /// Crank tip at absolute input angle `theta` \[rad\].
     #[must_use]
     pub fn crank_tip(&self, theta: f64) -> C64 {
         self.input_pivot + cis(theta) * self.crank
@@ -474,7 +474,7 @@ impl FourBar {
         SINGULAR_REL * self.scale()
     }
 
-    /// Closed-form position analysis (spec §4.4) at absolute input angle `theta` [rad] on branch `t`.
+    /// Closed-form position analysis (spec §4.4) at absolute input angle `theta` \[rad\] on branch `t`.
     /// With `clamp`, a negative `h²` is set to 0 (for inputs known to lie inside the feasible range,
     /// where only rounding can make it negative); otherwise beyond the slack it is `NotAssemblable`.
     #[must_use]
@@ -523,7 +523,7 @@ impl FourBar {
         pose.h <= TOGGLE_REL * self.coupler
     }
 
-    /// Transmission angle of a pose [rad]: angle between `D − E` and `O_out − E`, folded into
+    /// Transmission angle of a pose \[rad\]: angle between `D − E` and `O_out − E`, folded into
     /// `[0, π/2]` (spec §4.4).
     #[must_use]
     pub fn transmission_angle(&self, d: C64, e: C64) -> f64 {

@@ -37,7 +37,7 @@ pub const COLLINEAR_REL: f64 = 1e-12;
 /// Snapshot request in the normalised frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SnapshotSpec {
-    /// Absolute input angle θ2 [rad], in (−π, π].
+    /// Absolute input angle θ2 \[rad\], in (−π, π].
     pub theta: f64,
     /// Assembly branch t1.
     pub branch: Sign,

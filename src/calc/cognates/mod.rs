@@ -48,12 +48,6 @@
 //!   P near a joint) return results plus warnings. An input angle outside the feasible range returns
 //!   `status: not_assemblable` with the ranges.
 
-#![allow(
-    rustdoc::broken_intra_doc_links,
-    reason = "docs write units as `[length]`, `[deg]`, `[rad]` (the project's field-doc convention, also the \
-              OpenAPI descriptions); rustdoc would read them as links"
-)]
-
 pub mod compute;
 pub mod error;
 pub mod geometry;

@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 use super::geometry::{C64, Circuit, FourBar, Sign, Solve};
 use super::wire::Spacing;
 
-/// Input angle relative to the ground line [rad] and branch at circuit parameter `u ∈ [0, 2π]`.
+/// Input angle relative to the ground line \[rad\] and branch at circuit parameter `u ∈ [0, 2π]`.
 #[must_use]
 pub fn circuit_param(circuit: &Circuit, u: f64, spacing: Spacing) -> (f64, Sign) {
     match *circuit {

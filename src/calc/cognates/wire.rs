@@ -73,17 +73,17 @@ pub struct CognatesRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub ground: Option<GroundSpec>,
-    /// Crank (input link) length `a` [length], > 0 and ≥ 1e-12·L, L the largest length of the
+    /// Crank (input link) length `a` \[length\], > 0 and ≥ 1e-12·L, L the largest length of the
     /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.13)]
     pub crank: Option<f64>,
-    /// Coupler length `b` = |E − D| [length], > 0 and ≥ 1e-12·L, L the largest length of the
+    /// Coupler length `b` = |E − D| \[length\], > 0 and ≥ 1e-12·L, L the largest length of the
     /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.23)]
     pub coupler: Option<f64>,
-    /// Rocker (output link) length `c` [length], > 0 and ≥ 1e-12·L, L the largest length of the
+    /// Rocker (output link) length `c` \[length\], > 0 and ≥ 1e-12·L, L the largest length of the
     /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.04)]
@@ -97,7 +97,7 @@ pub struct CognatesRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub joints: Option<JointsSpec>,
-    /// Input angle of the snapshot configuration [deg] (θ2, or φ with `angle_reference: ground`).
+    /// Input angle of the snapshot configuration \[deg\] (θ2, or φ with `angle_reference: ground`).
     /// Omit for no snapshot.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 30.0)]
@@ -119,19 +119,19 @@ pub struct CognatesRequest {
 #[schema(as = cognates::GroundSpec)]
 #[serde(deny_unknown_fields)]
 pub struct GroundSpec {
-    /// Input pivot A [length], default `[0, 0]`.
+    /// Input pivot A \[length\], default `[0, 0]`.
     #[serde(rename = "A", default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([0.0, 0.0]))]
     pub a: Option<Point>,
-    /// Output pivot B [length], ≠ A.
+    /// Output pivot B \[length\], ≠ A.
     #[serde(rename = "B", default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([3.1, 0.0]))]
     pub b: Option<Point>,
-    /// Ground length `l` = |B − A| [length], > 0 (instead of `B`).
+    /// Ground length `l` = |B − A| \[length\], > 0 (instead of `B`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub length: Option<f64>,
-    /// Direction γ of A→B when `length` is used [deg], default 0.
+    /// Direction γ of A→B when `length` is used \[deg\], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub angle_deg: Option<f64>,
@@ -144,10 +144,10 @@ pub struct GroundSpec {
 pub enum CouplerPoint {
     /// Paper form: distances to the coupler joints and the side.
     Triangle {
-        /// `d` = |P − D| [length], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
+        /// `d` = |P − D| \[length\], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
         #[schema(example = 0.92)]
         d: f64,
-        /// `e` = |P − E| [length], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
+        /// `e` = |P − E| \[length\], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
         #[schema(example = 1.56)]
         e: f64,
         /// Coupler side `t2`: 1 when P is left of the directed line D→E. Default 1.
@@ -156,16 +156,16 @@ pub enum CouplerPoint {
     },
     /// Coupler frame: origin D, x along D→E, y to the left; `k = (u + i·v)/b`.
     Frame {
-        /// Coordinate along D→E [length].
+        /// Coordinate along D→E \[length\].
         u: f64,
-        /// Coordinate to the left of D→E [length].
+        /// Coordinate to the left of D→E \[length\].
         v: f64,
     },
     /// Polar form from D: `k = (p/b)·e^{i·alpha}`.
     Polar {
-        /// Distance |P − D| [length], ≥ 0.
+        /// Distance |P − D| \[length\], ≥ 0.
         p: f64,
-        /// Angle from D→E, CCW positive [deg].
+        /// Angle from D→E, CCW positive \[deg\].
         alpha_deg: f64,
     },
 }
@@ -223,23 +223,23 @@ impl TryFrom<CouplerPointRaw> for CouplerPoint {
 #[schema(as = cognates::JointsSpec)]
 #[serde(deny_unknown_fields)]
 pub struct JointsSpec {
-    /// Input pivot A [length].
+    /// Input pivot A \[length\].
     #[serde(rename = "A")]
     #[schema(value_type = [f64; 2])]
     pub a: Point,
-    /// Output pivot B [length].
+    /// Output pivot B \[length\].
     #[serde(rename = "B")]
     #[schema(value_type = [f64; 2])]
     pub b: Point,
-    /// Crank joint D [length].
+    /// Crank joint D \[length\].
     #[serde(rename = "D")]
     #[schema(value_type = [f64; 2])]
     pub d: Point,
-    /// Rocker joint E [length].
+    /// Rocker joint E \[length\].
     #[serde(rename = "E")]
     #[schema(value_type = [f64; 2])]
     pub e: Point,
-    /// Coupler point P [length].
+    /// Coupler point P \[length\].
     #[serde(rename = "P")]
     #[schema(value_type = [f64; 2])]
     pub p: Point,
@@ -345,7 +345,7 @@ impl Default for CognatesOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::CognatesResponse)]
 pub struct CognatesResponse {
-    /// Third ground pivot C = A + k·(B − A) [length].
+    /// Third ground pivot C = A + k·(B − A) \[length\].
     #[serde(rename = "C")]
     #[schema(value_type = [f64; 2])]
     pub c: Point,
@@ -377,7 +377,7 @@ pub struct Similarity {
     /// |BC|/|AB| = e/b.
     #[serde(rename = "ratio_BC_AB")]
     pub ratio_bc_ab: f64,
-    /// Signed angle ∠(AB, AC) = t2·θ3 [deg].
+    /// Signed angle ∠(AB, AC) = t2·θ3 \[deg\].
     #[serde(rename = "angle_at_A_deg")]
     pub angle_at_a_deg: f64,
     /// Complex coupler ratio k = [Re, Im] (P = D + k·(E − D)).
@@ -404,13 +404,13 @@ pub enum MechanismId {
 pub struct MechanismOut {
     /// Which member.
     pub id: MechanismId,
-    /// Input (crank) pivot [length].
+    /// Input (crank) pivot \[length\].
     #[schema(value_type = [f64; 2])]
     pub input_pivot: Point,
-    /// Output (rocker) pivot [length].
+    /// Output (rocker) pivot \[length\].
     #[schema(value_type = [f64; 2])]
     pub output_pivot: Point,
-    /// Direction of the ground line input→output pivot [deg].
+    /// Direction of the ground line input→output pivot \[deg\].
     pub ground_angle_deg: f64,
     /// Link lengths by physical role.
     pub links: Links,
@@ -438,7 +438,7 @@ pub struct MechanismOut {
     pub metrics: Option<MetricsOut>,
 }
 
-/// Link lengths by physical role [length].
+/// Link lengths by physical role \[length\].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::Links)]
 pub struct Links {
@@ -458,14 +458,14 @@ pub struct Links {
     pub rocker_joint_to_p: f64,
     /// Coupler side: 1 when P is left of the directed line D→E (nominal when P is on that line).
     pub coupler_side: i8,
-    /// Angle of the coupler triangle at the crank joint, unsigned [deg] (θ3 for the original).
+    /// Angle of the coupler triangle at the crank joint, unsigned \[deg\] (θ3 for the original).
     pub coupler_angle_at_crank_joint_deg: f64,
     /// Complex coupler ratio k_i = [Re, Im].
     #[schema(value_type = [f64; 2])]
     pub k: [f64; 2],
 }
 
-/// Coupler-triangle sides in similarity order (b_i : d_i : e_i = b : d : e) [length].
+/// Coupler-triangle sides in similarity order (b_i : d_i : e_i = b : d : e) \[length\].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::SimilarSides)]
 pub struct SimilarSides {
@@ -554,11 +554,11 @@ pub struct GrashofOut {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub special: Option<SpecialOut>,
-    /// Signed margin (s + l) − (p + q) [length]; negative = Grashof.
+    /// Signed margin (s + l) − (p + q) \[length\]; negative = Grashof.
     pub margin: f64,
-    /// s + l [length].
+    /// s + l \[length\].
     pub s_plus_l: f64,
-    /// p + q [length].
+    /// p + q \[length\].
     pub p_plus_q: f64,
     /// Shortest link.
     pub shortest: LinkRoleOut,
@@ -570,15 +570,15 @@ pub struct GrashofOut {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::InputRangeOut)]
 pub struct InputRangeOut {
-    /// Intervals of φ relative to the own ground line [deg]; an interval through 180° ends above 180.
+    /// Intervals of φ relative to the own ground line \[deg\]; an interval through 180° ends above 180.
     #[schema(value_type = Vec<[f64; 2]>)]
     pub intervals_rel_deg: Vec<[f64; 2]>,
-    /// The same intervals as absolute input angles [deg] (start wrapped to (−180, 180]).
+    /// The same intervals as absolute input angles \[deg\] (start wrapped to (−180, 180]).
     #[schema(value_type = Vec<[f64; 2]>)]
     pub intervals_abs_deg: Vec<[f64; 2]>,
     /// Whether the input link rotates fully.
     pub full_rotation: bool,
-    /// Toggle (dead-centre) input angles, absolute, wrapped to (−180, 180] [deg].
+    /// Toggle (dead-centre) input angles, absolute, wrapped to (−180, 180] \[deg\].
     pub toggle_angles_abs_deg: Vec<f64>,
     /// Number of closed circuits of the configuration space.
     pub n_circuits: usize,
@@ -605,7 +605,7 @@ pub enum OriginalLink {
 pub struct TurnsWith {
     /// The original link.
     pub turns_with: OriginalLink,
-    /// Constant offset: cognate link angle − original link angle [deg].
+    /// Constant offset: cognate link angle − original link angle \[deg\].
     pub offset_deg: f64,
 }
 
@@ -639,7 +639,7 @@ pub enum SnapshotStatus {
     Singular,
 }
 
-/// Joint positions of one configuration [length].
+/// Joint positions of one configuration \[length\].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::JointsOut)]
 pub struct JointsOut {
@@ -667,11 +667,11 @@ pub struct JointsOut {
 pub struct SnapshotOut {
     /// Status of this mechanism's own input at this pose.
     pub status: SnapshotStatus,
-    /// This mechanism's own input angle, absolute [deg] (absent when undetermined).
+    /// This mechanism's own input angle, absolute \[deg\] (absent when undetermined).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub input_angle_deg: Option<f64>,
-    /// The same angle relative to its own ground line [deg].
+    /// The same angle relative to its own ground line \[deg\].
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub input_angle_rel_deg: Option<f64>,
@@ -683,7 +683,7 @@ pub struct SnapshotOut {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub joints: Option<JointsOut>,
-    /// Transmission angle folded into [0°, 90°] [deg].
+    /// Transmission angle folded into [0°, 90°] \[deg\].
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub transmission_angle_deg: Option<f64>,
@@ -695,10 +695,10 @@ pub struct SnapshotOut {
 pub struct CurveOut {
     /// Whether the polyline closes on itself (last point connects to the first).
     pub closed: bool,
-    /// Coupler point positions [length].
+    /// Coupler point positions \[length\].
     #[schema(value_type = Vec<[f64; 2]>)]
     pub points: Vec<Point>,
-    /// Absolute input angle of each point [deg].
+    /// Absolute input angle of each point \[deg\].
     pub input_deg: Vec<f64>,
     /// Assembly branch of each point.
     pub branch: Vec<i8>,
@@ -715,17 +715,17 @@ fn is_zero(n: &usize) -> bool {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::MetricsOut)]
 pub struct MetricsOut {
-    /// ground + crank + coupler + rocker [length].
+    /// ground + crank + coupler + rocker \[length\].
     pub link_length_sum: f64,
-    /// Ground pivot distance [length].
+    /// Ground pivot distance \[length\].
     pub ground_span: f64,
-    /// Longest side of the coupler triangle [length].
+    /// Longest side of the coupler triangle \[length\].
     pub coupler_max_side: f64,
     /// Bounding box of the pivots and all moving joints over all circuits.
     pub footprint: Footprint,
-    /// Smallest transmission angle over the motion [deg] (0 at toggles).
+    /// Smallest transmission angle over the motion \[deg\] (0 at toggles).
     pub transmission_angle_min_deg: f64,
-    /// Largest transmission angle over the motion [deg].
+    /// Largest transmission angle over the motion \[deg\].
     pub transmission_angle_max_deg: f64,
     /// Whether the input rotates fully.
     pub full_rotation: bool,
@@ -735,7 +735,7 @@ pub struct MetricsOut {
     pub n_samples: usize,
 }
 
-/// Axis-aligned bounding box [length].
+/// Axis-aligned bounding box \[length\].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::Footprint)]
 pub struct Footprint {
@@ -745,11 +745,11 @@ pub struct Footprint {
     /// Upper-right corner.
     #[schema(value_type = [f64; 2])]
     pub max: Point,
-    /// Width [length].
+    /// Width \[length\].
     pub width: f64,
-    /// Height [length].
+    /// Height \[length\].
     pub height: f64,
-    /// Area [length²].
+    /// Area \[length²\].
     pub area: f64,
 }
 
@@ -832,20 +832,20 @@ pub struct HausdorffCheck {
 pub struct GearedFiveBar {
     /// Pivot names, e.g. `["A", "C"]`.
     pub pivot_names: [String; 2],
-    /// Ground pivots [length].
+    /// Ground pivots \[length\].
     #[schema(value_type = Vec<[f64; 2]>)]
     pub pivots: [Point; 2],
     /// Which family links the two cranks are.
     pub from: [String; 2],
-    /// Crank 1 length [length].
+    /// Crank 1 length \[length\].
     pub crank1: f64,
-    /// Crank 2 length [length].
+    /// Crank 2 length \[length\].
     pub crank2: f64,
-    /// Phase ψ = crank-2 angle − crank-1 angle, constant under the 1:1 same-direction gearing [deg].
+    /// Phase ψ = crank-2 angle − crank-1 angle, constant under the 1:1 same-direction gearing \[deg\].
     pub phase_deg: f64,
-    /// Dyad link from crank-1 tip to P [length].
+    /// Dyad link from crank-1 tip to P \[length\].
     pub dyad1: f64,
-    /// Dyad link from crank-2 tip to P [length].
+    /// Dyad link from crank-2 tip to P \[length\].
     pub dyad2: f64,
     /// The five-bar in the snapshot configuration (when the snapshot assembles).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -857,21 +857,21 @@ pub struct GearedFiveBar {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = cognates::FiveBarSnapshot)]
 pub struct FiveBarSnapshot {
-    /// Crank 1 angle [deg].
+    /// Crank 1 angle \[deg\].
     pub crank1_angle_deg: f64,
-    /// Crank 2 angle [deg].
+    /// Crank 2 angle \[deg\].
     pub crank2_angle_deg: f64,
-    /// Crank 1 tip [length].
+    /// Crank 1 tip \[length\].
     #[schema(value_type = [f64; 2])]
     pub crank1_tip: Point,
-    /// Crank 2 tip [length].
+    /// Crank 2 tip \[length\].
     #[schema(value_type = [f64; 2])]
     pub crank2_tip: Point,
-    /// Coupler point [length].
+    /// Coupler point \[length\].
     #[serde(rename = "P")]
     #[schema(value_type = [f64; 2])]
     pub p: Point,
-    /// Largest deviation of |P − tip_i| from the dyad lengths [length].
+    /// Largest deviation of |P − tip_i| from the dyad lengths \[length\].
     pub dyad_residual: f64,
 }
 
@@ -912,7 +912,7 @@ pub struct Warning {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub mechanism: Option<MechanismId>,
-    /// Related input angles (absolute) [deg], e.g. the folded positions of a change point.
+    /// Related input angles (absolute) \[deg\], e.g. the folded positions of a change point.
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub angles_deg: Option<Vec<f64>>,
@@ -924,18 +924,18 @@ pub struct Warning {
 pub struct Meta {
     /// Curve points returned (all mechanisms).
     pub points_total: usize,
-    /// Compute time [µs].
+    /// Compute time \[µs\].
     pub compute_us: u64,
 }
 
 /// Largest magnitude accepted for any coordinate or length: keeps `|B − A|` and every product of
 /// two lengths finite (1e100² = 1e200 < f64::MAX), far beyond any physical unit choice.
 pub const MAX_MAGNITUDE: f64 = 1e100;
-/// A link length [length]: positive and at most [`MAX_MAGNITUDE`].
+/// A link length \[length\]: positive and at most [`MAX_MAGNITUDE`].
 pub const LENGTH: Range = Range::FINITE.gt(0.0).max(MAX_MAGNITUDE);
-/// A distance that may be zero [length].
+/// A distance that may be zero \[length\].
 pub const NON_NEGATIVE_LENGTH: Range = Range::FINITE.min(0.0).max(MAX_MAGNITUDE);
-/// A coordinate or signed length [length].
+/// A coordinate or signed length \[length\].
 pub const COORDINATE: Range = Range::FINITE.min(-MAX_MAGNITUDE).max(MAX_MAGNITUDE);
 /// Samples per circuit N (spec §3).
 pub const POINTS_PER_CIRCUIT: Range = Range::int(16, 100_000);

@@ -84,7 +84,7 @@ pub struct IndexOutput {
 /// Everything at one time.
 #[derive(Debug, Clone)]
 pub struct TimeOutput {
-    /// t [h].
+    /// t \[h\].
     pub time_h: f64,
     /// F_i(t) used.
     pub f: Vec<f64>,

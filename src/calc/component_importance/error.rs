@@ -50,7 +50,7 @@ pub enum ComponentImportanceError {
         reason: StopReason,
         /// Paths enumerated so far.
         evaluations: u64,
-        /// Elapsed time [ms].
+        /// Elapsed time \[ms\].
         elapsed_ms: f64,
     },
     /// The Weibull hazard rate or the failure-mode risk RI = λ·S of a component exceeds the f64
@@ -66,7 +66,7 @@ pub enum ComponentImportanceError {
         id: String,
         /// Time index.
         time_index: usize,
-        /// Time [h].
+        /// Time \[h\].
         time_h: f64,
         /// λ [1/h] (possibly infinite).
         lambda: f64,

@@ -51,7 +51,7 @@ pub struct ComponentImportanceInput {
     pub graph: Digraph,
     /// For every request edge, its CSR edge index in `graph`.
     pub edge_csr: Vec<usize>,
-    /// Weibull (η [h], β) per component, if given.
+    /// Weibull (η \[h\], β) per component, if given.
     pub weibull: Vec<Option<(f64, f64)>>,
     /// S_i = Σ α·impact per component, if given.
     pub mode_sum: Vec<Option<f64>>,
@@ -59,7 +59,7 @@ pub struct ComponentImportanceInput {
     pub efficiency_override: Vec<Option<f64>>,
     /// `level_override` per component.
     pub level_override: Vec<Option<u32>>,
-    /// Evaluation times [h].
+    /// Evaluation times \[h\].
     pub times_h: Vec<f64>,
     /// Per time: F overrides per component (`None` for times without overrides).
     pub f_override: Vec<Option<Vec<Option<f64>>>>,

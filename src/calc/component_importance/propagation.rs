@@ -175,7 +175,7 @@ pub fn dag_total_sum(g: &Digraph, topo: &[usize], p: &[f64]) -> Vec<f64> {
     y
 }
 
-/// ln fp_raw_i = ln Σ_L c^L·s̃[L−1][i] for sums `s̃` computed with x scaled by 1/c; −∞ where
+/// ln fp_raw_i = ln Σ_L c^L·s̃[L−1]\[i\] for sums `s̃` computed with x scaled by 1/c; −∞ where
 /// every term is 0. `ln_c` = ln c.
 #[must_use]
 pub fn log_index(s: &LengthSums, ln_c: f64) -> Vec<f64> {

@@ -23,7 +23,7 @@ pub struct Reach {
     pub efficiency: Vec<f64>,
     /// r_i: number of nodes reachable from i, including i.
     pub reach: Vec<usize>,
-    /// Σ_j d_ij over the nodes reachable from i [hops].
+    /// Σ_j d_ij over the nodes reachable from i \[hops\].
     pub dist_sum: Vec<f64>,
 }
 

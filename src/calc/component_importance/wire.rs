@@ -37,7 +37,7 @@ pub struct ComponentImportanceRequest {
     /// Directed fault-propagation edges `[from_id, to_id]`: a fault of `from` directly causes a
     /// fault of `to` (paper adjacency A). At least one; no self-loops, no duplicates.
     pub edges: Vec<[String; 2]>,
-    /// Operating ages t at which the importance is evaluated [h]; 1–1000 values, each > 0.
+    /// Operating ages t at which the importance is evaluated \[h\]; 1–1000 values, each > 0.
     pub times_h: Vec<f64>,
     /// Per-time replacements of the Weibull-derived F_i(t) and RI_i(t) (reproduce paper inputs).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -84,7 +84,7 @@ pub struct ComponentSpec {
 #[schema(as = component_importance::Weibull)]
 #[serde(deny_unknown_fields)]
 pub struct Weibull {
-    /// Scale η [h] (same unit as `times_h`); finite, > 0.
+    /// Scale η \[h\] (same unit as `times_h`); finite, > 0.
     #[schema(example = 7832.7)]
     pub eta_h: f64,
     /// Shape β [–]; 0.05 ≤ β ≤ 20.
@@ -110,7 +110,7 @@ pub struct FailureMode {
 #[schema(as = component_importance::TimeOverride)]
 #[serde(deny_unknown_fields)]
 pub struct TimeOverride {
-    /// The time [h]; must be one of `times_h`.
+    /// The time \[h\]; must be one of `times_h`.
     pub time_h: f64,
     /// Failure probability F_i(t) [–] per id, in [0, 1].
     #[serde(rename = "F", default, skip_serializing_if = "BTreeMap::is_empty")]
@@ -145,7 +145,7 @@ impl Default for ConstantWeights {
 pub struct EntropyWeights {
     /// Subjective (e.g. Delphi) weights `[w1, w2]`, each > 0, sum 1.
     pub subjective: Vec<f64>,
-    /// The time t0 [h] whose normalized indices define the entropy weights; one of `times_h`.
+    /// The time t0 \[h\] whose normalized indices define the entropy weights; one of `times_h`.
     pub entropy_at_h: f64,
 }
 
@@ -300,7 +300,7 @@ pub struct ComponentImportanceResponse {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = component_importance::TimeResult)]
 pub struct TimeResult {
-    /// The time t [h].
+    /// The time t \[h\].
     pub time_h: f64,
     /// Comprehensive importance CI_i(t) [–] (Eq. 18).
     pub ci: Vec<f64>,
@@ -401,7 +401,7 @@ pub struct Meta {
     /// How the budgeted work ended: iterations = per-source passes, evaluations = enumerated
     /// simple paths.
     pub report: SolverReport,
-    /// Wall-clock time of the whole calculation [ms].
+    /// Wall-clock time of the whole calculation \[ms\].
     pub elapsed_ms: f64,
 }
 
@@ -477,7 +477,7 @@ pub struct KendallTau {
 
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
-/// An operating time [h]: positive (t = 0 makes every index 0, spec §6 H1).
+/// An operating time \[h\]: positive (t = 0 makes every index 0, spec §6 H1).
 pub const TIME_H: Range = Range::FINITE.gt(0.0);
 /// A constant weight of the probability/risk pair: positive (the pair sums to 1).
 pub const WEIGHT: Range = Range::FINITE.gt(0.0);
@@ -486,7 +486,7 @@ pub const WEIGHT: Range = Range::FINITE.gt(0.0);
 pub const PROBABILITY: Range = Range::closed(0.0, 1.0);
 /// A quantity that may be zero (RI override [1/h], mode sum, impact, efficiency override).
 pub const NON_NEGATIVE: Range = Range::FINITE.min(0.0);
-/// Weibull scale η [h]: positive.
+/// Weibull scale η \[h\]: positive.
 pub const ETA_H: Range = Range::FINITE.gt(0.0);
 /// Weibull shape β [–] (spec §2).
 pub const BETA: Range = Range::closed(0.05, 20.0);

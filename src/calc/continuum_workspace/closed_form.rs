@@ -11,15 +11,15 @@ use crate::numerics::elliptic::{ellip_e_inc, ellip_f};
 /// One closed-form rod solution (relative to the clamp point).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Elastica {
-    /// Tip position relative to the base `(x(phi2), y(phi2))` [m].
+    /// Tip position relative to the base `(x(phi2), y(phi2))` \[m\].
     pub tip: [f64; 2],
-    /// Rod force `n = R (cos psi, sin psi)` [N] (force of the tip support on the rod).
+    /// Rod force `n = R (cos psi, sin psi)` \[N\] (force of the tip support on the rod).
     pub force: [f64; 2],
     /// Base moment `m(phi1)` [N m].
     pub base_moment: f64,
     /// Tip moment `m(phi2)` [N m] (zero up to round-off: pinned tip).
     pub tip_moment: f64,
-    /// Load magnitude `R` [N].
+    /// Load magnitude `R` \[N\].
     pub load: f64,
 }
 

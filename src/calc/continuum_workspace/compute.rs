@@ -80,11 +80,11 @@ pub struct Metrics {
     pub folded_cells: usize,
     /// Quasi-translational area [m^2].
     pub qt_area: f64,
-    /// Max |theta| [rad].
+    /// Max |theta| \[rad\].
     pub max_abs_angle: f64,
-    /// Mean |theta| [rad].
+    /// Mean |theta| \[rad\].
     pub mean_abs_angle: f64,
-    /// Max stress [Pa].
+    /// Max stress \[Pa\].
     pub max_stress: Option<f64>,
 }
 

@@ -23,11 +23,11 @@ pub const TAUT_CHORD: f64 = 0.999;
 /// The stress-free home of a design: inputs, platform position and the exact home state.
 #[derive(Debug, Clone)]
 pub struct Home {
-    /// Home inputs [m].
+    /// Home inputs \[m\].
     pub lambda: Vec<f64>,
-    /// Platform position at home [m].
+    /// Platform position at home \[m\].
     pub position: [f64; 2],
-    /// Largest closure residual of the least-squares fit [m].
+    /// Largest closure residual of the least-squares fit \[m\].
     pub residual: f64,
 }
 
@@ -137,21 +137,21 @@ pub fn from_home(
 /// Everything reported about one solved equilibrium.
 #[derive(Debug, Clone)]
 pub struct Described {
-    /// Platform position [m].
+    /// Platform position \[m\].
     pub position: [f64; 2],
-    /// Platform angle [rad], continuous.
+    /// Platform angle \[rad\], continuous.
     pub angle: f64,
-    /// Rod forces `n_i` [N].
+    /// Rod forces `n_i` \[N\].
     pub forces: Vec<[f64; 2]>,
     /// Base moments `m_i(0)` [N m].
     pub base_moments: Vec<f64>,
     /// Largest `|m_i(s)|` over the RK4 nodes [N m].
     pub max_moments: Vec<f64>,
-    /// Largest bending stress per rod [Pa] (None without a diameter).
+    /// Largest bending stress per rod \[Pa\] (None without a diameter).
     pub stresses: Vec<Option<f64>>,
-    /// Bending energy per rod [J].
+    /// Bending energy per rod \[J\].
     pub energies: Vec<f64>,
-    /// Actuator forces `f_j = -sum n_i . d_j` [N].
+    /// Actuator forces `f_j = -sum n_i . d_j` \[N\].
     pub actuator_forces: Vec<f64>,
     /// Shapes `[x, y, theta_deg, m]` per rod, when requested.
     pub shapes: Option<Vec<Vec<[f64; 4]>>>,

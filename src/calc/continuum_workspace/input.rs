@@ -39,7 +39,7 @@ const MAX_LOAD_REL: f64 = 1e4;
 const MAX_GRID_NODES: u64 = 40_401;
 /// Largest number of closed-form grid combinations (spec 4.6).
 const MAX_COMBINATIONS: f64 = 1e8;
-/// Service-side ceiling of a request's own time limit [ms].
+/// Service-side ceiling of a request's own time limit \[ms\].
 pub const MAX_TIME_LIMIT_MS: u64 = 600_000;
 /// Default stability segments in sweeps (spec 8 targets use M = 20; the sign is what matters).
 const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
@@ -63,7 +63,7 @@ pub enum Start {
 pub struct SeedInput {
     /// Kind.
     pub kind: SeedKind,
-    /// Inputs near which the seed node is chosen [m].
+    /// Inputs near which the seed node is chosen \[m\].
     pub inputs: Option<[f64; 2]>,
     /// State for `guess`.
     pub state: Option<Vec<f64>>,
@@ -78,7 +78,7 @@ pub struct SweepInput {
     pub settings: SweepSettings,
     /// Seed.
     pub seed: SeedInput,
-    /// Quasi-translational threshold [rad].
+    /// Quasi-translational threshold \[rad\].
     pub qt_threshold: f64,
     /// Compute the union area.
     pub union: bool,

@@ -11,11 +11,11 @@ use super::rod::{self, RodEnd, RodOde, RodTrace};
 /// One linear actuator (guide) in SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Actuator {
-    /// Point on the guide `o_j` [m].
+    /// Point on the guide `o_j` \[m\].
     pub origin: [f64; 2],
     /// Unit guide direction `d_j`.
     pub dir: [f64; 2],
-    /// Admissible inputs `[min, max]` [m].
+    /// Admissible inputs `[min, max]` \[m\].
     pub stroke: [f64; 2],
 }
 
@@ -24,19 +24,19 @@ pub struct Actuator {
 pub struct Rod {
     /// Index of the actuator carrying the clamp.
     pub actuator: usize,
-    /// Clamp offset `c_i` on the carriage [m].
+    /// Clamp offset `c_i` on the carriage \[m\].
     pub offset: [f64; 2],
-    /// Clamp angle `theta_c,i` [rad].
+    /// Clamp angle `theta_c,i` \[rad\].
     pub clamp: f64,
-    /// Length `L_i` [m].
+    /// Length `L_i` \[m\].
     pub length: f64,
     /// Bending stiffness `EI_i` [N m^2].
     pub ei: f64,
-    /// Axial stiffness `EA_i` [N] when known (needs a diameter and a modulus).
+    /// Axial stiffness `EA_i` \[N\] when known (needs a diameter and a modulus).
     pub ea: Option<f64>,
-    /// Diameter `d_i` [m] when known (for stresses).
+    /// Diameter `d_i` \[m\] when known (for stresses).
     pub diameter: Option<f64>,
-    /// Platform attachment `r_i` in the platform frame [m].
+    /// Platform attachment `r_i` in the platform frame \[m\].
     pub attach: [f64; 2],
 }
 
@@ -49,16 +49,16 @@ pub struct Design {
     pub rods: Vec<Rod>,
     /// Inputs at which every rod is straight and unloaded with `theta_EE = 0`, if known.
     pub home: Option<Vec<f64>>,
-    /// Allowable bending stress [Pa] (warnings, optional workspace limit).
+    /// Allowable bending stress \[Pa\] (warnings, optional workspace limit).
     pub sigma_allow: Option<f64>,
 }
 
 /// Loads and inputs: the parameters of one FK problem.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Params {
-    /// Actuator inputs `lambda_j` [m].
+    /// Actuator inputs `lambda_j` \[m\].
     pub lambda: Vec<f64>,
-    /// Force on the platform at P [N].
+    /// Force on the platform at P \[N\].
     pub force: [f64; 2],
     /// Couple on the platform [N m].
     pub moment: f64,
@@ -69,11 +69,11 @@ pub struct Params {
 pub struct Model {
     /// The design.
     pub design: Design,
-    /// Mean rod length [m].
+    /// Mean rod length \[m\].
     pub l_ref: f64,
     /// Mean rod EI [N m^2].
     pub ei_ref: f64,
-    /// `EI_ref / L_ref^2` [N].
+    /// `EI_ref / L_ref^2` \[N\].
     pub f_ref: f64,
     /// Base RK4 steps per rod (`solver.rk4_steps`).
     pub base_steps: usize,
@@ -109,9 +109,9 @@ pub struct Eval {
     pub g: Vec<f64>,
     /// Jacobian `dg/dv`, row-major, empty unless requested.
     pub jac: Vec<f64>,
-    /// Tip positions `B_i` [m].
+    /// Tip positions `B_i` \[m\].
     pub tips: Vec<[f64; 2]>,
-    /// Rod forces `n_i` [N].
+    /// Rod forces `n_i` \[N\].
     pub forces: Vec<[f64; 2]>,
     /// End states of the rods.
     pub ends: Vec<RodEnd>,
@@ -207,14 +207,14 @@ impl Model {
         &self.odes[i]
     }
 
-    /// `EI_i / L_i^2` [N]: physical force per unit `nb`.
+    /// `EI_i / L_i^2` \[N\]: physical force per unit `nb`.
     #[must_use]
     pub fn k(&self, i: usize) -> f64 {
         let r = &self.design.rods[i];
         r.ei / (r.length * r.length)
     }
 
-    /// Clamp point `a_i(lambda)` [m].
+    /// Clamp point `a_i(lambda)` \[m\].
     #[must_use]
     pub fn base_point(&self, i: usize, lambda: &[f64]) -> [f64; 2] {
         let r = &self.design.rods[i];
@@ -232,14 +232,14 @@ impl Model {
         [v[3 * i], v[3 * i + 1], v[3 * i + 2]]
     }
 
-    /// Platform position [m] from the unknown vector.
+    /// Platform position \[m\] from the unknown vector.
     #[must_use]
     pub fn position(&self, v: &[f64]) -> [f64; 2] {
         let n = 3 * self.n_rods();
         [v[n] * self.l_ref, v[n + 1] * self.l_ref]
     }
 
-    /// Platform angle `theta_EE` [rad] from the unknown vector (continuous, unwrapped).
+    /// Platform angle `theta_EE` \[rad\] from the unknown vector (continuous, unwrapped).
     #[must_use]
     pub fn angle(&self, v: &[f64]) -> f64 {
         v[3 * self.n_rods() + 2]
@@ -390,7 +390,7 @@ impl Model {
         rod::trace(&self.odes[i], &self.q(v, i), steps)
     }
 
-    /// The unknown vector of the straight, unloaded home state at platform position `p` [m].
+    /// The unknown vector of the straight, unloaded home state at platform position `p` \[m\].
     #[must_use]
     pub fn home_state(&self, p: [f64; 2]) -> Vec<f64> {
         let nr = self.n_rods();

@@ -432,20 +432,20 @@ pub fn continuation(
 const CORRECTOR_TOL: f64 = 1e-6;
 /// A point whose chord corrector converged in at most this many iterations keeps the previous
 /// Jacobian (its LU) for the next tangent and corrector; else a fresh one is evaluated there.
-const REUSE_ITER: usize = 2;
+pub const REUSE_ITER: usize = 2;
 /// Chord iterations per corrector before falling back to a fresh Jacobian.
 const CHORD_MAX_ITER: usize = 6;
 /// A chord iteration must shrink the residual at least by this factor, else fresh Jacobian.
 const CHORD_RATE: f64 = 0.5;
 /// Steps whose corrector converged in at most this many chord iterations double the next step.
-const EASY_ITER: usize = 3;
+pub const EASY_ITER: usize = 3;
 /// Trust region of the predictor: the corrector may move at most this fraction of the predictor
 /// step (inf-norm of the unknowns), else the step is halved.
-const TRUST: f64 = 0.5;
+pub const TRUST: f64 = 0.5;
 /// Floor of the trust region's predictor length (unknowns are O(1) by their scaling).
-const TRUST_FLOOR: f64 = 1e-3;
+pub const TRUST_FLOOR: f64 = 1e-3;
 /// Longest adaptive step as a fraction of the path.
-const MAX_STEP: f64 = 0.25;
+pub const MAX_STEP: f64 = 0.25;
 
 /// Why a chord corrector gave up.
 enum ChordOutcome {

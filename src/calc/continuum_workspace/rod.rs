@@ -14,7 +14,7 @@
 /// Rod constants that enter the ODE.
 #[derive(Debug, Clone, Copy)]
 pub struct RodOde {
-    /// Clamp angle `theta_c` [rad]: tangent direction at `s = 0`.
+    /// Clamp angle `theta_c` \[rad\]: tangent direction at `s = 0`.
     pub theta_c: f64,
     /// Axial compliance `ca = EI/(EA L^2)` (0 for the paper's inextensible Kirchhoff rod).
     pub ca: f64,

@@ -23,13 +23,13 @@ const RANK_REL_TOL: f64 = 1e-9;
 pub struct RodDisc {
     /// Bending stiffness `EI_i` [N m^2].
     pub ei: f64,
-    /// Length `L_i` [m].
+    /// Length `L_i` \[m\].
     pub length: f64,
-    /// Clamp angle [rad].
+    /// Clamp angle \[rad\].
     pub clamp: f64,
-    /// Segment mid-point angles `t_ij`, `j = 1..M` [rad].
+    /// Segment mid-point angles `t_ij`, `j = 1..M` \[rad\].
     pub angles: Vec<f64>,
-    /// Rod force `n_i` [N] (force of the tip support on the rod, equal to the multiplier).
+    /// Rod force `n_i` \[N\] (force of the tip support on the rod, equal to the multiplier).
     pub force: [f64; 2],
 }
 
@@ -38,9 +38,9 @@ pub struct RodDisc {
 pub enum Tips<'a> {
     /// All tips pinned to a rigid platform with pose variables `(p, theta)`; `attach[i] = r_i`.
     Platform {
-        /// Platform angle `theta_EE` [rad].
+        /// Platform angle `theta_EE` \[rad\].
         theta: f64,
-        /// Attachment points `r_i` in the platform frame [m].
+        /// Attachment points `r_i` in the platform frame \[m\].
         attach: &'a [[f64; 2]],
     },
     /// Every tip pinned to a fixed point (no pose variables).

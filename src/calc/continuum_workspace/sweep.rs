@@ -45,9 +45,9 @@ pub enum StabilityCheck {
 /// Optional physical limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limits {
-    /// Minimum carriage gap [m] (see [`actuator_gap`]).
+    /// Minimum carriage gap \[m\] (see [`actuator_gap`]).
     pub min_gap: Option<f64>,
-    /// Allowable bending stress [Pa].
+    /// Allowable bending stress \[Pa\].
     pub sigma_allow: Option<f64>,
     /// Reject nodes where two rods cross.
     pub rod_crossing: bool,
@@ -58,7 +58,7 @@ pub struct Limits {
 pub struct SweepSettings {
     /// Grid size `[n1, n2]`.
     pub grid: [usize; 2],
-    /// Input ranges `[[min1, max1], [min2, max2]]` [m].
+    /// Input ranges `[[min1, max1], [min2, max2]]` \[m\].
     pub ranges: [[f64; 2]; 2],
     /// Also try the 4 diagonal neighbours (after the 4 axis neighbours).
     pub diagonal_neighbours: bool,
@@ -73,7 +73,7 @@ pub struct SweepSettings {
     /// abandoned in favour of smaller sub-steps (on the design-1 reference sweep 20 accepts exactly
     /// the nodes an uncapped Newton accepts at a third of the cost).
     pub substep_max_iter: usize,
-    /// Largest platform rotation within one sub-step [rad].
+    /// Largest platform rotation within one sub-step \[rad\].
     pub angle_jump: f64,
     /// Largest platform displacement within one sub-step, as a multiple of the input change.
     pub position_factor: f64,
@@ -174,15 +174,15 @@ pub struct NodeData {
     pub tangent: Vec<f64>,
     /// Sign of det J.
     pub det_sign: i8,
-    /// Platform position [m].
+    /// Platform position \[m\].
     pub position: [f64; 2],
-    /// Platform angle [rad] (continuous along the wave).
+    /// Platform angle \[rad\] (continuous along the wave).
     pub angle: f64,
     /// Stability margin (full mode only).
     pub margin: Option<f64>,
-    /// Largest rod bending stress [Pa] (None when a rod has no diameter).
+    /// Largest rod bending stress \[Pa\] (None when a rod has no diameter).
     pub max_stress: Option<f64>,
-    /// Actuator forces [N].
+    /// Actuator forces \[N\].
     pub actuator_forces: Vec<f64>,
     /// Jacobian condition number.
     pub cond: f64,

@@ -55,7 +55,7 @@ pub struct ContinuumWorkspaceRequest {
     pub mode: Mode,
     /// Mechanism design (explicit, or a preset).
     pub design: DesignRequest,
-    /// Actuator inputs `lambda_j` [m] (fk, assembly_modes; inside the strokes).
+    /// Actuator inputs `lambda_j` \[m\] (fk, assembly_modes; inside the strokes).
     #[serde(default)]
     #[schema(example = json!([-0.15, 0.2225]))]
     pub inputs_m: Option<Vec<f64>>,
@@ -84,7 +84,7 @@ pub struct ContinuumWorkspaceRequest {
     #[serde(default)]
     #[schema(nullable = false)]
     pub assembly_modes: Option<AssemblyModesRequest>,
-    /// Wall-clock limit for this request [ms] (extension; capped by the service limit).
+    /// Wall-clock limit for this request \[ms\] (extension; capped by the service limit).
     #[serde(default)]
     #[schema(example = 10_000)]
     pub time_limit_ms: Option<u64>,
@@ -106,12 +106,12 @@ pub struct DesignRequest {
     /// Rods (2..8).
     #[serde(default)]
     pub rods: Option<Vec<RodRequest>>,
-    /// Inputs at which every rod is straight and unloaded with `theta_EE = 0` [m]; computed by
+    /// Inputs at which every rod is straight and unloaded with `theta_EE = 0` \[m\]; computed by
     /// least squares when absent.
     #[serde(default)]
     #[schema(example = json!([-0.25, 0.2725]))]
     pub home_inputs_m: Option<Vec<f64>>,
-    /// Allowable bending stress [Pa]: FK warnings and default workspace stress limit.
+    /// Allowable bending stress \[Pa\]: FK warnings and default workspace stress limit.
     #[serde(default)]
     #[schema(example = 1.2e9)]
     pub sigma_allow_pa: Option<f64>,
@@ -122,13 +122,13 @@ pub struct DesignRequest {
 #[schema(as = continuum_workspace::ActuatorRequest)]
 #[serde(deny_unknown_fields)]
 pub struct ActuatorRequest {
-    /// Point on the guide `o_j` [m].
+    /// Point on the guide `o_j` \[m\].
     #[schema(example = json!([0.0, 0.0]))]
     pub origin_m: [f64; 2],
     /// Guide direction `d_j` (normalised by the service; norm > 1e-12).
     #[schema(example = json!([1.0, 0.0]))]
     pub direction: [f64; 2],
-    /// Admissible inputs `[min, max]` [m], min < max.
+    /// Admissible inputs `[min, max]` \[m\], min < max.
     #[schema(example = json!([-0.7, 0.2]))]
     pub stroke_m: [f64; 2],
 }
@@ -141,18 +141,18 @@ pub struct RodRequest {
     /// Index `j(i)` of the actuator carrying the clamp.
     #[schema(example = 0)]
     pub actuator: usize,
-    /// Clamp offset `c_i` on the carriage [m].
+    /// Clamp offset `c_i` on the carriage \[m\].
     #[serde(default)]
     #[schema(example = json!([-0.0225, 0.0]))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub offset_m: Option<[f64; 2]>,
-    /// Clamp angle `theta_c,i` [deg] (tangent direction at s = 0, counter-clockwise from +X).
+    /// Clamp angle `theta_c,i` \[deg\] (tangent direction at s = 0, counter-clockwise from +X).
     #[schema(example = -60.0)]
     pub clamp_angle_deg: f64,
-    /// Rod length `L_i` [m].
+    /// Rod length `L_i` \[m\].
     #[schema(example = 0.5)]
     pub length_m: f64,
-    /// Solid round section diameter `d_i` [m] (L/d >= 20 recommended, >= 5 required).
+    /// Solid round section diameter `d_i` \[m\] (L/d >= 20 recommended, >= 5 required).
     #[serde(default)]
     #[schema(example = 0.004)]
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -162,12 +162,12 @@ pub struct RodRequest {
     #[schema(example = 2.63894)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ei_nm2: Option<f64>,
-    /// Young's modulus `E_i` [Pa] (default 2.1e11).
+    /// Young's modulus `E_i` \[Pa\] (default 2.1e11).
     #[serde(default)]
     #[schema(example = 2.1e11)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub youngs_modulus_pa: Option<f64>,
-    /// Platform point `r_i` in the platform frame [m].
+    /// Platform point `r_i` in the platform frame \[m\].
     #[schema(example = json!([-0.0225, 0.0]))]
     pub attach_m: [f64; 2],
 }
@@ -177,7 +177,7 @@ pub struct RodRequest {
 #[schema(as = continuum_workspace::LoadRequest)]
 #[serde(deny_unknown_fields)]
 pub struct LoadRequest {
-    /// Force `F` at P [N]; `|F| <= 1e4 EI_ref/L_ref^2`.
+    /// Force `F` at P \[N\]; `|F| <= 1e4 EI_ref/L_ref^2`.
     #[serde(default)]
     #[schema(example = json!([0.0, -50.0]))]
     pub force_n: Option<[f64; 2]>,
@@ -324,7 +324,7 @@ pub enum SeedKind {
 pub struct SeedRequest {
     /// `home`, `guess`, `assembly_mode` or `all_stable_modes`.
     pub kind: SeedKind,
-    /// Inputs near which the seed node is chosen [m] (default: home inputs, else the range centre).
+    /// Inputs near which the seed node is chosen \[m\] (default: home inputs, else the range centre).
     #[serde(default)]
     pub inputs_m: Option<[f64; 2]>,
     /// Solver state (kind = guess).
@@ -341,7 +341,7 @@ pub struct SeedRequest {
 #[schema(as = continuum_workspace::JumpLimits)]
 #[serde(deny_unknown_fields)]
 pub struct JumpLimits {
-    /// Largest platform rotation per sub-step [deg].
+    /// Largest platform rotation per sub-step \[deg\].
     #[serde(default)]
     #[schema(example = 5.0)]
     pub angle_deg: Option<f64>,
@@ -380,12 +380,12 @@ pub enum RodCrossing {
 #[schema(as = continuum_workspace::WorkspaceLimits)]
 #[serde(deny_unknown_fields)]
 pub struct WorkspaceLimits {
-    /// Minimum carriage gap [m] (clamp points of carriage 2 minus those of carriage 1, along guide
+    /// Minimum carriage gap \[m\] (clamp points of carriage 2 minus those of carriage 1, along guide
     /// 1); null = none.
     #[serde(default)]
     #[schema(example = 0.05)]
     pub min_actuator_gap_m: Option<f64>,
-    /// Allowable bending stress [Pa]; null = `design.sigma_allow_pa` or none.
+    /// Allowable bending stress \[Pa\]; null = `design.sigma_allow_pa` or none.
     #[serde(default)]
     pub sigma_allow_pa: Option<f64>,
     /// `ignore` (default) or `reject`.
@@ -414,7 +414,7 @@ pub struct WorkspaceRequest {
     #[serde(default)]
     #[schema(example = json!([31, 31]))]
     pub grid: Option<[u32; 2]>,
-    /// Input ranges `[[min1, max1], [min2, max2]]` [m] (default: the strokes).
+    /// Input ranges `[[min1, max1], [min2, max2]]` \[m\] (default: the strokes).
     #[serde(default)]
     #[schema(example = json!([[-0.70, 0.20], [-0.1775, 0.7225]]))]
     pub ranges_m: Option<[[f64; 2]; 2]>,
@@ -463,7 +463,7 @@ pub struct WorkspaceRequest {
     #[serde(default)]
     #[schema(nullable = false)]
     pub limits: Option<WorkspaceLimits>,
-    /// Threshold of the quasi-translational area [deg] (default 1).
+    /// Threshold of the quasi-translational area \[deg\] (default 1).
     #[serde(default)]
     #[schema(example = 1.0)]
     pub quasi_translational_deg: Option<f64>,
@@ -549,9 +549,9 @@ pub enum FkStatus {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = continuum_workspace::PlatformOut)]
 pub struct PlatformOut {
-    /// Position of P [m].
+    /// Position of P \[m\].
     pub position_m: [f64; 2],
-    /// Parasitic angle `theta_EE` [deg], wrapped to (-180, 180].
+    /// Parasitic angle `theta_EE` \[deg\], wrapped to (-180, 180].
     pub parasitic_angle_deg: f64,
 }
 
@@ -559,15 +559,15 @@ pub struct PlatformOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = continuum_workspace::RodOut)]
 pub struct RodOut {
-    /// Rod force `n_i` [N] = force of the platform on the rod tip (omitted when indeterminate).
+    /// Rod force `n_i` \[N\] = force of the platform on the rod tip (omitted when indeterminate).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tip_force_n: Option<[f64; 2]>,
     /// Base moment `m_i(0)` [N m].
     pub base_moment_nm: f64,
-    /// Largest bending stress over the RK4 nodes [Pa] (omitted without a diameter).
+    /// Largest bending stress over the RK4 nodes \[Pa\] (omitted without a diameter).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_bending_stress_pa: Option<f64>,
-    /// Bending energy `int m^2/(2EI) ds` [J] (extension).
+    /// Bending energy `int m^2/(2EI) ds` \[J\] (extension).
     pub elastic_energy_j: f64,
     /// `[x_m, y_m, theta_deg, m_nm]` at `rod_shape_points` points (when requested).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -629,7 +629,7 @@ pub struct PresetOut {
     pub actuators: Vec<ActuatorRequest>,
     /// The rods used.
     pub rods: Vec<RodRequest>,
-    /// Home inputs [m], if any.
+    /// Home inputs \[m\], if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub home_inputs_m: Option<Vec<f64>>,
 }
@@ -649,7 +649,7 @@ pub struct FkResponse {
     /// Per-rod results (omitted when not converged).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rods: Option<Vec<RodOut>>,
-    /// Actuator forces `f_j = -sum n_i . d_j` [N] (omitted unless status ok).
+    /// Actuator forces `f_j = -sum n_i . d_j` \[N\] (omitted unless status ok).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub actuator_forces_n: Option<Vec<f64>>,
     /// Stability (when requested and converged).
@@ -677,9 +677,9 @@ pub struct FkResponse {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = continuum_workspace::GridOut)]
 pub struct GridOut {
-    /// `lambda1` values [m].
+    /// `lambda1` values \[m\].
     pub lambda1_m: Vec<f64>,
-    /// `lambda2` values [m].
+    /// `lambda2` values \[m\].
     pub lambda2_m: Vec<f64>,
 }
 
@@ -690,18 +690,18 @@ pub struct GridOut {
 pub struct NodesOut {
     /// Status codes.
     pub status: Vec<&'static str>,
-    /// Platform x [m].
+    /// Platform x \[m\].
     pub px_m: Vec<Option<f64>>,
-    /// Platform y [m].
+    /// Platform y \[m\].
     pub py_m: Vec<Option<f64>>,
-    /// Parasitic angle [deg] (continuous along the wave).
+    /// Parasitic angle \[deg\] (continuous along the wave).
     pub parasitic_angle_deg: Vec<Option<f64>>,
     /// Stability margin (full stability only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stability_margin: Option<Vec<Option<f64>>>,
-    /// Largest rod bending stress [Pa].
+    /// Largest rod bending stress \[Pa\].
     pub max_stress_pa: Vec<Option<f64>>,
-    /// Actuator forces [N].
+    /// Actuator forces \[N\].
     pub actuator_forces_n: Vec<Option<[f64; 2]>>,
 }
 
@@ -722,11 +722,11 @@ pub struct MetricsOut {
     pub folded_cells: u64,
     /// Area of cells whose 4 corners have |theta_EE| below the threshold [m^2] (union or sum).
     pub quasi_translational_area_m2: f64,
-    /// Largest |theta_EE| over accepted nodes [deg].
+    /// Largest |theta_EE| over accepted nodes \[deg\].
     pub max_abs_parasitic_deg: f64,
-    /// Mean |theta_EE| over accepted nodes [deg].
+    /// Mean |theta_EE| over accepted nodes \[deg\].
     pub mean_abs_parasitic_deg: f64,
-    /// Largest bending stress over accepted nodes [Pa] (omitted without diameters).
+    /// Largest bending stress over accepted nodes \[Pa\] (omitted without diameters).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_bending_stress_pa: Option<f64>,
 }
@@ -739,7 +739,7 @@ pub struct SeedOut {
     pub kind: SeedKind,
     /// Grid node `[i, j]`.
     pub node: [u64; 2],
-    /// Inputs of the seed node [m].
+    /// Inputs of the seed node \[m\].
     pub inputs_m: [f64; 2],
     /// Status of the seed node (`ok` or why the wave could not start).
     pub status: &'static str,
@@ -782,7 +782,7 @@ pub struct WorkspaceResponse {
     /// Further waves (seed kind all_stable_modes), each with its own seed/nodes/metrics/failures.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub other_waves: Option<Vec<WaveOut>>,
-    /// Wall-clock time [ms].
+    /// Wall-clock time \[ms\].
     pub timing_ms: f64,
     /// Warnings.
     pub warnings: Vec<String>,
@@ -799,7 +799,7 @@ pub struct WorkspaceResponse {
 pub struct AssemblyModeOut {
     /// Platform pose.
     pub pose: PlatformOut,
-    /// Parasitic angle [deg] (as in `pose`, spec 5 field list).
+    /// Parasitic angle \[deg\] (as in `pose`, spec 5 field list).
     pub parasitic_angle_deg: f64,
     /// margin > 1e-8.
     pub stable: bool,
@@ -808,7 +808,7 @@ pub struct AssemblyModeOut {
     pub margin: Option<f64>,
     /// Sign of det J.
     pub det_sign: i8,
-    /// Rod forces `n_i` [N].
+    /// Rod forces `n_i` \[N\].
     pub rod_forces: Vec<[f64; 2]>,
     /// State for warm starts.
     pub solver_state: SolverState,
@@ -846,21 +846,21 @@ pub struct AssemblyModesResponse {
 
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
-/// Largest accepted coordinate, stroke or length magnitude [m]: the scales the service is
+/// Largest accepted coordinate, stroke or length magnitude \[m\]: the scales the service is
 /// tested at run from 1e-6 m to 1e6 m; beyond, products such as EI or B x n leave the range
 /// where the scaled residual is meaningful.
 pub const MAX_COORD_M: f64 = 1e6;
-/// A coordinate, stroke end or actuator input [m].
+/// A coordinate, stroke end or actuator input \[m\].
 pub const COORDINATE_M: Range = Range::FINITE.min(-MAX_COORD_M).max(MAX_COORD_M);
-/// A rod length [m] (see [`MAX_COORD_M`]).
+/// A rod length \[m\] (see [`MAX_COORD_M`]).
 pub const LENGTH_M: Range = Range::FINITE.min(1e-7).max(MAX_COORD_M);
-/// A rod diameter [m] (EI ~ d^4 must stay a normal float).
+/// A rod diameter \[m\] (EI ~ d^4 must stay a normal float).
 pub const DIAMETER_M: Range = Range::FINITE.min(1e-9).max(MAX_COORD_M);
-/// Young's modulus [Pa] (gels to beyond diamond).
+/// Young's modulus \[Pa\] (gels to beyond diamond).
 pub const YOUNGS_MODULUS_PA: Range = Range::closed(1.0, 1e13);
 /// Bending stiffness given directly [N m^2].
 pub const EI_NM2: Range = Range::closed(1e-30, 1e20);
-/// Allowable stress [Pa].
+/// Allowable stress \[Pa\].
 pub const SIGMA_ALLOW_PA: Range = Range::FINITE.min(f64::MIN_POSITIVE).max(1e15);
 
 /// RK4 steps per rod (spec 4.1).
@@ -889,13 +889,13 @@ pub const MAX_SUBSTEPS: Range = Range::int(1, 64);
 pub const MAX_TRIES: Range = Range::int(1, 8);
 /// Newton iterations per substep.
 pub const SUBSTEP_MAX_ITER: Range = Range::int(5, 200);
-/// Largest accepted jump of the platform angle between neighbours [deg].
+/// Largest accepted jump of the platform angle between neighbours \[deg\].
 pub const JUMP_LIMITS_ANGLE_DEG: Range = Range::closed(1e-6, 180.0);
 /// Largest accepted position jump, in units of the grid step.
 pub const JUMP_LIMITS_POSITION_FACTOR: Range = Range::closed(1e-6, 1000.0);
 /// Largest accepted Jacobian condition number.
 pub const COND_MAX: Range = Range::closed(10.0, 1e18);
-/// Parasitic-angle threshold of the quasi-translational area [deg].
+/// Parasitic-angle threshold of the quasi-translational area \[deg\].
 pub const QUASI_TRANSLATIONAL_DEG: Range = Range::closed(1e-9, 180.0);
 /// Nodes per side of the workspace grid (spec 4.7).
 pub const GRID_SIDE: Range = Range::int(2, 401);

@@ -46,7 +46,7 @@ pub enum IrefcError {
     Cusp {
         /// Wheel with the cusp.
         wheel: Wheel,
-        /// Element angle [deg].
+        /// Element angle \[deg\].
         phi_deg: f64,
     },
     /// A result is not a finite number (inputs at absurd scales).
@@ -54,7 +54,7 @@ pub enum IrefcError {
     NonFinite {
         /// Offending quantity.
         quantity: &'static str,
-        /// Element angle where it happened [deg], if tied to one.
+        /// Element angle where it happened \[deg\], if tied to one.
         phi_deg: Option<f64>,
     },
     /// The budget ran out before a single design was finished.

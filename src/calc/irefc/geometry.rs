@@ -63,7 +63,7 @@ pub struct Trig {
 }
 
 impl Trig {
-    /// Trigonometric values of any real φ [rad].
+    /// Trigonometric values of any real φ \[rad\].
     ///
     /// φ is reduced to ψ = |φ| mod 2π folded into [0, π]; on (π/2, π] the functions are evaluated at
     /// π − ψ, which is exact (Sterbenz), so sin π = 0 and cos π = −1 exactly.
@@ -99,25 +99,25 @@ impl Trig {
 /// Everything the compute modules need at one element angle φ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AnglePoint {
-    /// Element angle φ [rad].
+    /// Element angle φ \[rad\].
     pub phi: f64,
     /// s(φ) = L/r2 = sqrt(1 + χ² − 2χ cos φ) [–].
     pub s: f64,
-    /// Pitch point to element centre distance L = r2·s [m] (force paper eq. 15).
+    /// Pitch point to element centre distance L = r2·s \[m\] (force paper eq. 15).
     pub l: f64,
     /// sin α [–].
     pub sin_alpha: f64,
     /// cos α [–].
     pub cos_alpha: f64,
-    /// True contact angle α ∈ [0, π] [rad].
+    /// True contact angle α ∈ [0, π] \[rad\].
     pub alpha: f64,
-    /// Cam lever arm h_cam = r1·sin α [m] (force paper eq. 13).
+    /// Cam lever arm h_cam = r1·sin α \[m\] (force paper eq. 13).
     pub h_cam: f64,
-    /// Crown lever arm h_crown = r3·sin α [m].
+    /// Crown lever arm h_crown = r3·sin α \[m\].
     pub h_crown: f64,
-    /// Pitch point to cam contact A, LA = L − rb [m] (efficiency paper eq. 8).
+    /// Pitch point to cam contact A, LA = L − rb \[m\] (efficiency paper eq. 8).
     pub la: f64,
-    /// Pitch point to crown contact B, LB = L + rb [m].
+    /// Pitch point to crown contact B, LB = L + rb \[m\].
     pub lb: f64,
     /// D_cam(φ) = Z2 + χ² − (Z2+1)χ cos φ [–].
     pub d_cam: f64,
@@ -131,9 +131,9 @@ pub struct AnglePoint {
     pub k_cam: f64,
     /// Hertz curvature sum at the crown contact K_crown = κ_crown + 1/rb [1/m].
     pub k_crown: f64,
-    /// Cusp margin at the cam, L³ − rb·r2²·D_cam scaled by 1/r2², i.e. r2·s³ − rb·D_cam [m]; must be > 0.
+    /// Cusp margin at the cam, L³ − rb·r2²·D_cam scaled by 1/r2², i.e. r2·s³ − rb·D_cam \[m\]; must be > 0.
     pub margin_cam: f64,
-    /// Cusp margin at the crown, r2·s³ − rb·D_crown [m]; must be > 0.
+    /// Cusp margin at the crown, r2·s³ − rb·D_crown \[m\]; must be > 0.
     pub margin_crown: f64,
 }
 
@@ -156,7 +156,7 @@ impl AnglePoint {
         }
     }
 
-    /// Lever arm of wheel w, r_w·sin α [m].
+    /// Lever arm of wheel w, r_w·sin α \[m\].
     #[must_use]
     pub const fn lever_arm(&self, w: Wheel) -> f64 {
         match w {
@@ -165,14 +165,14 @@ impl AnglePoint {
         }
     }
 
-    /// Signed profile radius ρ_w = 1/κ_w [m]; `None` at an inflection (κ = 0, ρ = ∞).
+    /// Signed profile radius ρ_w = 1/κ_w \[m\]; `None` at an inflection (κ = 0, ρ = ∞).
     #[must_use]
     pub fn rho(&self, w: Wheel) -> Option<f64> {
         let r = 1.0 / self.kappa(w);
         r.is_finite().then_some(r)
     }
 
-    /// Cusp margin r2·s³ − rb·D_w [m] (> 0 away from a cusp).
+    /// Cusp margin r2·s³ − rb·D_w \[m\] (> 0 away from a cusp).
     #[must_use]
     pub const fn margin(&self, w: Wheel) -> f64 {
         match w {
@@ -191,7 +191,7 @@ pub struct Kernel {
     pub k_cam: f64,
     /// K_crown [1/m].
     pub k_crown: f64,
-    /// min(cusp margins) [m]; ≤ 0 means the profile has a cusp at this angle.
+    /// min(cusp margins) \[m\]; ≤ 0 means the profile has a cusp at this angle.
     pub margin: f64,
 }
 
@@ -202,16 +202,16 @@ pub enum Infeasibility {
     Undercut {
         /// Wheel whose profile limits rb.
         wheel: Wheel,
-        /// rb [m].
+        /// rb \[m\].
         rb: f64,
-        /// rb_undercut [m].
+        /// rb_undercut \[m\].
         limit: f64,
     },
     /// rb ≥ χ·r2·sin(π/Z2): adjacent elements touch or overlap.
     ElementOverlap {
-        /// rb [m].
+        /// rb \[m\].
         rb: f64,
-        /// rb_overlap [m].
+        /// rb_overlap \[m\].
         limit: f64,
     },
 }
@@ -244,7 +244,7 @@ impl Infeasibility {
         }
     }
 
-    /// The broken limit [m].
+    /// The broken limit \[m\].
     #[must_use]
     pub const fn limit(&self) -> f64 {
         match self {
@@ -279,7 +279,7 @@ impl GeometryWarning {
     }
 }
 
-/// One point of a generated profile (all in the wheel's own frame, wheel centre at the origin) [m].
+/// One point of a generated profile (all in the wheel's own frame, wheel centre at the origin) \[m\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProfilePoint {
     /// Rolling element centre O′.
@@ -296,47 +296,47 @@ pub struct ProfilePoint {
 /// buildability with [`Geometry::infeasibilities`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Geometry {
-    /// Cage pitch circle radius r2 [m].
+    /// Cage pitch circle radius r2 \[m\].
     pub r2: f64,
     /// Number of rolling elements Z2.
     pub z2: u32,
     /// Displacement coefficient χ (rc = χ·r2) [–].
     pub chi: f64,
-    /// Rolling element radius rb [m].
+    /// Rolling element radius rb \[m\].
     pub rb: f64,
     /// Z2 as f64.
     pub z2f: f64,
-    /// Eccentricity of each mesh e = r2/Z2 [m] (force paper eq. 5).
+    /// Eccentricity of each mesh e = r2/Z2 \[m\] (force paper eq. 5).
     pub e: f64,
-    /// Cam centre to crown centre 2e [m].
+    /// Cam centre to crown centre 2e \[m\].
     pub e_total: f64,
-    /// Cam pitch radius r1 = r2(1 − 1/Z2) [m].
+    /// Cam pitch radius r1 = r2(1 − 1/Z2) \[m\].
     pub r1: f64,
-    /// Crown pitch radius r3 = r2(1 + 1/Z2) [m].
+    /// Crown pitch radius r3 = r2(1 + 1/Z2) \[m\].
     pub r3: f64,
-    /// Element-centre circle radius rc = χ·r2 [m] (force paper eq. 4).
+    /// Element-centre circle radius rc = χ·r2 \[m\] (force paper eq. 4).
     pub rc: f64,
     /// Cam lobes Z1 = Z2 − 1.
     pub z1: u32,
     /// Crown lobes Z3 = Z2 + 1.
     pub z3: u32,
-    /// Cam tip radius r2(χ + 1/Z2) − rb [m] (eq. 8).
+    /// Cam tip radius r2(χ + 1/Z2) − rb \[m\] (eq. 8).
     pub cam_tip: f64,
-    /// Cam root radius r2(χ − 1/Z2) − rb [m] (eq. 9).
+    /// Cam root radius r2(χ − 1/Z2) − rb \[m\] (eq. 9).
     pub cam_root: f64,
-    /// Crown tip radius r2(χ − 1/Z2) + rb [m] (eq. 10).
+    /// Crown tip radius r2(χ − 1/Z2) + rb \[m\] (eq. 10).
     pub crown_tip: f64,
-    /// Crown root radius r2(χ + 1/Z2) + rb [m] (eq. 11).
+    /// Crown root radius r2(χ + 1/Z2) + rb \[m\] (eq. 11).
     pub crown_root: f64,
-    /// Lower bound of force-paper eq. 3, 2·r2/Z2 [m].
+    /// Lower bound of force-paper eq. 3, 2·r2/Z2 \[m\].
     pub rb_min_paper: f64,
-    /// Element overlap limit χ·r2·sin(π/Z2) [m] (upper bound of eq. 3).
+    /// Element overlap limit χ·r2·sin(π/Z2) \[m\] (upper bound of eq. 3).
     pub rb_overlap: f64,
-    /// Smallest positive radius of the element-centre path relative to the cam, min ρt_cam [m].
+    /// Smallest positive radius of the element-centre path relative to the cam, min ρt_cam \[m\].
     pub rho_t_min_cam: f64,
-    /// Smallest positive ρt_crown [m]; `None` when the crown profile is concave everywhere (χ ≥ Z2).
+    /// Smallest positive ρt_crown \[m\]; `None` when the crown profile is concave everywhere (χ ≥ Z2).
     pub rho_t_min_crown: Option<f64>,
-    /// Undercut limit rb_undercut = min(ρt_min_cam, ρt_min_crown) [m].
+    /// Undercut limit rb_undercut = min(ρt_min_cam, ρt_min_crown) \[m\].
     pub rb_undercut: f64,
 }
 
@@ -383,19 +383,19 @@ impl Geometry {
         }
     }
 
-    /// Sharpest convex cam profile radius min ρt_cam − rb [m] (negative once undercut).
+    /// Sharpest convex cam profile radius min ρt_cam − rb \[m\] (negative once undercut).
     #[must_use]
     pub fn min_profile_radius_cam(&self) -> f64 {
         self.rho_t_min_cam - self.rb
     }
 
-    /// Sharpest convex crown profile radius [m]; `None` if the crown profile is concave everywhere.
+    /// Sharpest convex crown profile radius \[m\]; `None` if the crown profile is concave everywhere.
     #[must_use]
     pub fn min_profile_radius_crown(&self) -> Option<f64> {
         self.rho_t_min_crown.map(|r| r - self.rb)
     }
 
-    /// Smallest convex profile radius of either wheel [m].
+    /// Smallest convex profile radius of either wheel \[m\].
     #[must_use]
     pub fn min_profile_radius(&self) -> f64 {
         self.min_profile_radius_crown()
@@ -532,7 +532,7 @@ impl Geometry {
         }
     }
 
-    /// All per-angle quantities at φ [rad] (spec "Per-angle functions").
+    /// All per-angle quantities at φ \[rad\] (spec "Per-angle functions").
     #[must_use]
     pub fn at(&self, phi: f64) -> AnglePoint {
         let t = Trig::of(phi);
@@ -572,13 +572,13 @@ impl Geometry {
         }
     }
 
-    /// Pitch point to element centre distance L(φ) = r2·s(φ) [m].
+    /// Pitch point to element centre distance L(φ) = r2·s(φ) \[m\].
     #[must_use]
     pub fn l(&self, phi: f64) -> f64 {
         self.r2 * self.s2(&Trig::of(phi)).sqrt()
     }
 
-    /// Signed radius of curvature of the element-centre path relative to wheel w, ρt_w = L³/(r2²·D_w) [m]
+    /// Signed radius of curvature of the element-centre path relative to wheel w, ρt_w = L³/(r2²·D_w) \[m\]
     /// (infinite where D_w = 0).
     #[must_use]
     pub fn rho_t(&self, w: Wheel, phi: f64) -> f64 {
@@ -622,8 +622,8 @@ impl Geometry {
         if (0.0..1.0).contains(&p) { p } else { 0.0 }
     }
 
-    /// One profile point of wheel w at curve parameter t [rad] (spec "profile point sets"), in the wheel's
-    /// frame [m].
+    /// One profile point of wheel w at curve parameter t \[rad\] (spec "profile point sets"), in the wheel's
+    /// frame \[m\].
     #[must_use]
     pub fn profile_point(&self, w: Wheel, t: f64) -> ProfilePoint {
         let zt = self.z2f * t;
@@ -660,7 +660,7 @@ impl Geometry {
         }
     }
 
-    /// `n` profile points of wheel w at t = 2πi/n, i = 0..n−1 [m].
+    /// `n` profile points of wheel w at t = 2πi/n, i = 0..n−1 \[m\].
     #[must_use]
     pub fn profile(&self, w: Wheel, n: usize) -> Vec<[f64; 2]> {
         // n ≤ PROFILE_POINTS_MAX (validated), so the usize → f64 conversions are exact.

@@ -19,16 +19,16 @@ pub const PROFILE_POINTS_MAX: u32 = 100_000;
 /// Smallest number of profile points per wheel (a closed polygon needs a few).
 pub const PROFILE_POINTS_MIN: u32 = 8;
 
-/// Cage pitch radius r2 [mm]: 0 < r2 ≤ 10 000 (spec).
+/// Cage pitch radius r2 \[mm\]: 0 < r2 ≤ 10 000 (spec).
 pub const R2_MM: Range = Range::FINITE.gt(0.0).max(10_000.0);
 /// Number of rolling elements Z2 [–]: 3 ≤ Z2 ≤ 1000 (Z2 = 2 gives Σsin²α = 0).
 pub const Z2: Range = Range::int(Z2_MIN as i64, Z2_MAX as i64);
 /// Displacement coefficient χ [–]: 1 < χ ≤ 5.
 pub const CHI: Range = Range::FINITE.gt(1.0).max(CHI_MAX);
-/// Rolling element radius rb [mm]: > 0. Buildability (rb below rb_overlap and rb_undercut, which
+/// Rolling element radius rb \[mm\]: > 0. Buildability (rb below rb_overlap and rb_undercut, which
 /// depend on r2, Z2 and χ) is checked on the geometry (`ELEMENT_OVERLAP`, `UNDERCUT`).
 pub const RB_MM: Range = Range::FINITE.gt(0.0);
-/// Young's modulus E [MPa].
+/// Young's modulus E \[MPa\].
 pub const E_MPA: Range = Range::closed(1e3, 1e7);
 /// Poisson's ratio ν [–]: 0 ≤ ν < 0.5.
 pub const NU: Range = Range::FINITE.min(0.0).lt(0.5);
@@ -92,7 +92,7 @@ pub fn geometry_warnings(g: &Geometry) -> Vec<Warning> {
 #[schema(as = irefc::Material)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
-    /// Young's modulus E [MPa].
+    /// Young's modulus E \[MPa\].
     #[serde(rename = "E_MPa")]
     #[schema(example = 210_000.0)]
     pub e_mpa: f64,
@@ -125,9 +125,9 @@ impl Material {
 pub struct Profiles {
     /// Points per wheel.
     pub n_points: u32,
-    /// Cam profile [[x, y]] [mm] in the cam frame (cam centre at the origin), Z2 − 1 lobes.
+    /// Cam profile [[x, y]] \[mm\] in the cam frame (cam centre at the origin), Z2 − 1 lobes.
     pub cam_mm: Vec<[f64; 2]>,
-    /// Crown profile [[x, y]] [mm] in the crown frame (crown centre at the origin), Z2 + 1 lobes.
+    /// Crown profile [[x, y]] \[mm\] in the crown frame (crown centre at the origin), Z2 + 1 lobes.
     pub crown_mm: Vec<[f64; 2]>,
 }
 
@@ -151,15 +151,15 @@ impl Profiles {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = irefc::GeometryOut)]
 pub struct GeometryOut {
-    /// Eccentricity of each mesh e = r2/Z2 [mm].
+    /// Eccentricity of each mesh e = r2/Z2 \[mm\].
     pub e_mm: f64,
-    /// Cam centre to crown centre 2e [mm].
+    /// Cam centre to crown centre 2e \[mm\].
     pub e_total_mm: f64,
-    /// Cam pitch radius r1 = r2(1 − 1/Z2) [mm].
+    /// Cam pitch radius r1 = r2(1 − 1/Z2) \[mm\].
     pub r1_mm: f64,
-    /// Crown pitch radius r3 = r2(1 + 1/Z2) [mm].
+    /// Crown pitch radius r3 = r2(1 + 1/Z2) \[mm\].
     pub r3_mm: f64,
-    /// Element-centre circle radius rc = χ·r2 [mm].
+    /// Element-centre circle radius rc = χ·r2 \[mm\].
     pub rc_mm: f64,
     /// Cam lobes Z1 = Z2 − 1.
     #[serde(rename = "Z1")]
@@ -167,23 +167,23 @@ pub struct GeometryOut {
     /// Crown lobes Z3 = Z2 + 1.
     #[serde(rename = "Z3")]
     pub z3: u32,
-    /// Cam tip radius r2(χ + 1/Z2) − rb [mm] (force paper eq. 8).
+    /// Cam tip radius r2(χ + 1/Z2) − rb \[mm\] (force paper eq. 8).
     pub cam_tip_mm: f64,
-    /// Cam root radius r2(χ − 1/Z2) − rb [mm] (eq. 9).
+    /// Cam root radius r2(χ − 1/Z2) − rb \[mm\] (eq. 9).
     pub cam_root_mm: f64,
-    /// Crown tip radius r2(χ − 1/Z2) + rb [mm] (eq. 10).
+    /// Crown tip radius r2(χ − 1/Z2) + rb \[mm\] (eq. 10).
     pub crown_tip_mm: f64,
-    /// Crown root radius r2(χ + 1/Z2) + rb [mm] (eq. 11).
+    /// Crown root radius r2(χ + 1/Z2) + rb \[mm\] (eq. 11).
     pub crown_root_mm: f64,
-    /// Lower bound of force-paper eq. 3, 2·r2/Z2 [mm] (below it: warning only).
+    /// Lower bound of force-paper eq. 3, 2·r2/Z2 \[mm\] (below it: warning only).
     pub rb_min_paper_mm: f64,
-    /// Element overlap limit χ·r2·sin(π/Z2) [mm] (rb must be below).
+    /// Element overlap limit χ·r2·sin(π/Z2) \[mm\] (rb must be below).
     pub rb_overlap_mm: f64,
-    /// Undercut limit (closed form) [mm] (rb must be below).
+    /// Undercut limit (closed form) \[mm\] (rb must be below).
     pub rb_undercut_mm: f64,
-    /// Sharpest convex cam profile radius [mm].
+    /// Sharpest convex cam profile radius \[mm\].
     pub min_profile_radius_cam_mm: f64,
-    /// Sharpest convex crown profile radius [mm]; null when the crown profile is concave everywhere (χ ≥ Z2).
+    /// Sharpest convex crown profile radius \[mm\]; null when the crown profile is concave everywhere (χ ≥ Z2).
     pub min_profile_radius_crown_mm: Option<f64>,
     /// Carrier → cam ratio with the crown fixed, (Z2 − 1)/2; the cam turns opposite to the carrier.
     pub ratio_cam_output: f64,

@@ -57,11 +57,6 @@
 //! * Outside the range: a 422 with a pointer (`INVALID_INPUT`, `TOO_LARGE`, `MODEL_INVALID`,
 //!   `UNSUPPORTED_MODEL`, `SMOGN_DEGENERATE_RELEVANCE`, `GRA_ZERO_MEAN`, `DEADLINE_EXCEEDED`).
 
-#![allow(
-    rustdoc::broken_intra_doc_links,
-    reason = "docs write units as `[target unit]` (the project's field-doc convention)"
-)]
-
 pub mod boost;
 pub mod compute;
 pub mod data;

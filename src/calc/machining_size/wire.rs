@@ -141,7 +141,7 @@ pub struct TrainRequest {
     /// Optional outputs: `importance` (default), `shap_summary`, `test_predictions`.
     #[serde(default = "default_outputs")]
     pub outputs: Vec<TrainOutputKind>,
-    /// Wall-clock budget of the request [ms], 1..600 000 (capped by the server); training stops
+    /// Wall-clock budget of the request \[ms\], 1..600 000 (capped by the server); training stops
     /// at the first round after it and returns the trees built.
     #[serde(default)]
     #[schema(nullable = false)]
@@ -688,7 +688,7 @@ pub struct PredictRequest {
     /// SHAP interaction values (path-dependent; rows ≤ 1000 and rows·d² ≤ 2 000 000).
     #[serde(default)]
     pub interactions: bool,
-    /// Wall-clock budget of the request [ms], 1..600 000 (capped by the server).
+    /// Wall-clock budget of the request \[ms\], 1..600 000 (capped by the server).
     #[serde(default)]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,
@@ -831,7 +831,7 @@ pub struct AnalyzeRequest {
     #[serde(default)]
     #[schema(nullable = false)]
     pub smogn: Option<SmognPreviewIn>,
-    /// Wall-clock budget of the request [ms], 1..600 000 (capped by the server).
+    /// Wall-clock budget of the request \[ms\], 1..600 000 (capped by the server).
     #[serde(default)]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,

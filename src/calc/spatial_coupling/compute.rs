@@ -14,7 +14,7 @@ pub const CHUNK: usize = 4096;
 /// Contact point in SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactOut {
-    /// r_B [m].
+    /// r_B \[m\].
     pub r: V3,
     /// v_B [m/s].
     pub v: V3,
@@ -27,15 +27,15 @@ pub struct ContactOut {
 /// Motion relative to one shaft in SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RelOut {
-    /// x [m].
+    /// x \[m\].
     pub x: f64,
-    /// z [m].
+    /// z \[m\].
     pub z: f64,
     /// dx/dt [m/s].
     pub vx: f64,
     /// dz/dt [m/s].
     pub vz: f64,
-    /// Relative rotation of body 3 [deg] (wrapped to [0°, 360°) for points, continuous for
+    /// Relative rotation of body 3 \[deg\] (wrapped to [0°, 360°) for points, continuous for
     /// sweeps).
     pub theta_deg: f64,
     /// Its rate [rad/s].
@@ -56,11 +56,11 @@ pub struct FramesOut {
 /// A body-3 point in SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Body3Out {
-    /// Ground frame position [m].
+    /// Ground frame position \[m\].
     pub r0: V3,
-    /// Frame-1 position [m].
+    /// Frame-1 position \[m\].
     pub r1: V3,
-    /// Frame-2 position [m].
+    /// Frame-2 position \[m\].
     pub r2: V3,
     /// Absolute velocity [m/s].
     pub v0: V3,
@@ -82,9 +82,9 @@ pub struct CheckOut {
 /// The kinematics at one input angle, SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointKin {
-    /// θ1 [deg].
+    /// θ1 \[deg\].
     pub theta1_deg: f64,
-    /// θ2 [deg] (wrapped to [0°, 360°) for points, continuous for sweeps).
+    /// θ2 \[deg\] (wrapped to [0°, 360°) for points, continuous for sweeps).
     pub theta2_deg: f64,
     /// i12.
     pub i12: f64,
@@ -117,7 +117,7 @@ pub enum PointResult {
     Ok(Box<PointKin>),
     /// D is zero to round-off: no finite contact point.
     AtInfinity {
-        /// θ1 [deg].
+        /// θ1 \[deg\].
         theta1_deg: f64,
         /// D(θ1).
         d: f64,
@@ -133,17 +133,17 @@ pub struct SweepSummary {
     pub i12: [f64; 2],
     /// [min, max] |i12|.
     pub i12_abs: [f64; 2],
-    /// [min, max] continuous θ31 [deg].
+    /// [min, max] continuous θ31 \[deg\].
     pub theta31: [f64; 2],
-    /// [min, max] continuous θ32 [deg].
+    /// [min, max] continuous θ32 \[deg\].
     pub theta32: [f64; 2],
-    /// [min, max] |rB| [m].
+    /// [min, max] |rB| \[m\].
     pub r_b: [f64; 2],
     /// [min, max] |vB| [m/s].
     pub v_b: [f64; 2],
-    /// [min, max] x2B [m].
+    /// [min, max] x2B \[m\].
     pub x2: [f64; 2],
-    /// [min, max] z2B [m].
+    /// [min, max] z2B \[m\].
     pub z2: [f64; 2],
     /// max |ω31| [rad/s].
     pub omega31: f64,
@@ -530,7 +530,7 @@ pub fn compute(
     })
 }
 
-/// An angle [deg] wrapped to [0°, 360°), −0 written as 0.
+/// An angle \[deg\] wrapped to [0°, 360°), −0 written as 0.
 #[must_use]
 pub fn wrap_360(deg: f64) -> f64 {
     let d = deg.rem_euclid(360.0);

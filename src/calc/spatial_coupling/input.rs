@@ -15,7 +15,7 @@ use super::wire::{
     MIN_ABS_COS_2ALPHA, N_POINTS, OMEGA1, SpatialCouplingRequest, THETA1_DEG, Vec3,
 };
 
-/// Default α [deg] (spec §2; the paper-like case).
+/// Default α \[deg\] (spec §2; the paper-like case).
 pub const DEFAULT_ALPHA_DEG: f64 = 15.0;
 /// Default sweep (spec §2): 0° … 360°, 721 points.
 pub const DEFAULT_SWEEP: Sweep = Sweep {
@@ -27,16 +27,16 @@ pub const DEFAULT_SWEEP: Sweep = Sweep {
 /// A uniform sweep of θ1.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sweep {
-    /// First θ1 [deg].
+    /// First θ1 \[deg\].
     pub start_deg: f64,
-    /// Last θ1 [deg].
+    /// Last θ1 \[deg\].
     pub end_deg: f64,
     /// Number of points (≥ 2).
     pub n_points: usize,
 }
 
 impl Sweep {
-    /// θ1 [deg] of point `k` (the last point is `end_deg` exactly).
+    /// θ1 \[deg\] of point `k` (the last point is `end_deg` exactly).
     #[must_use]
     pub fn theta1_deg(&self, k: usize) -> f64 {
         if k + 1 >= self.n_points {
@@ -72,21 +72,21 @@ pub struct Groups {
 /// The validated request (angles in degrees as given, lengths in m, rates in rad/s).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpatialCouplingInput {
-    /// α [deg].
+    /// α \[deg\].
     pub alpha_deg: f64,
-    /// β [deg].
+    /// β \[deg\].
     pub beta_deg: f64,
-    /// a [m].
+    /// a \[m\].
     pub a: f64,
     /// ω1 [rad/s].
     pub omega1: f64,
     /// σ = ±1.
     pub sigma: f64,
-    /// Single input angles [deg].
+    /// Single input angles \[deg\].
     pub points: Vec<f64>,
     /// Sweep, if any (the default sweep when neither points nor a sweep were given).
     pub sweep: Option<Sweep>,
-    /// Body-3 points in frame 3 [m].
+    /// Body-3 points in frame 3 \[m\].
     pub body3: Vec<Vec3>,
     /// Output groups of every point.
     pub groups: Groups,

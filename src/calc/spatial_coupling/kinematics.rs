@@ -55,7 +55,7 @@ pub struct Core {
     pub c2: f64,
     /// ρ = √(s1² + cos²2α·c1²).
     pub rho: f64,
-    /// θ2 = atan2(σ cos2α c1, σ s1) [rad], wrapped to [0, 2π).
+    /// θ2 = atan2(σ cos2α c1, σ s1) \[rad\], wrapped to [0, 2π).
     pub theta2: f64,
     /// i12 = dθ2/dθ1.
     pub i12: f64,
@@ -85,7 +85,7 @@ pub struct RelKin {
     pub dx: f64,
     /// dz/dθ1 / a.
     pub dz: f64,
-    /// Relative rotation of body 3 [rad], wrapped to (−π, π].
+    /// Relative rotation of body 3 \[rad\], wrapped to (−π, π].
     pub theta: f64,
     /// Its rate per unit ω1.
     pub omega: f64,
@@ -125,7 +125,7 @@ pub fn norm(a: V3) -> f64 {
 }
 
 impl Coupling {
-    /// The coupling for α, β [deg] and assembly mode σ (±1).
+    /// The coupling for α, β \[deg\] and assembly mode σ (±1).
     #[must_use]
     pub fn new(alpha_deg: f64, beta_deg: f64, sigma: f64) -> Self {
         let (sa, ca) = sin_cos_deg(alpha_deg);
@@ -349,7 +349,7 @@ impl Coupling {
         if self.sigma > 0.0 { PI } else { 0.0 }
     }
 
-    /// θ2 [deg] continuous in θ1 [deg] over any number of revolutions (spec §3.5, §7.6): the
+    /// θ2 \[deg\] continuous in θ1 \[deg\] over any number of revolutions (spec §3.5, §7.6): the
     /// output turns once per input revolution, in the −z2 sense for |α| < 45°.
     #[must_use]
     pub fn theta2_continuous_deg(&self, theta1_deg: f64, core: &Core) -> f64 {
@@ -366,7 +366,7 @@ impl Coupling {
     }
 }
 
-/// An oscillating angle [rad] placed continuously about its centre: exact because the swing
+/// An oscillating angle \[rad\] placed continuously about its centre: exact because the swing
 /// about the centre is at most 90° (2|α| or 180° − 2|α|).
 #[must_use]
 pub fn about_centre(theta: f64, centre: f64) -> f64 {

@@ -20,7 +20,7 @@ pub const WARN_ABS_COS_2ALPHA: f64 = 0.1;
 pub const WARN_D_RATIO: f64 = 1e-3;
 /// |rB|/a above this: the contact point is far away (B near infinity).
 pub const WARN_RADIUS_OVER_A: f64 = 1e3;
-/// |θ1| above this [deg]: one ulp of θ1 exceeds 1e-6°.
+/// |θ1| above this \[deg\]: one ulp of θ1 exceeds 1e-6°.
 pub const WARN_LARGE_ANGLE_DEG: f64 = 8.0e9;
 
 /// Builds the response.

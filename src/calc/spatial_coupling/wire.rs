@@ -84,17 +84,17 @@ impl ToSchema for Branch {
     "outputs": {"contact": true, "relative_1": true, "relative_2": true, "summary": true, "check": true}
 }))]
 pub struct SpatialCouplingRequest {
-    /// Half-angle parameter α [deg]: the shaft axes make 180° − 2α (misalignment from collinear
+    /// Half-angle parameter α \[deg\]: the shaft axes make 180° − 2α (misalignment from collinear
     /// 2α). |cos 2α| ≥ 1e-9 (α = ±45°, perpendicular shafts, is a dead-point configuration and
     /// is rejected); |cos 2α| < 0.1 answers with a warning. Default 15.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 15.0)]
     pub alpha_deg: Option<f64>,
-    /// Half of the common-normal length `a` [m] (A1 = (a, 0, 0), A2 = (−a, 0, 0)). Default 1.
+    /// Half of the common-normal length `a` \[m\] (A1 = (a, 0, 0), A2 = (−a, 0, 0)). Default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
     pub a_m: Option<f64>,
-    /// Orientation β of the support plane P0 [deg] (P0 contains Ox; normal (0, −cos β, sin β)).
+    /// Orientation β of the support plane P0 \[deg\] (P0 contains Ox; normal (0, −cos β, sin β)).
     /// β = α puts P0 perpendicular to the input shaft (the paper's design). Default: `alpha_deg`.
     /// Requests with a `sweep` need cos(α−β)·cos 2α·cos(α+β) > 0 (contact point finite at every
     /// θ1, spec §7.2); points-only requests answer per point.
@@ -110,7 +110,7 @@ pub struct SpatialCouplingRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub branch: Option<Branch>,
-    /// Input angles θ1 [deg] evaluated one by one (any finite value; reduced modulo 360°).
+    /// Input angles θ1 \[deg\] evaluated one by one (any finite value; reduced modulo 360°).
     /// At most 100 000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, max_items = 100_000, example = json!([30.0]))]
@@ -119,7 +119,7 @@ pub struct SpatialCouplingRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub sweep: Option<SweepIn>,
-    /// Points fixed in body 3, in frame-3 coordinates [m], whose paths and velocities are
+    /// Points fixed in body 3, in frame-3 coordinates \[m\], whose paths and velocities are
     /// returned at every point (`body3_points` of each point). At most 100.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, max_items = 100, value_type = Vec<[f64; 3]>)]
@@ -127,7 +127,7 @@ pub struct SpatialCouplingRequest {
     /// Optional output groups (spec §5); each costs O(1) per point.
     #[serde(default)]
     pub outputs: OutputsIn,
-    /// Wall-clock limit for this request [ms] (capped by the service limit).
+    /// Wall-clock limit for this request \[ms\] (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
@@ -144,11 +144,11 @@ impl crate::calc::common::TimeLimited for SpatialCouplingRequest {
 #[schema(as = spatial_coupling::SweepIn)]
 #[serde(deny_unknown_fields)]
 pub struct SweepIn {
-    /// First input angle [deg]. Default 0.
+    /// First input angle \[deg\]. Default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.0)]
     pub start_deg: Option<f64>,
-    /// Last input angle [deg] (may be below `start_deg`: a reversed sweep). Default 360.
+    /// Last input angle \[deg\] (may be below `start_deg`: a reversed sweep). Default 360.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 360.0)]
     pub end_deg: Option<f64>,
@@ -233,7 +233,7 @@ pub struct SpatialCouplingResponse {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = spatial_coupling::Configuration)]
 pub struct Configuration {
-    /// Bend angle of the equivalent Hooke (Cardan) joint, 2α [deg]; its input angle is 90° − θ1.
+    /// Bend angle of the equivalent Hooke (Cardan) joint, 2α \[deg\]; its input angle is 90° − θ1.
     pub cardan_bend_angle_deg: f64,
     /// Whether the coupling is homokinetic (|1 − |cos 2α|| < 1e-12; only α = 0 in the valid range
     /// of perpendicular-free shafts, or α → ±90°).
@@ -293,7 +293,7 @@ pub struct PointError {
     pub code: String,
     /// Explanation naming the input angle and D.
     pub message: String,
-    /// The input angle of this point [deg], as requested.
+    /// The input angle of this point \[deg\], as requested.
     pub theta1_deg: f64,
 }
 
@@ -301,9 +301,9 @@ pub struct PointError {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = spatial_coupling::Point)]
 pub struct Point {
-    /// Input angle θ1 [deg] (as requested, or the sweep's value).
+    /// Input angle θ1 \[deg\] (as requested, or the sweep's value).
     pub theta1_deg: f64,
-    /// Output angle θ2 [deg]: in [0°, 360°) for single points, unwrapped along a sweep.
+    /// Output angle θ2 \[deg\]: in [0°, 360°) for single points, unwrapped along a sweep.
     pub theta2_deg: f64,
     /// Transmission ratio i12 = dθ2/dθ1 = ω2/ω1 (negative for |α| < 45°: the output turns in −z2).
     pub i12: f64,
@@ -347,7 +347,7 @@ pub struct Point {
     reason = "the spec's wire names rB_m, vB_m_s, vB_mag, D"
 )]
 pub struct Contact {
-    /// Position r_B in the ground frame [m].
+    /// Position r_B in the ground frame \[m\].
     #[schema(value_type = [f64; 3])]
     pub rB_m: Vec3,
     /// Velocity v_B in the ground frame [m/s].
@@ -364,15 +364,15 @@ pub struct Contact {
 #[schema(as = spatial_coupling::Relative1)]
 #[expect(non_snake_case, reason = "the spec's wire names x1B_m, …")]
 pub struct Relative1 {
-    /// x of B in frame 1 [m].
+    /// x of B in frame 1 \[m\].
     pub x1B_m: f64,
-    /// z of B in frame 1 [m] (0 for β = α).
+    /// z of B in frame 1 \[m\] (0 for β = α).
     pub z1B_m: f64,
     /// dx1B/dt [m/s].
     pub vx1B_m_s: f64,
     /// dz1B/dt [m/s].
     pub vz1B_m_s: f64,
-    /// Rotation θ31 of body 3 relative to shaft 1 about i3 ≡ j1 [deg] ([0°, 360°) for single
+    /// Rotation θ31 of body 3 relative to shaft 1 about i3 ≡ j1 \[deg\] ([0°, 360°) for single
     /// points, unwrapped along a sweep).
     pub theta31_deg: f64,
     /// ω31 = dθ31/dt [rad/s].
@@ -384,15 +384,15 @@ pub struct Relative1 {
 #[schema(as = spatial_coupling::Relative2)]
 #[expect(non_snake_case, reason = "the spec's wire names x2B_m, …")]
 pub struct Relative2 {
-    /// x of B in frame 2 [m].
+    /// x of B in frame 2 \[m\].
     pub x2B_m: f64,
-    /// z of B in frame 2 [m].
+    /// z of B in frame 2 \[m\].
     pub z2B_m: f64,
     /// dx2B/dt [m/s].
     pub vx2B_m_s: f64,
     /// dz2B/dt [m/s].
     pub vz2B_m_s: f64,
-    /// Rotation θ32 of body 3 relative to shaft 2 about j3 ≡ j2 [deg] ([0°, 360°) for single
+    /// Rotation θ32 of body 3 relative to shaft 2 about j3 ≡ j2 \[deg\] ([0°, 360°) for single
     /// points, unwrapped along a sweep).
     pub theta32_deg: f64,
     /// ω32 = dθ32/dt = −σ·ω1·sin2α·sin θ1/√(sin²θ1 + cos²2α·cos²θ1) [rad/s] (flips with σ
@@ -444,13 +444,13 @@ pub struct Frames {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = spatial_coupling::Body3Point)]
 pub struct Body3Point {
-    /// Position in the ground frame [m].
+    /// Position in the ground frame \[m\].
     #[schema(value_type = [f64; 3])]
     pub r0_m: Vec3,
-    /// Position in frame 1 [m].
+    /// Position in frame 1 \[m\].
     #[schema(value_type = [f64; 3])]
     pub r1_m: Vec3,
-    /// Position in frame 2 [m].
+    /// Position in frame 2 \[m\].
     #[schema(value_type = [f64; 3])]
     pub r2_m: Vec3,
     /// Absolute velocity, ground frame [m/s].
@@ -498,17 +498,17 @@ pub struct Summary {
     pub ratio_range_abs: [f64; 2],
     /// |i12|max − |i12|min.
     pub fluctuation: f64,
-    /// (max − min)/2 of the unwrapped θ31 [deg] (2|α| over a revolution for |α| < 45°).
+    /// (max − min)/2 of the unwrapped θ31 \[deg\] (2|α| over a revolution for |α| < 45°).
     pub theta31_amplitude_deg: f64,
-    /// (max − min)/2 of the unwrapped θ32 [deg].
+    /// (max − min)/2 of the unwrapped θ32 \[deg\].
     pub theta32_amplitude_deg: f64,
-    /// [min, max] of |rB| [m].
+    /// [min, max] of |rB| \[m\].
     #[schema(value_type = [f64; 2])]
     pub rB_radius_range_m: [f64; 2],
     /// [min, max] of |vB| [m/s].
     #[schema(value_type = [f64; 2])]
     pub vB_range_m_s: [f64; 2],
-    /// Bounding box of the path of B in frame 2 (x2B, z2B) [m].
+    /// Bounding box of the path of B in frame 2 (x2B, z2B) \[m\].
     pub lemniscate_box_m: LemniscateBox,
     /// max |ω31| [rad/s].
     pub omega31_max_abs: f64,
@@ -518,14 +518,14 @@ pub struct Summary {
     pub D_min_over_max: f64,
 }
 
-/// An axis-aligned box in the (x2, z2) plane of frame 2 [m].
+/// An axis-aligned box in the (x2, z2) plane of frame 2 \[m\].
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = spatial_coupling::LemniscateBox)]
 pub struct LemniscateBox {
-    /// [min, max] of x2B [m].
+    /// [min, max] of x2B \[m\].
     #[schema(value_type = [f64; 2])]
     pub x: [f64; 2],
-    /// [min, max] of z2B [m].
+    /// [min, max] of z2B \[m\].
     #[schema(value_type = [f64; 2])]
     pub z: [f64; 2],
 }
@@ -534,26 +534,26 @@ pub struct LemniscateBox {
 // Bounds
 // ---------------------------------------------------------------------------------------------
 
-/// α [deg]: open interval (−90°, 90°); |cos 2α| ≥ [`MIN_ABS_COS_2ALPHA`] is a separate rule.
+/// α \[deg\]: open interval (−90°, 90°); |cos 2α| ≥ [`MIN_ABS_COS_2ALPHA`] is a separate rule.
 pub const ALPHA_DEG: Range = Range::FINITE.gt(-90.0).lt(90.0);
-/// β [deg]: (−90°, 90°] (spec §2); the plane-validity test is a separate rule.
+/// β \[deg\]: (−90°, 90°] (spec §2); the plane-validity test is a separate rule.
 pub const BETA_DEG: Range = Range::FINITE.gt(-90.0).max(90.0);
-/// Largest half common-normal length [m]: with |ω1| ≤ [`MAX_OMEGA1`] every returned length,
+/// Largest half common-normal length \[m\]: with |ω1| ≤ [`MAX_OMEGA1`] every returned length,
 /// speed and acceleration stays far inside f64 even at the conditioning limits of §7.
 pub const MAX_LENGTH_M: f64 = 1e6;
-/// a [m]: positive, at most [`MAX_LENGTH_M`].
+/// a \[m\]: positive, at most [`MAX_LENGTH_M`].
 pub const A_M: Range = Range::FINITE.gt(0.0).max(MAX_LENGTH_M);
 /// Largest |ω1| [rad/s] (1e6 rad/s ≈ 1e7 rpm, far beyond any machine).
 pub const MAX_OMEGA1: f64 = 1e6;
 /// ω1 [rad/s].
 pub const OMEGA1: Range = Range::closed(-MAX_OMEGA1, MAX_OMEGA1);
-/// θ1 [deg]: any finite angle (reduced modulo 360°).
+/// θ1 \[deg\]: any finite angle (reduced modulo 360°).
 pub const THETA1_DEG: Range = Range::FINITE;
 /// Sweep points n (spec §2: 2 … 10⁶).
 pub const N_POINTS: Range = Range::int(2, 1_000_000);
 /// `decimate`: 1 … 10⁶.
 pub const DECIMATE: Range = Range::int(1, 1_000_000);
-/// Body-3 point coordinates [m].
+/// Body-3 point coordinates \[m\].
 pub const BODY3_COORD_M: Range = Range::closed(-MAX_LENGTH_M, MAX_LENGTH_M);
 /// |cos 2α| below this is rejected (spec §2, §7.1: perpendicular shafts, dead points).
 pub const MIN_ABS_COS_2ALPHA: f64 = 1e-9;

@@ -20,7 +20,7 @@ pub const NODE_WARN_REL: f64 = 1e-3;
 
 /// A complex response per frequency; `None` where `jω` is (numerically) a pole.
 pub type Response = Vec<Option<Complex<f64>>>;
-/// Coupled FRF: frequencies [Hz], abscissae [m], one [`Response`] per abscissa.
+/// Coupled FRF: frequencies \[Hz\], abscissae \[m\], one [`Response`] per abscissa.
 pub type Frf = (Vec<f64>, Vec<f64>, Vec<Response>);
 
 /// Everything `compute` found, in SI units.
@@ -30,17 +30,17 @@ pub struct VibrationAbsorberOutput {
     pub model: Model,
     /// `β_k L`.
     pub beta_l: Vec<f64>,
-    /// Bare-beam `f_k` [Hz].
+    /// Bare-beam `f_k` \[Hz\].
     pub freqs_hz: Vec<f64>,
-    /// Beam mass [kg].
+    /// Beam mass \[kg\].
     pub beam_mass: f64,
     /// Static compliance at `x_p` [m/N].
     pub static_compliance: f64,
-    /// Nodes of the tuned mode [m].
+    /// Nodes of the tuned mode \[m\].
     pub tuned_nodes: Option<Vec<f64>>,
     /// Gains (active only).
     pub gains: Option<Gains>,
-    /// Table-2 frequencies `(without, with)` [Hz].
+    /// Table-2 frequencies `(without, with)` \[Hz\].
     pub natural: Option<(Vec<f64>, Vec<f64>)>,
     /// Coupled eigen-analysis.
     pub eigen: Option<Eigen>,
@@ -63,13 +63,13 @@ pub struct VibrationAbsorberOutput {
 /// Time response reductions with their channel layout.
 #[derive(Debug, Clone)]
 pub struct TimeOutput {
-    /// Frequency of each harmonic component [Hz] (empty unless harmonic).
+    /// Frequency of each harmonic component \[Hz\] (empty unless harmonic).
     pub excitation_hz: Vec<f64>,
     /// Whether the components were listed (`excitation.harmonics`).
     pub listed: bool,
     /// Samples.
     pub n_samples: usize,
-    /// Output abscissae [m].
+    /// Output abscissae \[m\].
     pub points: Vec<f64>,
     /// Reductions; rows: points, then stroke, force, current, voltage as present.
     pub series: TimeSeries,

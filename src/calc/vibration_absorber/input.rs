@@ -38,7 +38,7 @@ pub enum Config {
 /// A frequency given in Hz or as a bare-beam mode index.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FreqRef {
-    /// [Hz].
+    /// \[Hz\].
     Hz(f64),
     /// Mode k (1-based) of the bare beam.
     Mode(usize),
@@ -47,15 +47,15 @@ pub enum FreqRef {
 /// The beam.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Beam {
-    /// `L` [m].
+    /// `L` \[m\].
     pub length: f64,
-    /// `E` [Pa].
+    /// `E` \[Pa\].
     pub youngs: f64,
     /// `ρ` [kg/m³].
     pub density: f64,
-    /// `A` [m²].
+    /// `A` \[m²\].
     pub area: f64,
-    /// `I` [m⁴].
+    /// `I` \[m⁴\].
     pub inertia: f64,
     /// `n`.
     pub n_modes: usize,
@@ -66,7 +66,7 @@ pub struct Beam {
 /// The absorber.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Absorber {
-    /// `m_a` [kg].
+    /// `m_a` \[kg\].
     pub mass: f64,
     /// Explicit `k_a` [N/m].
     pub stiffness: Option<f64>,
@@ -74,16 +74,16 @@ pub struct Absorber {
     pub passive_tuning: FreqRef,
     /// `b_a` [N·s/m].
     pub damping: f64,
-    /// `x_a` [m].
+    /// `x_a` \[m\].
     pub position: f64,
 }
 
 /// The actuator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Actuator {
-    /// `R` [Ω].
+    /// `R` \[Ω\].
     pub r: f64,
-    /// `L_c` [H].
+    /// `L_c` \[H\].
     pub lc: f64,
     /// `K_c` [N/A].
     pub kc: f64,
@@ -108,11 +108,11 @@ pub enum GainSource {
 /// One harmonic component `P sin(Ωt + φ)` of the force.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Harmonic {
-    /// `P` [N].
+    /// `P` \[N\].
     pub amplitude: f64,
     /// Ω/2π.
     pub freq: FreqRef,
-    /// φ [rad].
+    /// φ \[rad\].
     pub phase: f64,
 }
 
@@ -137,9 +137,9 @@ pub enum Forcing {
 /// A frequency grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Grid {
-    /// [Hz].
+    /// \[Hz\].
     pub f_min: f64,
-    /// [Hz].
+    /// \[Hz\].
     pub f_max: f64,
     /// Points.
     pub n: usize,
@@ -148,7 +148,7 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// The frequencies [Hz].
+    /// The frequencies \[Hz\].
     #[must_use]
     pub fn frequencies(&self) -> Vec<f64> {
         if self.n == 1 {
@@ -173,9 +173,9 @@ impl Grid {
 pub struct TimeRequest {
     /// Number of steps K (samples K + 1).
     pub steps: usize,
-    /// Output step [s].
+    /// Output step \[s\].
     pub dt: f64,
-    /// Output abscissae [m].
+    /// Output abscissae \[m\].
     pub points: Vec<f64>,
     /// Return series.
     pub series: bool,
@@ -219,9 +219,9 @@ pub struct VibrationAbsorberInput {
     pub gains: GainSource,
     /// Force law.
     pub forcing: Forcing,
-    /// `x_p` [m].
+    /// `x_p` \[m\].
     pub force_position: f64,
-    /// `P0` [N] or [N·s] of an impulse or a step (the single harmonic's amplitude too; the
+    /// `P0` \[N\] or [N·s] of an impulse or a step (the single harmonic's amplitude too; the
     /// components carry their own).
     pub amplitude: f64,
     /// Analyses.

@@ -78,11 +78,6 @@
 //!   warning. Overflow (e.g. an unstable design over a long horizon) is the typed 422
 //!   `NON_FINITE_RESPONSE`; a spent budget is `DEADLINE_EXCEEDED`.
 
-#![allow(
-    rustdoc::broken_intra_doc_links,
-    reason = "docs write units as `[m]`, `[Hz]` (the project's field-doc convention); rustdoc would read them as links"
-)]
-
 pub mod beam;
 pub mod compute;
 pub mod error;

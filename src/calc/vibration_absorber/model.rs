@@ -13,7 +13,7 @@ pub struct Gains {
     pub kp: f64,
     /// `K_d` [V·s/m].
     pub kd: f64,
-    /// Target `f_c` [Hz] (`None` for explicit gains).
+    /// Target `f_c` \[Hz\] (`None` for explicit gains).
     pub tuning_hz: Option<f64>,
     /// Third root `−(R/L_c + b_a/m_a)` [1/s] (exact only for tuned gains).
     pub third_pole: f64,
@@ -24,15 +24,15 @@ pub struct Gains {
 /// The absorber and actuator constants.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Device {
-    /// `m_a` [kg].
+    /// `m_a` \[kg\].
     pub ma: f64,
     /// `k_a` [N/m].
     pub ka: f64,
     /// `b_a` [N·s/m].
     pub ba: f64,
-    /// `R` [Ω].
+    /// `R` \[Ω\].
     pub r: f64,
-    /// `L_c` [H].
+    /// `L_c` \[H\].
     pub lc: f64,
     /// `K_c` [N/A].
     pub kc: f64,
@@ -41,7 +41,7 @@ pub struct Device {
 }
 
 impl Device {
-    /// Gains of Eq. (7)(8) for the target `f_c` [Hz]; `None` when `K_c = 0`.
+    /// Gains of Eq. (7)(8) for the target `f_c` \[Hz\]; `None` when `K_c = 0`.
     #[must_use]
     pub fn tuned_gains(&self, fc: f64) -> Option<Gains> {
         if self.kc == 0.0 {
@@ -97,9 +97,9 @@ impl Device {
 pub struct Model {
     /// Configuration (which states exist).
     pub config: Config,
-    /// Beam length `L` [m].
+    /// Beam length `L` \[m\].
     pub length: f64,
-    /// Modal mass `m = ρAL` [kg] (every mode).
+    /// Modal mass `m = ρAL` \[kg\] (every mode).
     pub modal_mass: f64,
     /// Bare-beam circular frequencies `ω_k` [rad/s].
     pub omega: Vec<f64>,
@@ -126,7 +126,7 @@ impl Model {
         self.omega.len()
     }
 
-    /// `[φ_k(x)]` at abscissa `x` [m].
+    /// `[φ_k(x)]` at abscissa `x` \[m\].
     #[must_use]
     pub fn phi_at(&self, x: f64) -> Vec<f64> {
         let xi = (x / self.length).clamp(0.0, 1.0);
@@ -262,7 +262,7 @@ impl Model {
         Some(-(r * self.kp + rd * self.kd))
     }
 
-    /// Undamped natural frequencies [Hz] of the beam with the absorber's mass and spring only
+    /// Undamped natural frequencies \[Hz\] of the beam with the absorber's mass and spring only
     /// (spec §3.D.1): `K v = λ M v`, reduced with `M^{-1/2}`; ascending, n + 1 values.
     #[must_use]
     pub fn with_absorber_frequencies(&self) -> Vec<f64> {

@@ -13,7 +13,7 @@ use crate::numerics::{Budget, par_map_while};
 pub const SINGULAR_REL: f64 = 1e-11;
 /// Stability threshold on max Re λ relative to max |λ| (spec §3.D.2).
 pub const STABILITY_REL: f64 = 1e-9;
-/// Re-anchor period of long time responses [steps] (spec §3.D.4).
+/// Re-anchor period of long time responses \[steps\] (spec §3.D.4).
 pub const REANCHOR_EVERY: usize = 10_000;
 /// Horizons longer than this many steps are re-anchored.
 pub const REANCHOR_ABOVE: usize = 100_000;
@@ -138,7 +138,7 @@ pub struct TimeSeries {
     pub rms: Vec<f64>,
     /// Kept samples per row (every `decimate`-th), when asked.
     pub series: Option<Vec<Vec<f64>>>,
-    /// Kept sample times [s].
+    /// Kept sample times \[s\].
     pub t: Option<Vec<f64>>,
     /// Matrix exponentials evaluated.
     pub expms: u64,
@@ -155,7 +155,7 @@ pub struct Stepper<'a> {
     pub rows: &'a [DVector<f64>],
     /// Steps K (samples K + 1).
     pub steps: usize,
-    /// Output step h [s].
+    /// Output step h \[s\].
     pub dt: f64,
     /// First sample of the "last period" window.
     pub last_from: usize,
@@ -260,7 +260,7 @@ impl Stepper<'_> {
 /// Exact step metrics of one single-input system.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepMetrics {
-    /// 2 % settling time [s], `None` when the response does not settle.
+    /// 2 % settling time \[s\], `None` when the response does not settle.
     pub settling: Option<f64>,
     /// Overshoot [%].
     pub overshoot_pct: f64,

@@ -9,15 +9,15 @@ use crate::calc::Range;
 use crate::calc::common::Warning;
 use crate::numerics::SolverReport;
 
-/// Beam length, positions and abscissae [m]: positive; positions also ≤ `beam.length_m`.
+/// Beam length, positions and abscissae \[m\]: positive; positions also ≤ `beam.length_m`.
 pub const LENGTH: Range = Range::FINITE.gt(0.0).max(1e3);
-/// Output abscissae [m]: in [0, 1e3], and ≤ `beam.length_m`.
+/// Output abscissae \[m\]: in [0, 1e3], and ≤ `beam.length_m`.
 pub const ABSCISSA: Range = Range::closed(0.0, 1e3);
-/// Young's modulus [Pa].
+/// Young's modulus \[Pa\].
 pub const MODULUS: Range = Range::FINITE.gt(0.0).max(1e13);
 /// Density [kg/m³].
 pub const DENSITY: Range = Range::FINITE.gt(0.0).max(1e6);
-/// Section area [m²], second moment [m⁴], section width/thickness [m].
+/// Section area \[m²\], second moment \[m⁴\], section width/thickness \[m\].
 pub const SECTION: Range = Range::FINITE.gt(0.0).max(1e2);
 /// Modes kept (spec §2: 1…50; mode-shape cost and overflow beyond).
 pub const N_MODES: Range = Range::int(1, 50);
@@ -25,17 +25,17 @@ pub const N_MODES: Range = Range::int(1, 50);
 pub const MODE_INDEX: Range = Range::int(1, 50);
 /// Modal damping ratio ζ: 0 ≤ ζ < 1.
 pub const DAMPING_RATIO: Range = Range::FINITE.min(0.0).lt(1.0);
-/// Absorber mass [kg].
+/// Absorber mass \[kg\].
 pub const MASS: Range = Range::FINITE.gt(0.0).max(1e6);
 /// Absorber stiffness [N/m] (0 = no spring).
 pub const STIFFNESS: Range = Range::closed(0.0, 1e12);
 /// Absorber viscous damping [N·s/m].
 pub const DAMPING: Range = Range::closed(0.0, 1e9);
-/// A frequency [Hz] (tunings, excitation, grid ends).
+/// A frequency \[Hz\] (tunings, excitation, grid ends).
 pub const FREQUENCY: Range = Range::FINITE.gt(0.0).max(1e6);
-/// Coil resistance [Ω].
+/// Coil resistance \[Ω\].
 pub const RESISTANCE: Range = Range::FINITE.gt(0.0).max(1e6);
-/// Coil inductance [H] (L_c = 0 would make the coil algebraic: rejected, spec §7.6).
+/// Coil inductance \[H\] (L_c = 0 would make the coil algebraic: rejected, spec §7.6).
 pub const INDUCTANCE: Range = Range::FINITE.gt(0.0).max(1e3);
 /// Force constant [N/A] (≠ 0 with `active`).
 pub const FORCE_CONSTANT: Range = Range::closed(-1e6, 1e6);
@@ -43,15 +43,15 @@ pub const FORCE_CONSTANT: Range = Range::closed(-1e6, 1e6);
 pub const BACK_EMF: Range = Range::closed(0.0, 1e6);
 /// Explicit PD gains [V/m], [V·s/m].
 pub const GAIN: Range = Range::closed(-1e12, 1e12);
-/// Force amplitude [N] (impulse [N·s]).
+/// Force amplitude \[N\] (impulse [N·s]).
 pub const AMPLITUDE: Range = Range::closed(-1e9, 1e9);
-/// Excitation phase [rad].
+/// Excitation phase \[rad\].
 pub const PHASE: Range = Range::closed(-1e6, 1e6);
 /// Frequency-grid size (spec §2: at most 1e5 points).
 pub const FREQ_POINTS: Range = Range::int(1, 100_000);
-/// Time horizon [s].
+/// Time horizon \[s\].
 pub const T_END: Range = Range::FINITE.gt(0.0).max(1e6);
-/// Output step [s] (also `t_end_s / dt_s ≤ 2e6`).
+/// Output step \[s\] (also `t_end_s / dt_s ≤ 2e6`).
 pub const DT: Range = Range::FINITE.gt(0.0).max(1e3);
 /// Series decimation (every k-th sample).
 pub const DECIMATE: Range = Range::int(1, 2_000_000);
@@ -89,7 +89,7 @@ pub struct VibrationAbsorberRequest {
     /// Optional analyses (none is computed unless asked).
     #[serde(default)]
     pub outputs: OutputsIn,
-    /// Wall-clock budget of this request [ms] (capped by the service).
+    /// Wall-clock budget of this request \[ms\] (capped by the service).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 10000)]
     pub time_limit_ms: Option<u64>,
@@ -101,11 +101,11 @@ pub struct VibrationAbsorberRequest {
 #[schema(as = vibration_absorber::BeamIn)]
 #[serde(deny_unknown_fields)]
 pub struct BeamIn {
-    /// Length `L` [m], default 1.
+    /// Length `L` \[m\], default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
     pub length_m: Option<f64>,
-    /// Young's modulus `E` [Pa], default 2.1e11.
+    /// Young's modulus `E` \[Pa\], default 2.1e11.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 2.1e11)]
     pub youngs_modulus_pa: Option<f64>,
@@ -113,11 +113,11 @@ pub struct BeamIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 7850.0)]
     pub density_kg_m3: Option<f64>,
-    /// Cross-section area `A` [m²] (with `second_moment_m4`; exclusive with `section`).
+    /// Cross-section area `A` \[m²\] (with `second_moment_m4`; exclusive with `section`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub area_m2: Option<f64>,
-    /// Second moment of area `I` [m⁴] (with `area_m2`; exclusive with `section`).
+    /// Second moment of area `I` \[m⁴\] (with `area_m2`; exclusive with `section`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub second_moment_m4: Option<f64>,
@@ -141,10 +141,10 @@ pub struct BeamIn {
 #[schema(as = vibration_absorber::SectionIn)]
 #[serde(deny_unknown_fields)]
 pub struct SectionIn {
-    /// Width `b` [m].
+    /// Width `b` \[m\].
     #[schema(example = 0.05)]
     pub width_m: f64,
-    /// Thickness `e` [m] (bending direction).
+    /// Thickness `e` \[m\] (bending direction).
     #[schema(example = 0.005)]
     pub thickness_m: f64,
 }
@@ -154,7 +154,7 @@ pub struct SectionIn {
 #[schema(as = vibration_absorber::AbsorberIn)]
 #[serde(deny_unknown_fields)]
 pub struct AbsorberIn {
-    /// Mass `m_a` [kg], default 0.05.
+    /// Mass `m_a` \[kg\], default 0.05.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.05)]
     pub mass_kg: Option<f64>,
@@ -162,7 +162,7 @@ pub struct AbsorberIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub stiffness_n_m: Option<f64>,
-    /// Passive tuning frequency `f` [Hz] setting `k_a` (exclusive with `stiffness_n_m` and
+    /// Passive tuning frequency `f` \[Hz\] setting `k_a` (exclusive with `stiffness_n_m` and
     /// `passive_tuning_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 4.14)]
@@ -175,7 +175,7 @@ pub struct AbsorberIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.01)]
     pub damping_n_s_m: Option<f64>,
-    /// Attachment abscissa `x_a` from the clamp [m], 0 < x_a ≤ `beam.length_m`, default the tip.
+    /// Attachment abscissa `x_a` from the clamp \[m\], 0 < x_a ≤ `beam.length_m`, default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
     pub position_m: Option<f64>,
@@ -186,11 +186,11 @@ pub struct AbsorberIn {
 #[schema(as = vibration_absorber::ActuatorIn)]
 #[serde(deny_unknown_fields)]
 pub struct ActuatorIn {
-    /// Coil resistance `R` [Ω], default 1.6.
+    /// Coil resistance `R` \[Ω\], default 1.6.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.6)]
     pub resistance_ohm: Option<f64>,
-    /// Coil inductance `L_c` [H], default 0.75e-3.
+    /// Coil inductance `L_c` \[H\], default 0.75e-3.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.00075)]
     pub inductance_h: Option<f64>,
@@ -230,7 +230,7 @@ pub struct ControlIn {
     /// Configuration, default `active`.
     #[serde(default)]
     pub mode: ControlMode,
-    /// Target frequency `f_c` [Hz] of the tuning (exclusive with `tuning_mode`).
+    /// Target frequency `f_c` \[Hz\] of the tuning (exclusive with `tuning_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 26.26)]
     pub tuning_hz: Option<f64>,
@@ -275,15 +275,15 @@ pub struct ExcitationIn {
     /// Time law, default `harmonic`.
     #[serde(default, rename = "type")]
     pub kind: ExcitationType,
-    /// Force abscissa `x_p` [m], 0 < x_p ≤ `beam.length_m`, default the tip.
+    /// Force abscissa `x_p` \[m\], 0 < x_p ≤ `beam.length_m`, default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
     pub position_m: Option<f64>,
-    /// Amplitude `P0` [N] (impulse: [N·s]), default 1.
+    /// Amplitude `P0` \[N\] (impulse: [N·s]), default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
     pub amplitude_n: Option<f64>,
-    /// Excitation frequency `Ω/2π` [Hz] (exclusive with `resonance_of_mode`).
+    /// Excitation frequency `Ω/2π` \[Hz\] (exclusive with `resonance_of_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub frequency_hz: Option<f64>,
@@ -291,7 +291,7 @@ pub struct ExcitationIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 2)]
     pub resonance_of_mode: Option<u32>,
-    /// Phase `φ0` [rad], default 0.
+    /// Phase `φ0` \[rad\], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.0)]
     pub phase_rad: Option<f64>,
@@ -309,10 +309,10 @@ pub struct ExcitationIn {
 #[schema(as = vibration_absorber::HarmonicIn)]
 #[serde(deny_unknown_fields)]
 pub struct HarmonicIn {
-    /// Amplitude `P_j` [N].
+    /// Amplitude `P_j` \[N\].
     #[schema(example = 1.0)]
     pub amplitude_n: f64,
-    /// Frequency `Ω_j/2π` [Hz] (exclusive with `resonance_of_mode`).
+    /// Frequency `Ω_j/2π` \[Hz\] (exclusive with `resonance_of_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub frequency_hz: Option<f64>,
@@ -320,7 +320,7 @@ pub struct HarmonicIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub resonance_of_mode: Option<u32>,
-    /// Phase `φ_j` [rad], default 0.
+    /// Phase `φ_j` \[rad\], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub phase_rad: Option<f64>,
@@ -375,7 +375,7 @@ pub struct ModeShapesIn {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = vibration_absorber::ModeShapesOut)]
 pub struct ModeShapesOut {
-    /// Abscissae [m].
+    /// Abscissae \[m\].
     pub x_m: Vec<f64>,
     /// `shapes[k][i] = φ_{k+1}(x_i)`.
     pub shapes: Vec<Vec<f64>>,
@@ -386,10 +386,10 @@ pub struct ModeShapesOut {
 #[schema(as = vibration_absorber::GridIn)]
 #[serde(deny_unknown_fields)]
 pub struct GridIn {
-    /// Lowest frequency [Hz].
+    /// Lowest frequency \[Hz\].
     #[schema(example = 0.5)]
     pub f_min_hz: f64,
-    /// Highest frequency [Hz], > `f_min_hz` (equal only with `n_points` = 1).
+    /// Highest frequency \[Hz\], > `f_min_hz` (equal only with `n_points` = 1).
     #[schema(example = 100.0)]
     pub f_max_hz: f64,
     /// Number of frequencies, 1…1e5.
@@ -405,10 +405,10 @@ pub struct GridIn {
 #[schema(as = vibration_absorber::FrequencyResponseIn)]
 #[serde(deny_unknown_fields)]
 pub struct FrequencyResponseIn {
-    /// Lowest frequency [Hz].
+    /// Lowest frequency \[Hz\].
     #[schema(example = 0.5)]
     pub f_min_hz: f64,
-    /// Highest frequency [Hz], > `f_min_hz` (equal only with `n_points` = 1).
+    /// Highest frequency \[Hz\], > `f_min_hz` (equal only with `n_points` = 1).
     #[schema(example = 100.0)]
     pub f_max_hz: f64,
     /// Number of frequencies, 1…1e5. Cost n_points · O(N³).
@@ -417,7 +417,7 @@ pub struct FrequencyResponseIn {
     /// Logarithmic spacing (default linear).
     #[serde(default)]
     pub log: bool,
-    /// Output abscissae `x_o` [m], each in [0, `beam.length_m`], at most 64; default the tip.
+    /// Output abscissae `x_o` \[m\], each in [0, `beam.length_m`], at most 64; default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = json!([1.0]))]
     pub points_m: Option<Vec<f64>>,
@@ -428,15 +428,15 @@ pub struct FrequencyResponseIn {
 #[schema(as = vibration_absorber::TimeResponseIn)]
 #[serde(deny_unknown_fields)]
 pub struct TimeResponseIn {
-    /// Horizon [s].
+    /// Horizon \[s\].
     #[schema(example = 10.0)]
     pub t_end_s: f64,
-    /// Output step `h` [s] (the result is exact for any h; `t_end_s/dt_s` ≤ 2e6 samples). Samples
+    /// Output step `h` \[s\] (the result is exact for any h; `t_end_s/dt_s` ≤ 2e6 samples). Samples
     /// are `t = k·h`, `k = 0…K`, `K = ⌈t_end_s/dt_s⌉` (a ratio within 1e-9 of an integer is that
     /// integer).
     #[schema(example = 0.001)]
     pub dt_s: f64,
-    /// Output abscissae `x_o` [m], each in [0, `beam.length_m`], at most 64; default the tip.
+    /// Output abscissae `x_o` \[m\], each in [0, `beam.length_m`], at most 64; default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = json!([1.0]))]
     pub points_m: Option<Vec<f64>>,
@@ -507,16 +507,16 @@ pub struct VibrationAbsorberResponse {
 pub struct BeamOut {
     /// `β_k L`, k = 1…n.
     pub beta_l: Vec<f64>,
-    /// Bare-beam natural frequencies `f_k` [Hz] (Euler–Bernoulli).
+    /// Bare-beam natural frequencies `f_k` \[Hz\] (Euler–Bernoulli).
     pub natural_frequencies_hz: Vec<f64>,
-    /// Modal mass `m = ρAL` [kg] (mode shapes with ∫φ² dx = L).
+    /// Modal mass `m = ρAL` \[kg\] (mode shapes with ∫φ² dx = L).
     pub modal_mass_kg: f64,
-    /// Beam mass [kg].
+    /// Beam mass \[kg\].
     pub mass_kg: f64,
     /// Static compliance at the force point of the truncated model `Σ φ_k(x_p)²/(m ω_k²)` [m/N]
     /// (→ `L³/3EI` at the tip as n grows).
     pub static_compliance_m_per_n: f64,
-    /// Nodes of the tuned mode (the one nearest `f_c`) [m]: an absorber there cannot act on it.
+    /// Nodes of the tuned mode (the one nearest `f_c`) \[m\]: an absorber there cannot act on it.
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub tuned_mode_nodes_m: Option<Vec<f64>>,
@@ -528,7 +528,7 @@ pub struct BeamOut {
 pub struct AbsorberOut {
     /// Spring stiffness `k_a` in use [N/m].
     pub stiffness_n_m: f64,
-    /// Passive frequency `sqrt(k_a/m_a)/2π` [Hz].
+    /// Passive frequency `sqrt(k_a/m_a)/2π` \[Hz\].
     pub passive_frequency_hz: f64,
     /// Mass ratio `m_a / (ρAL)`.
     pub mass_ratio: f64,
@@ -542,7 +542,7 @@ pub struct GainsOut {
     pub kp_v_m: f64,
     /// `K_d` [V·s/m].
     pub kd_v_s_m: f64,
-    /// Target `f_c` [Hz] (absent for explicit gains).
+    /// Target `f_c` \[Hz\] (absent for explicit gains).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub tuning_frequency_hz: Option<f64>,
@@ -558,9 +558,9 @@ pub struct GainsOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = vibration_absorber::NaturalFrequenciesOut)]
 pub struct NaturalFrequenciesOut {
-    /// Bare beam [Hz].
+    /// Bare beam \[Hz\].
     pub without_absorber_hz: Vec<f64>,
-    /// Beam + absorber mass and spring (no actuator, no damping) [Hz], n + 1 values.
+    /// Beam + absorber mass and spring (no actuator, no damping) \[Hz\], n + 1 values.
     pub with_passive_absorber_hz: Vec<f64>,
 }
 
@@ -583,7 +583,7 @@ pub enum Stability {
 pub struct EigenvalueOut {
     /// Real part [1/s].
     pub re_1_s: f64,
-    /// Imaginary part / 2π [Hz].
+    /// Imaginary part / 2π \[Hz\].
     pub im_hz: f64,
 }
 
@@ -605,7 +605,7 @@ pub struct ClosedLoopOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = vibration_absorber::StepOut)]
 pub struct StepOut {
-    /// Settling time (2 % band, exact response, last crossing refined) [s]; absent when the
+    /// Settling time (2 % band, exact response, last crossing refined) \[s\]; absent when the
     /// response does not settle (undamped or integrating).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
@@ -618,7 +618,7 @@ pub struct StepOut {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub dc_gain: Option<f64>,
-    /// Time samples [s] (`outputs.ava_step_series`).
+    /// Time samples \[s\] (`outputs.ava_step_series`).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub t_s: Option<Vec<f64>>,
@@ -644,13 +644,13 @@ pub struct AvaStepOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = vibration_absorber::AvaFrfOut)]
 pub struct AvaFrfOut {
-    /// Frequencies [Hz].
+    /// Frequencies \[Hz\].
     pub frequencies_hz: Vec<f64>,
     /// `|G_cl|` [m/m]; null where the denominator vanishes (the tuned pole on the axis).
     pub magnitude: Vec<Option<f64>>,
-    /// Phase of `G_cl` [deg] in (−180, 180]; null as `magnitude`.
+    /// Phase of `G_cl` \[deg\] in (−180, 180]; null as `magnitude`.
     pub phase_deg: Vec<Option<f64>>,
-    /// Grid frequency of the largest `|G_cl|` [Hz] (the tuning `f_c` for tuned gains).
+    /// Grid frequency of the largest `|G_cl|` \[Hz\] (the tuning `f_c` for tuned gains).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub peak_frequency_hz: Option<f64>,
@@ -660,7 +660,7 @@ pub struct AvaFrfOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = vibration_absorber::FrfOut)]
 pub struct FrfOut {
-    /// Frequencies [Hz].
+    /// Frequencies \[Hz\].
     pub frequencies_hz: Vec<f64>,
     /// One receptance curve per output abscissa.
     pub points: Vec<FrfPointOut>,
@@ -670,12 +670,12 @@ pub struct FrfOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = vibration_absorber::FrfPointOut)]
 pub struct FrfPointOut {
-    /// Output abscissa `x_o` [m].
+    /// Output abscissa `x_o` \[m\].
     pub x_m: f64,
     /// `|H|` [m/N] per frequency; null where `j2πf` is (numerically) an eigenvalue (undamped
     /// resonance, warning `UNDAMPED_RESONANCE`).
     pub magnitude_m_per_n: Vec<Option<f64>>,
-    /// Phase of `H` [deg] in (−180, 180]; null as `magnitude_m_per_n`.
+    /// Phase of `H` \[deg\] in (−180, 180]; null as `magnitude_m_per_n`.
     pub phase_deg: Vec<Option<f64>>,
 }
 
@@ -683,17 +683,17 @@ pub struct FrfPointOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = vibration_absorber::TimePointOut)]
 pub struct TimePointOut {
-    /// Output abscissa `x_o` [m].
+    /// Output abscissa `x_o` \[m\].
     pub x_m: f64,
-    /// max |w| over all samples [m].
+    /// max |w| over all samples \[m\].
     pub max_abs_m: f64,
-    /// max |w| over the samples with `t ≥ t_end − T` [m], `T` the excitation period (harmonic;
+    /// max |w| over the samples with `t ≥ t_end − T` \[m\], `T` the excitation period (harmonic;
     /// with several harmonics the longest component period) or 1 s (other excitations), whole
     /// horizon if shorter.
     pub max_abs_last_period_m: f64,
-    /// RMS of w over all samples [m].
+    /// RMS of w over all samples \[m\].
     pub rms_m: f64,
-    /// Samples of w [m] (`return_series`).
+    /// Samples of w \[m\] (`return_series`).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub w_m: Option<Vec<f64>>,
@@ -706,11 +706,11 @@ pub struct TimeOut {
     /// `expm-exosystem`: one matrix exponential of the augmented autonomous system, then
     /// `s_{k+1} = Φ s_k` (re-anchored every 1e4 steps beyond 1e5 samples).
     pub method: String,
-    /// Excitation frequency [Hz] (single harmonic only).
+    /// Excitation frequency \[Hz\] (single harmonic only).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub excitation_frequency_hz: Option<f64>,
-    /// Frequency of each component of `excitation.harmonics` [Hz], in request order (several
+    /// Frequency of each component of `excitation.harmonics` \[Hz\], in request order (several
     /// harmonics only).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
@@ -719,39 +719,39 @@ pub struct TimeOut {
     pub n_samples: usize,
     /// Per output abscissa.
     pub points: Vec<TimePointOut>,
-    /// max |stroke r| [m] (with an absorber).
+    /// max |stroke r| \[m\] (with an absorber).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub stroke_max_m: Option<f64>,
-    /// max |u = K_c i| [N] (with a coil).
+    /// max |u = K_c i| \[N\] (with a coil).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub force_max_n: Option<f64>,
-    /// max |i| [A] (with a coil).
+    /// max |i| \[A\] (with a coil).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub current_max_a: Option<f64>,
-    /// max |e_c| [V] (`active`).
+    /// max |e_c| \[V\] (`active`).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub voltage_max_v: Option<f64>,
-    /// Sample times [s] of the series (`return_series`, after decimation).
+    /// Sample times \[s\] of the series (`return_series`, after decimation).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub t_s: Option<Vec<f64>>,
-    /// Stroke samples [m] (`return_series`, with an absorber).
+    /// Stroke samples \[m\] (`return_series`, with an absorber).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub stroke_m: Option<Vec<f64>>,
-    /// Actuator force samples `u = K_c i` [N] (`return_series`, with a coil).
+    /// Actuator force samples `u = K_c i` \[N\] (`return_series`, with a coil).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub force_n: Option<Vec<f64>>,
-    /// Coil current samples `i` [A] (`return_series`, with a coil).
+    /// Coil current samples `i` \[A\] (`return_series`, with a coil).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub current_a: Option<Vec<f64>>,
-    /// Control voltage samples `e_c = −(K_p r + K_d ṙ)` [V] (`return_series`, `active`).
+    /// Control voltage samples `e_c = −(K_p r + K_d ṙ)` \[V\] (`return_series`, `active`).
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub voltage_v: Option<Vec<f64>>,

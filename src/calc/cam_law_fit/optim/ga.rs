@@ -42,7 +42,7 @@ pub struct GaParams {
     pub p_inversion: f64,
     /// Probability per gene of "mutation around the range" (paper: 0.1).
     pub p_range_mutation: f64,
-    /// Initial mutation range, absolute in the gene domain [0,1] (paper: 10 %).
+    /// Initial mutation range, absolute in the gene domain \[0,1\] (paper: 10 %).
     pub range0: f64,
     /// Factor applied to the range every `range_every` generations (paper: "reduced by 75 %").
     pub range_factor: f64,

@@ -8,20 +8,20 @@ use crate::calc::irefc::geometry::Geometry;
 use crate::calc::irefc::stress::compute::element_forces;
 use crate::numerics::Budget;
 
-/// One loaded element [SI].
+/// One loaded element \[SI\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ElementLoss {
     /// Element index k.
     pub k: u32,
-    /// φ2 [rad].
+    /// φ2 \[rad\].
     pub phi: f64,
-    /// L [m].
+    /// L \[m\].
     pub l: f64,
-    /// LA = L − rb [m].
+    /// LA = L − rb \[m\].
     pub la: f64,
-    /// LB = L + rb [m].
+    /// LB = L + rb \[m\].
     pub lb: f64,
-    /// Element force R [N].
+    /// Element force R \[N\].
     pub r: f64,
     /// Slip speed at A [m/s] (paper Vs, or rigid-body vs).
     pub vs: f64,
@@ -31,11 +31,11 @@ pub struct ElementLoss {
     pub omega_a_roll: Option<f64>,
     /// Rigid body: rolling rate on the crown Ω_B [rad/s].
     pub omega_b_roll: Option<f64>,
-    /// Loss at A [W].
+    /// Loss at A \[W\].
     pub nsa: f64,
-    /// Loss at B [W].
+    /// Loss at B \[W\].
     pub nsb: f64,
-    /// NSA + NSB [W].
+    /// NSA + NSB \[W\].
     pub ns: f64,
     /// 1 − NS/P_in.
     pub eta: f64,
@@ -44,9 +44,9 @@ pub struct ElementLoss {
 /// Totals of one cage phase.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhaseTotals {
-    /// Σ NS [W].
+    /// Σ NS \[W\].
     pub ns_total: f64,
-    /// Largest NS [W].
+    /// Largest NS \[W\].
     pub ns_max: f64,
     /// k of the largest NS.
     pub k_at_max: u32,
@@ -61,7 +61,7 @@ pub struct PhaseTotals {
 /// Losses of one cage phase.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PhaseLosses {
-    /// Fmax [N].
+    /// Fmax \[N\].
     pub fmax: f64,
     /// Elements.
     pub elements: Vec<ElementLoss>,
@@ -83,7 +83,7 @@ pub struct Stats {
 /// Phase statistics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhaseStatistics {
-    /// Σ NS [W].
+    /// Σ NS \[W\].
     pub ns_total: Stats,
     /// η product (`None` if some phase has no product).
     pub eta_product: Option<Stats>,

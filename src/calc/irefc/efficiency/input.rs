@@ -12,14 +12,14 @@ use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::MM;
 use crate::calc::{CalcFailure, ProblemClass};
 
-/// The paper's rolling-friction lever arm μ = 0.001 m [mm].
+/// The paper's rolling-friction lever arm μ = 0.001 m \[mm\].
 pub const ROLLING_FRICTION_PAPER_MM: f64 = 1.0;
-/// Rolling-friction lever arms above this [mm] get `ROLLING_FRICTION_HIGH` (largest tabulated steel value).
+/// Rolling-friction lever arms above this \[mm\] get `ROLLING_FRICTION_HIGH` (largest tabulated steel value).
 pub const ROLLING_FRICTION_HIGH_MM: f64 = 0.5;
 /// The paper's sliding friction coefficient.
 pub const SLIDING_FRICTION_PAPER: f64 = 0.1;
 
-/// Validated efficiency input [SI].
+/// Validated efficiency input \[SI\].
 #[derive(Debug, Clone, PartialEq)]
 pub struct EfficiencyInput {
     /// Geometry (feasible).
@@ -28,9 +28,9 @@ pub struct EfficiencyInput {
     pub omega1: f64,
     /// Input torque M_in [N·m].
     pub m_in: f64,
-    /// Input power P_in = M_in·ω1 [W].
+    /// Input power P_in = M_in·ω1 \[W\].
     pub p_in: f64,
-    /// Rolling-friction lever arm μ [m].
+    /// Rolling-friction lever arm μ \[m\].
     pub mu: f64,
     /// Sliding friction coefficient f_s.
     pub fs: f64,

@@ -50,7 +50,7 @@ pub struct EfficiencyInclude {
     "rolling_friction_mm":1.0,"sliding_friction":0.1,"model":"paper_table","phase_deg":0,"n_phase":1,
     "include":{"elements":true}}))]
 pub struct IrefcEfficiencyRequest {
-    /// Cage generating (pitch) circle radius r2 [mm].
+    /// Cage generating (pitch) circle radius r2 \[mm\].
     #[schema(example = 20.0)]
     pub r2_mm: f64,
     /// Number of rolling elements Z2 [–].
@@ -60,10 +60,10 @@ pub struct IrefcEfficiencyRequest {
     /// Displacement coefficient χ (rc = χ·r2) [–].
     #[schema(example = 1.4)]
     pub chi: f64,
-    /// Rolling element radius rb [mm]; must be below rb_overlap and rb_undercut.
+    /// Rolling element radius rb \[mm\]; must be below rb_overlap and rb_undercut.
     #[schema(example = 2.0)]
     pub rb_mm: f64,
-    /// Input (motor) power P_in [W]; give this or `input_torque_Nm`, not both.
+    /// Input (motor) power P_in \[W\]; give this or `input_torque_Nm`, not both.
     #[serde(rename = "power_W")]
     #[schema(example = 1500.0)]
     pub power_w: Option<f64>,
@@ -71,10 +71,10 @@ pub struct IrefcEfficiencyRequest {
     #[serde(rename = "input_torque_Nm")]
     #[schema(example = 9.549297)]
     pub input_torque_nm: Option<f64>,
-    /// Input shaft (carrier) speed n [rpm].
+    /// Input shaft (carrier) speed n \[rpm\].
     #[schema(example = 1500.0)]
     pub speed_rpm: f64,
-    /// Rolling-friction lever arm μ [mm] (default 1.0, the paper's 0.001 m).
+    /// Rolling-friction lever arm μ \[mm\] (default 1.0, the paper's 0.001 m).
     #[schema(example = 1.0)]
     pub rolling_friction_mm: Option<f64>,
     /// Sliding friction coefficient f_s [–] (default 0.1, the paper's).
@@ -83,7 +83,7 @@ pub struct IrefcEfficiencyRequest {
     /// "paper_table" (default), "paper_abs" or "rigid_body".
     #[schema(nullable = false)]
     pub model: Option<EfficiencyModel>,
-    /// Cage phase: element k at φ2 = phase + 360k/Z2 [deg], in [0, 360/Z2) (default 0, the paper);
+    /// Cage phase: element k at φ2 = phase + 360k/Z2 \[deg\], in [0, 360/Z2) (default 0, the paper);
     /// the upper end depends on `Z2`.
     #[schema(example = 0.0)]
     pub phase_deg: Option<f64>,
@@ -101,18 +101,18 @@ pub struct IrefcEfficiencyRequest {
 pub struct EfficiencyElement {
     /// Element index k (paper row k + 1).
     pub k: u32,
-    /// Element angle φ2 [deg].
+    /// Element angle φ2 \[deg\].
     pub phi2_deg: f64,
-    /// Pitch point to element centre L [mm] (eq. 7, corrected).
+    /// Pitch point to element centre L \[mm\] (eq. 7, corrected).
     #[serde(rename = "L_mm")]
     pub l_mm: f64,
-    /// Pitch point to cam contact LA = L − rb [mm] (eq. 8).
+    /// Pitch point to cam contact LA = L − rb \[mm\] (eq. 8).
     #[serde(rename = "LA_mm")]
     pub la_mm: f64,
-    /// Pitch point to crown contact LB = L + rb [mm] (eq. 8).
+    /// Pitch point to crown contact LB = L + rb \[mm\] (eq. 8).
     #[serde(rename = "LB_mm")]
     pub lb_mm: f64,
-    /// Element force R [N].
+    /// Element force R \[N\].
     #[serde(rename = "R_N")]
     pub r_n: f64,
     /// Slip speed at the cam contact [m/s] (paper models: Vs of eq. 14, signed; rigid_body: vs).
@@ -120,13 +120,13 @@ pub struct EfficiencyElement {
     pub vs_m_s: f64,
     /// Element rotation rate [rad/s] (paper: ωb = V23/rb; rigid_body: spin relative to the cage).
     pub omega_b_rad_s: f64,
-    /// Friction power at the cam contact A [W] (eq. 18).
+    /// Friction power at the cam contact A \[W\] (eq. 18).
     #[serde(rename = "NSA_W")]
     pub nsa_w: f64,
-    /// Friction power at the crown contact B [W] (eq. 19).
+    /// Friction power at the crown contact B \[W\] (eq. 19).
     #[serde(rename = "NSB_W")]
     pub nsb_w: f64,
-    /// NSA + NSB [W] (eq. 22).
+    /// NSA + NSB \[W\] (eq. 22).
     #[serde(rename = "NS_W")]
     pub ns_w: f64,
     /// 1 − NS/P_in (eq. 21).
@@ -143,10 +143,10 @@ pub struct EfficiencyElement {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = irefc::efficiency::EfficiencyTotals)]
 pub struct EfficiencyTotals {
-    /// Σ NS [W].
+    /// Σ NS \[W\].
     #[serde(rename = "NS_total_W")]
     pub ns_total_w: f64,
-    /// Largest element loss [W].
+    /// Largest element loss \[W\].
     #[serde(rename = "NS_max_W")]
     pub ns_max_w: f64,
     /// Element index with the largest loss.
@@ -155,7 +155,7 @@ pub struct EfficiencyTotals {
     pub eta_product: Option<f64>,
     /// 1 − Σ NS/P_in (energy balance).
     pub eta_linear: f64,
-    /// P_in − Σ NS [W].
+    /// P_in − Σ NS \[W\].
     #[serde(rename = "P_out_W")]
     pub p_out_w: f64,
 }
@@ -190,7 +190,7 @@ pub struct NullableStat {
 pub struct PhaseStats {
     /// Phases evaluated.
     pub n_phase: u32,
-    /// Σ NS [W].
+    /// Σ NS \[W\].
     #[serde(rename = "NS_total_W")]
     pub ns_total_w: Stat,
     /// η product; its fields are null when some phase has an η_k ≤ 0.
@@ -203,7 +203,7 @@ pub struct PhaseStats {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = irefc::efficiency::EfficiencyMeta)]
 pub struct EfficiencyMeta {
-    /// Wall-clock compute time [ms].
+    /// Wall-clock compute time \[ms\].
     pub compute_ms: f64,
 }
 
@@ -222,7 +222,7 @@ pub struct IrefcEfficiencyResponse {
     /// Input torque M_in [N·m].
     #[serde(rename = "M_in_Nm")]
     pub m_in_nm: f64,
-    /// Input power P_in [W].
+    /// Input power P_in \[W\].
     #[serde(rename = "P_in_W")]
     pub p_in_w: f64,
     /// Lossless cam torque M_in·(Z2−1)/2 [N·m].
@@ -230,7 +230,7 @@ pub struct IrefcEfficiencyResponse {
     pub t_cam_nm: f64,
     /// Cam (output) speed 2ω1/(Z2−1) [rad/s] (eq. 13; opposite to the input).
     pub omega_cam_rad_s: f64,
-    /// Fmax of the element set [N].
+    /// Fmax of the element set \[N\].
     #[serde(rename = "Fmax_N")]
     pub fmax_n: f64,
     /// Per-element table (`include.elements`, default on).
@@ -248,23 +248,23 @@ pub struct IrefcEfficiencyResponse {
     pub meta: EfficiencyMeta,
 }
 
-/// Input power P_in [W]: 0 < P ≤ 1e8 (spec).
+/// Input power P_in \[W\]: 0 < P ≤ 1e8 (spec).
 pub const POWER_W: Range = Range::FINITE.gt(0.0).max(1e8);
 /// Input torque M_in [N·m]: 0 < M ≤ 1e7 (the stress endpoint's torque scale).
 pub const INPUT_TORQUE_NM: Range = Range::FINITE.gt(0.0).max(1e7);
-/// Input speed [rpm]: 0 < n ≤ 1e6 (spec).
+/// Input speed \[rpm\]: 0 < n ≤ 1e6 (spec).
 pub const SPEED_RPM: Range = Range::FINITE.gt(0.0).max(1e6);
-/// Rolling-friction lever arm μ [mm]: 0 ≤ μ ≤ 10 (spec).
+/// Rolling-friction lever arm μ \[mm\]: 0 ≤ μ ≤ 10 (spec).
 pub const ROLLING_FRICTION_MM: Range = Range::closed(0.0, 10.0);
 /// Sliding friction coefficient f_s [–]: 0 ≤ f_s ≤ 1.
 pub const SLIDING_FRICTION: Range = Range::closed(0.0, 1.0);
-/// Cage phase [deg]: ≥ 0; the upper end 360/Z2 (exclusive) depends on Z2 (a cross-field rule,
+/// Cage phase \[deg\]: ≥ 0; the upper end 360/Z2 (exclusive) depends on Z2 (a cross-field rule,
 /// [`phase_deg_range`]).
 pub const PHASE_DEG: Range = Range::FINITE.min(0.0);
 /// Number of cage phases averaged (spec).
 pub const N_PHASE: Range = Range::int(1, 10_000);
 
-/// The cage phase range of a design with `z2` elements [deg]: [0, 360/Z2).
+/// The cage phase range of a design with `z2` elements \[deg\]: [0, 360/Z2).
 #[must_use]
 pub fn phase_deg_range(z2: u32) -> Range {
     PHASE_DEG.lt(360.0 / f64::from(z2))

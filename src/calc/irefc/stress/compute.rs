@@ -12,7 +12,7 @@ use crate::calc::irefc::geometry::{AnglePoint, Geometry, Trig, Wheel};
 use crate::numerics::roots;
 use crate::numerics::{Budget, StopReason, par_map_while};
 
-/// Refinement stops when the bracket half-width is below this [rad] (spec step 6).
+/// Refinement stops when the bracket half-width is below this \[rad\] (spec step 6).
 pub const REFINE_TOL_RAD: f64 = 1e-10;
 /// Iteration cap of one refinement (Brent needs ~10–40 for the smooth, single-peaked σ near its maximum).
 pub const REFINE_MAX_ITER: u32 = 100;
@@ -28,26 +28,26 @@ pub const TAU_DEPTH_RATIO: f64 = 0.786;
 pub struct ElementForce {
     /// Element index k.
     pub k: u32,
-    /// Element angle φ_k [rad].
+    /// Element angle φ_k \[rad\].
     pub phi: f64,
     /// sin α_k.
     pub sin_alpha: f64,
-    /// True contact angle α_k [rad].
+    /// True contact angle α_k \[rad\].
     pub alpha: f64,
-    /// Cam lever arm h_k = r1·sin α_k [m].
+    /// Cam lever arm h_k = r1·sin α_k \[m\].
     pub h: f64,
-    /// Element force F_k [N] (eq. 16).
+    /// Element force F_k \[N\] (eq. 16).
     pub f: f64,
 }
 
 /// Force distribution over one cage phase (spec step 3, eqs 12–17).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ElementForces {
-    /// Fmax = T_cam/(r1·Σsin²α) [N] (eq. 17).
+    /// Fmax = T_cam/(r1·Σsin²α) \[N\] (eq. 17).
     pub fmax: f64,
     /// Σ sin²α over the loaded set.
     pub sum_s2: f64,
-    /// Σh² = r1²·Σsin²α [m²].
+    /// Σh² = r1²·Σsin²α \[m²\].
     pub sum_h2: f64,
     /// The loaded elements.
     pub elements: Vec<ElementForce>,
@@ -109,18 +109,18 @@ pub struct Stresser<'g> {
 /// Stresses at one angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StressSample {
-    /// Element force F(φ) [N].
+    /// Element force F(φ) \[N\].
     pub f: f64,
-    /// σ_cam² [Pa²].
+    /// σ_cam² \[Pa²\].
     pub s2_cam: f64,
-    /// σ_crown² [Pa²].
+    /// σ_crown² \[Pa²\].
     pub s2_crown: f64,
-    /// Smaller cusp margin [m] (≤ 0: cusp).
+    /// Smaller cusp margin \[m\] (≤ 0: cusp).
     pub margin: f64,
 }
 
 impl<'g> Stresser<'g> {
-    /// Evaluator for geometry `g`, cam torque `t_cam` [N·m], Fmax [N], E* [Pa], contact length `lb` [m].
+    /// Evaluator for geometry `g`, cam torque `t_cam` [N·m], Fmax \[N\], E* \[Pa\], contact length `lb` \[m\].
     #[must_use]
     pub fn new(
         g: &'g Geometry,
@@ -164,33 +164,33 @@ impl<'g> Stresser<'g> {
         }
     }
 
-    /// σ² of both wheels at any φ [rad].
+    /// σ² of both wheels at any φ \[rad\].
     #[must_use]
     pub fn sample_at(&self, phi: f64) -> StressSample {
         self.sample(&Trig::of(phi), || self.g.phase_fraction_at(phi))
     }
 
-    /// Full state at φ: the sample, the per-angle geometry and σ of both wheels [Pa].
+    /// Full state at φ: the sample, the per-angle geometry and σ of both wheels \[Pa\].
     #[must_use]
     pub fn state_at(&self, phi: f64) -> (StressSample, AnglePoint) {
         (self.sample_at(phi), self.g.at(phi))
     }
 }
 
-/// Maximum contact stress of one wheel (spec step 7) [SI].
+/// Maximum contact stress of one wheel (spec step 7) \[SI\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WheelMaxResult {
     /// Wheel.
     pub wheel: Wheel,
-    /// φ of the maximum [rad]; `None` at zero torque (no argmax).
+    /// φ of the maximum \[rad\]; `None` at zero torque (no argmax).
     pub phi: Option<f64>,
-    /// σ_H max [Pa].
+    /// σ_H max \[Pa\].
     pub sigma: f64,
-    /// Element force there [N].
+    /// Element force there \[N\].
     pub f: f64,
     /// Geometry there (`None` at zero torque).
     pub point: Option<AnglePoint>,
-    /// Contact half-width b [m].
+    /// Contact half-width b \[m\].
     pub b: f64,
 }
 
@@ -210,17 +210,17 @@ impl WheelMaxResult {
 /// Curves over the grid (SI).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct CurveData {
-    /// φ [rad].
+    /// φ \[rad\].
     pub phi: Vec<f64>,
-    /// F [N].
+    /// F \[N\].
     pub f: Vec<f64>,
-    /// σ_cam [Pa].
+    /// σ_cam \[Pa\].
     pub sigma_cam: Vec<f64>,
-    /// σ_crown [Pa].
+    /// σ_crown \[Pa\].
     pub sigma_crown: Vec<f64>,
-    /// ρ_cam [m] (None at inflection).
+    /// ρ_cam \[m\] (None at inflection).
     pub rho_cam: Vec<Option<f64>>,
-    /// ρ_crown [m].
+    /// ρ_crown \[m\].
     pub rho_crown: Vec<Option<f64>>,
 }
 
@@ -235,9 +235,9 @@ pub struct DesignResult {
     pub t_crown: f64,
     /// Lossless carrier torque [N·m].
     pub t_in: f64,
-    /// E* [Pa].
+    /// E* \[Pa\].
     pub e_star: f64,
-    /// Contact length [m].
+    /// Contact length \[m\].
     pub lb: f64,
     /// Phase-0 element forces.
     pub forces: ElementForces,

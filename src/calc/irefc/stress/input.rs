@@ -10,10 +10,10 @@ use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::{MM, PROFILE_POINTS_DEFAULT, Warning};
 use crate::calc::{CalcFailure, ProblemClass, Range, Validator};
 
-/// Default φ2 grid step [deg]: 1° + refinement is ≤ 1e-10 from the exact maximum and ~40× cheaper than the
+/// Default φ2 grid step \[deg\]: 1° + refinement is ≤ 1e-10 from the exact maximum and ~40× cheaper than the
 /// paper's 0.02° grid (whose error is 1.8e-8); see `benches/RESULTS.md` (## irefc).
 pub const STEP_DEG_DEFAULT: f64 = 1.0;
-/// The paper's grid step [deg] (0.02°, no refinement).
+/// The paper's grid step \[deg\] (0.02°, no refinement).
 pub const STEP_DEG_PAPER: f64 = 0.02;
 /// Largest number of sweep combinations (spec).
 pub const SWEEP_COMBINATIONS_MAX: u64 = 100_000;
@@ -22,18 +22,18 @@ pub const SWEEP_WORK_MAX: f64 = 5e8;
 /// Tolerance on the last χ of a sweep range: χ_i = from + i·step is kept while ≤ to + this (spec).
 pub const CHI_RANGE_TOL: f64 = 1e-12;
 
-/// Scalar settings shared by every combination [SI].
+/// Scalar settings shared by every combination \[SI\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StressParams {
     /// Output torque T_out [N·m].
     pub torque: f64,
     /// Output link.
     pub output_link: OutputLink,
-    /// Contact length [m]; `None` = 2·rb of each design.
+    /// Contact length \[m\]; `None` = 2·rb of each design.
     pub lb: Option<f64>,
-    /// Contact modulus E* [Pa].
+    /// Contact modulus E* \[Pa\].
     pub e_star: f64,
-    /// Requested grid step [deg].
+    /// Requested grid step \[deg\].
     pub step_deg: f64,
     /// Grid intervals N = round(180/step) (grid points N + 1).
     pub n_intervals: usize,
@@ -45,16 +45,16 @@ pub struct StressParams {
     pub subsurface: bool,
 }
 
-/// One design of the four initial parameters [SI].
+/// One design of the four initial parameters \[SI\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Design {
-    /// r2 [m].
+    /// r2 \[m\].
     pub r2: f64,
     /// Z2.
     pub z2: u32,
     /// χ.
     pub chi: f64,
-    /// rb [m].
+    /// rb \[m\].
     pub rb: f64,
 }
 
@@ -80,9 +80,9 @@ pub struct SweepInput {
     pub z2: Vec<u32>,
     /// χ values in order.
     pub chi: Vec<f64>,
-    /// rb values [m].
+    /// rb values \[m\].
     pub rb: Vec<f64>,
-    /// r2 values [m].
+    /// r2 values \[m\].
     pub r2: Vec<f64>,
     /// Shared settings.
     pub params: StressParams,

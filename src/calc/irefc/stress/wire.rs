@@ -110,9 +110,9 @@ pub struct SweepSpec {
     pub z2: IntRange,
     /// Displacement coefficient χ.
     pub chi: StepRange,
-    /// Rolling element radii [mm]; default: the top-level `rb_mm`.
+    /// Rolling element radii \[mm\]; default: the top-level `rb_mm`.
     pub rb_mm: Option<Vec<f64>>,
-    /// Cage pitch radii [mm]; default: the top-level `r2_mm`.
+    /// Cage pitch radii \[mm\]; default: the top-level `r2_mm`.
     pub r2_mm: Option<Vec<f64>>,
 }
 
@@ -127,7 +127,7 @@ pub struct IrefcStressRequest {
     /// "single" (default without `sweep`) or "sweep" (default when `sweep` is present).
     #[schema(nullable = false)]
     pub mode: Option<StressMode>,
-    /// Cage generating (pitch) circle radius r2 [mm]; required unless `sweep.r2_mm` is given.
+    /// Cage generating (pitch) circle radius r2 \[mm\]; required unless `sweep.r2_mm` is given.
     #[schema(example = 20.0)]
     pub r2_mm: Option<f64>,
     /// Number of rolling elements Z2 [–]; required in mode "single".
@@ -137,7 +137,7 @@ pub struct IrefcStressRequest {
     /// Displacement coefficient χ (element-centre circle rc = χ·r2) [–]; required in mode "single".
     #[schema(example = 1.4)]
     pub chi: Option<f64>,
-    /// Rolling element radius rb [mm]; must be below rb_overlap and rb_undercut. Required unless
+    /// Rolling element radius rb \[mm\]; must be below rb_overlap and rb_undercut. Required unless
     /// `sweep.rb_mm` is given.
     #[schema(example = 2.0)]
     pub rb_mm: Option<f64>,
@@ -148,7 +148,7 @@ pub struct IrefcStressRequest {
     /// Output link: "cam" (crown fixed, default) or "crown" (cam rotation locked).
     #[schema(nullable = false)]
     pub output_link: Option<OutputLink>,
-    /// Contact (roller) length lb [mm]; default 2·rb ("equal to the diameter"). 0 < lb ≤ 100·r2.
+    /// Contact (roller) length lb \[mm\]; default 2·rb ("equal to the diameter"). 0 < lb ≤ 100·r2.
     #[schema(example = 4.0)]
     pub lb_mm: Option<f64>,
     /// Cam and crown material; default steel {210000, 0.3}.
@@ -157,7 +157,7 @@ pub struct IrefcStressRequest {
     /// Rolling element material; default steel {210000, 0.3}.
     #[schema(nullable = false)]
     pub roller_material: Option<Material>,
-    /// φ2 grid step over [0°, 180°] [deg]; 0 < step ≤ 10 and 180/step ≤ 2·10⁶ (a finer step than
+    /// φ2 grid step over [0°, 180°] \[deg\]; 0 < step ≤ 10 and 180/step ≤ 2·10⁶ (a finer step than
     /// 9e-5 is `GRID_TOO_FINE`). Default 1 with refine (see the module docs; the paper used 0.02
     /// without refinement).
     #[schema(example = 1.0)]
@@ -194,13 +194,13 @@ pub struct IrefcStressRequest {
 pub struct ElementOut {
     /// Element index k (φ2 = 360k/Z2).
     pub k: u32,
-    /// Element angle φ2 [deg].
+    /// Element angle φ2 \[deg\].
     pub phi2_deg: f64,
-    /// True contact angle α [deg].
+    /// True contact angle α \[deg\].
     pub alpha_deg: f64,
-    /// Cam lever arm h = r1·sin α [mm] (eq. 13).
+    /// Cam lever arm h = r1·sin α \[mm\] (eq. 13).
     pub h_mm: f64,
-    /// Element force F_k = Fmax·sin α [N] (eq. 16).
+    /// Element force F_k = Fmax·sin α \[N\] (eq. 16).
     #[serde(rename = "F_N")]
     pub f_n: f64,
 }
@@ -209,29 +209,29 @@ pub struct ElementOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = irefc::stress::WheelMax)]
 pub struct WheelMax {
-    /// Element angle of the maximum [deg]; null when the torque is zero (no argmax).
+    /// Element angle of the maximum \[deg\]; null when the torque is zero (no argmax).
     pub phi2_deg: Option<f64>,
-    /// Hertz peak contact pressure σ_H [MPa].
+    /// Hertz peak contact pressure σ_H \[MPa\].
     #[serde(rename = "sigma_MPa")]
     pub sigma_mpa: f64,
-    /// Element force there [N].
+    /// Element force there \[N\].
     #[serde(rename = "F_N")]
     pub f_n: f64,
-    /// Lever arm of this wheel, r_w·sin α (r1 for the cam, r3 for the crown) [mm].
+    /// Lever arm of this wheel, r_w·sin α (r1 for the cam, r3 for the crown) \[mm\].
     pub h_mm: Option<f64>,
-    /// True contact angle α [deg].
+    /// True contact angle α \[deg\].
     pub alpha_deg: Option<f64>,
-    /// Pitch point to element centre distance L [mm].
+    /// Pitch point to element centre distance L \[mm\].
     #[serde(rename = "L_mm")]
     pub l_mm: Option<f64>,
-    /// Signed profile radius ρ_w (negative = concave) [mm]; null at an inflection or zero torque.
+    /// Signed profile radius ρ_w (negative = concave) \[mm\]; null at an inflection or zero torque.
     pub rho_mm: Option<f64>,
-    /// Contact half-width b = sqrt(4F/(π·lb·E*·K)) [mm].
+    /// Contact half-width b = sqrt(4F/(π·lb·E*·K)) \[mm\].
     pub b_mm: f64,
-    /// Subsurface maximum shear stress 0.300·σ [MPa] (only with `include.subsurface`).
+    /// Subsurface maximum shear stress 0.300·σ \[MPa\] (only with `include.subsurface`).
     #[serde(rename = "tau_max_MPa", skip_serializing_if = "Option::is_none")]
     pub tau_max_mpa: Option<f64>,
-    /// Depth of τ_max below the surface, 0.786·b [mm] (only with `include.subsurface`).
+    /// Depth of τ_max below the surface, 0.786·b \[mm\] (only with `include.subsurface`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tau_depth_mm: Option<f64>,
 }
@@ -252,20 +252,20 @@ pub struct MaxOut {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = irefc::stress::Curves)]
 pub struct Curves {
-    /// Element angle φ2 [deg].
+    /// Element angle φ2 \[deg\].
     pub phi2_deg: Vec<f64>,
-    /// Element force F(φ2) [N].
+    /// Element force F(φ2) \[N\].
     #[serde(rename = "F_N")]
     pub f_n: Vec<f64>,
-    /// Cam contact stress [MPa].
+    /// Cam contact stress \[MPa\].
     #[serde(rename = "sigma_cam_MPa")]
     pub sigma_cam_mpa: Vec<f64>,
-    /// Crown contact stress [MPa].
+    /// Crown contact stress \[MPa\].
     #[serde(rename = "sigma_crown_MPa")]
     pub sigma_crown_mpa: Vec<f64>,
-    /// Signed cam profile radius [mm] (null at an inflection).
+    /// Signed cam profile radius \[mm\] (null at an inflection).
     pub rho_cam_mm: Vec<Option<f64>>,
-    /// Signed crown profile radius [mm] (null at an inflection).
+    /// Signed crown profile radius \[mm\] (null at an inflection).
     pub rho_crown_mm: Vec<Option<f64>>,
 }
 
@@ -273,7 +273,7 @@ pub struct Curves {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = irefc::stress::StressMeta)]
 pub struct StressMeta {
-    /// Requested grid step [deg] (the grid uses 180/n_intervals, n_intervals = round(180/step)).
+    /// Requested grid step \[deg\] (the grid uses 180/n_intervals, n_intervals = round(180/step)).
     pub step_deg: f64,
     /// Whether maxima were refined.
     pub refine: bool,
@@ -284,7 +284,7 @@ pub struct StressMeta {
     pub n_grid: u64,
     /// Stress evaluations (grid + refinement).
     pub evaluations: u64,
-    /// Wall-clock compute time [ms].
+    /// Wall-clock compute time \[ms\].
     pub compute_ms: f64,
 }
 
@@ -305,15 +305,15 @@ pub struct StressSingleResponse {
     /// Lossless carrier (input) torque T_cam·2/(Z2−1) [N·m].
     #[serde(rename = "T_in_Nm")]
     pub t_in_nm: f64,
-    /// Contact modulus E* = 1/((1−ν_w²)/E_w + (1−ν_r²)/E_r) [MPa].
+    /// Contact modulus E* = 1/((1−ν_w²)/E_w + (1−ν_r²)/E_r) \[MPa\].
     #[serde(rename = "E_star_MPa")]
     pub e_star_mpa: f64,
-    /// Contact length used [mm].
+    /// Contact length used \[mm\].
     pub lb_mm: f64,
-    /// Force an element would carry at α = 90°, T_cam/(r1·Σsin²α) [N] (eq. 17).
+    /// Force an element would carry at α = 90°, T_cam/(r1·Σsin²α) \[N\] (eq. 17).
     #[serde(rename = "Fmax_N")]
     pub fmax_n: f64,
-    /// Σh² = r1²·Σsin²α over the phase-0 set [mm²].
+    /// Σh² = r1²·Σsin²α over the phase-0 set \[mm²\].
     pub sum_h2_mm2: f64,
     /// Phase-0 element table (`include.elements`, default on).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -349,9 +349,9 @@ pub struct SweepRecord {
     pub z2: u32,
     /// Displacement coefficient.
     pub chi: f64,
-    /// Rolling element radius [mm].
+    /// Rolling element radius \[mm\].
     pub rb_mm: f64,
-    /// Cage pitch radius [mm].
+    /// Cage pitch radius \[mm\].
     pub r2_mm: f64,
     /// Whether the design is feasible and was computed.
     pub valid: bool,
@@ -359,37 +359,37 @@ pub struct SweepRecord {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub reason: Option<Reason>,
-    /// Fmax [N].
+    /// Fmax \[N\].
     #[serde(rename = "Fmax_N", skip_serializing_if = "Option::is_none")]
     pub fmax_n: Option<f64>,
-    /// Cam maximum contact stress [MPa].
+    /// Cam maximum contact stress \[MPa\].
     #[serde(rename = "sigma_cam_max_MPa", skip_serializing_if = "Option::is_none")]
     pub sigma_cam_max_mpa: Option<f64>,
-    /// φ2 of the cam maximum [deg].
+    /// φ2 of the cam maximum \[deg\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub phi2_cam_deg: Option<f64>,
-    /// Crown maximum contact stress [MPa].
+    /// Crown maximum contact stress \[MPa\].
     #[serde(
         rename = "sigma_crown_max_MPa",
         skip_serializing_if = "Option::is_none"
     )]
     pub sigma_crown_max_mpa: Option<f64>,
-    /// φ2 of the crown maximum [deg].
+    /// φ2 of the crown maximum \[deg\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub phi2_crown_deg: Option<f64>,
-    /// Larger of both maxima [MPa].
+    /// Larger of both maxima \[MPa\].
     #[serde(rename = "sigma_max_MPa", skip_serializing_if = "Option::is_none")]
     pub sigma_max_mpa: Option<f64>,
     /// "cam" or "crown".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub governing: Option<String>,
-    /// Element force at the governing maximum [N].
+    /// Element force at the governing maximum \[N\].
     #[serde(rename = "F_at_max_N", skip_serializing_if = "Option::is_none")]
     pub f_at_max_n: Option<f64>,
-    /// Signed profile radius at the governing maximum [mm].
+    /// Signed profile radius at the governing maximum \[mm\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rho_at_max_mm: Option<f64>,
-    /// Sharpest convex profile radius of either wheel [mm] (negative past the undercut limit).
+    /// Sharpest convex profile radius of either wheel \[mm\] (negative past the undercut limit).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub min_profile_radius_mm: Option<f64>,
     /// Geometry warning codes of this combination (omitted when none).
@@ -401,7 +401,7 @@ pub struct SweepRecord {
 #[derive(Debug, Clone, Serialize, ToSchema)]
 #[schema(as = irefc::stress::SweepMeta)]
 pub struct SweepMeta {
-    /// Requested grid step [deg].
+    /// Requested grid step \[deg\].
     pub step_deg: f64,
     /// Whether maxima were refined.
     pub refine: bool,
@@ -414,7 +414,7 @@ pub struct SweepMeta {
     pub n_combinations: u64,
     /// Worker threads used.
     pub threads: u32,
-    /// Wall-clock compute time [ms].
+    /// Wall-clock compute time \[ms\].
     pub compute_ms: f64,
     /// How the sweep stopped (`completed`, or `deadline`/`max_evaluations` with unevaluated records);
     /// iterations = evaluations = combinations evaluated.
@@ -472,14 +472,14 @@ pub enum IrefcStressResponse {
 pub const TORQUE_NM: Range = Range::closed(0.0, 1e7);
 /// lb may be at most this multiple of r2 (spec).
 pub const LB_MAX_OVER_R2: f64 = 100.0;
-/// Contact length lb [mm]: > 0; the upper end [`LB_MAX_OVER_R2`]·r2 depends on r2 (a cross-field
+/// Contact length lb \[mm\]: > 0; the upper end [`LB_MAX_OVER_R2`]·r2 depends on r2 (a cross-field
 /// rule, stated in the field's doc).
 pub const LB_MM: Range = Range::FINITE.gt(0.0);
 /// Largest number of φ2 grid intervals 180/step (spec: 180/step ≤ 2·10⁶).
 pub const GRID_INTERVALS_MAX: f64 = 2e6;
-/// Grid steps a φ2 grid can be built from [deg]: 0 < step ≤ 10 (spec; `BAD_RANGE` outside).
+/// Grid steps a φ2 grid can be built from \[deg\]: 0 < step ≤ 10 (spec; `BAD_RANGE` outside).
 pub const STEP_DEG_BUILDABLE: Range = Range::FINITE.gt(0.0).max(10.0);
-/// The documented φ2 grid step [deg]: 180/step ≤ 2·10⁶ (step ≥ 9e-5) and step ≤ 10. A positive
+/// The documented φ2 grid step \[deg\]: 180/step ≤ 2·10⁶ (step ≥ 9e-5) and step ≤ 10. A positive
 /// step below the lower end is `GRID_TOO_FINE` (a size limit), outside [`STEP_DEG_BUILDABLE`]
 /// `BAD_RANGE`. (Division is correctly rounded and monotone, so `step ≥ 180/2e6` is exactly
 /// `180/step ≤ 2e6`.)
