@@ -8,6 +8,7 @@ use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
 use crate::calc::bus_fuel_economy::{
     self, BusFuelEconomyRequest, BusFuelEconomyResponse, MotorMapRequest, MotorMapResponse,
 };
+use crate::calc::common::TimeLimited;
 
 /// Energy and fuel economy of an electric bus over drive cycles, for 1..8 traction motors.
 ///
@@ -35,7 +36,8 @@ pub async fn compute(
     State(state): State<AppState>,
     ApiJson(req): ApiJson<BusFuelEconomyRequest>,
 ) -> Result<Response, ApiError> {
-    run_calc(&state, None, move |budget| {
+    let limit = req.time_limit();
+    run_calc(&state, limit, move |budget| {
         bus_fuel_economy::run(req, budget)
     })
     .await
@@ -62,7 +64,8 @@ pub async fn motor_map(
     State(state): State<AppState>,
     ApiJson(req): ApiJson<MotorMapRequest>,
 ) -> Result<Response, ApiError> {
-    run_calc(&state, None, move |budget| {
+    let limit = req.time_limit();
+    run_calc(&state, limit, move |budget| {
         bus_fuel_economy::run_motor_map(req, budget)
     })
     .await

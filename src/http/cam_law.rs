@@ -5,6 +5,7 @@ use axum::response::Response;
 
 use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
 use crate::calc::cam_law::{self, wire::EvaluateRequest, wire::EvaluateResponse};
+use crate::calc::common::TimeLimited;
 
 /// Evaluate a cam motion law: s, v, a, jerk at given abscissae, knots, exact peaks and jumps.
 ///
@@ -27,5 +28,6 @@ pub async fn evaluate(
     State(state): State<AppState>,
     ApiJson(req): ApiJson<EvaluateRequest>,
 ) -> Result<Response, ApiError> {
-    run_calc(&state, None, move |budget| cam_law::run(req, budget)).await
+    let limit = req.time_limit();
+    run_calc(&state, limit, move |budget| cam_law::run(req, budget)).await
 }

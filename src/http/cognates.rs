@@ -5,6 +5,7 @@ use axum::response::Response;
 
 use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
 use crate::calc::cognates::{self, wire::CognatesRequest, wire::CognatesResponse};
+use crate::calc::common::TimeLimited;
 
 /// Roberts–Chebyshev cognates: two other four-bars that trace the same coupler curve.
 ///
@@ -31,5 +32,6 @@ pub async fn construct(
     State(state): State<AppState>,
     ApiJson(req): ApiJson<CognatesRequest>,
 ) -> Result<Response, ApiError> {
-    run_calc(&state, None, move |budget| cognates::run(req, budget)).await
+    let limit = req.time_limit();
+    run_calc(&state, limit, move |budget| cognates::run(req, budget)).await
 }

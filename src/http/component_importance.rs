@@ -4,6 +4,7 @@ use axum::extract::State;
 use axum::response::Response;
 
 use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
+use crate::calc::common::TimeLimited;
 use crate::calc::component_importance::{
     self, ComponentImportanceRequest, ComponentImportanceResponse,
 };
@@ -32,7 +33,8 @@ pub async fn rank(
     State(state): State<AppState>,
     ApiJson(req): ApiJson<ComponentImportanceRequest>,
 ) -> Result<Response, ApiError> {
-    run_calc(&state, None, move |budget| {
+    let limit = req.time_limit();
+    run_calc(&state, limit, move |budget| {
         component_importance::run(req, budget)
     })
     .await

@@ -5,6 +5,7 @@ use axum::extract::State;
 use axum::response::Response;
 
 use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
+use crate::calc::common::TimeLimited;
 use crate::calc::irefc::{
     self, IrefcEfficiencyRequest, IrefcEfficiencyResponse, IrefcStressRequest, IrefcStressResponse,
 };
@@ -36,7 +37,8 @@ pub async fn stress(
     State(state): State<AppState>,
     ApiJson(req): ApiJson<IrefcStressRequest>,
 ) -> Result<Response, ApiError> {
-    run_calc(&state, None, move |budget| irefc::run_stress(req, budget)).await
+    let limit = req.time_limit();
+    run_calc(&state, limit, move |budget| irefc::run_stress(req, budget)).await
 }
 
 /// IREFC cycloid gear: slip speeds, friction power and mesh efficiency.
@@ -62,7 +64,8 @@ pub async fn efficiency(
     State(state): State<AppState>,
     ApiJson(req): ApiJson<IrefcEfficiencyRequest>,
 ) -> Result<Response, ApiError> {
-    run_calc(&state, None, move |budget| {
+    let limit = req.time_limit();
+    run_calc(&state, limit, move |budget| {
         irefc::run_efficiency(req, budget)
     })
     .await

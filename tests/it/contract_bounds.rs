@@ -310,3 +310,60 @@ async fn documented_bounds_are_the_enforced_bounds() {
         failures.join("\n  ")
     );
 }
+
+/// The wire convention's `time_limit_ms` is accepted at the top level of every operation's
+/// request, documented there with the shared bound [1, 600 000] ms, and enforced: 0 and 600 001
+/// are 422 naming `/time_limit_ms`, the bound's ends are answered like the example itself.
+#[tokio::test]
+async fn every_operation_takes_the_top_level_time_limit() {
+    let doc = doc();
+    let mut failures = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for (file, endpoint, body) in examples() {
+        if !seen.insert(endpoint.clone()) {
+            continue;
+        }
+        let schema = resolve(&doc, &crate::contract::request_schema(&doc, &endpoint)).clone();
+        let prop = resolve(&doc, &schema["properties"]["time_limit_ms"]);
+        if prop["minimum"] != json!(1) || prop["maximum"] != json!(600_000) {
+            failures.push(format!(
+                "{endpoint}: time_limit_ms documented as {prop} (want minimum 1, maximum 600000)"
+            ));
+        }
+        let base = post(&endpoint, &body).await.status;
+        for (ms, want_rejected) in [(0u64, true), (600_001, true), (1, false), (600_000, false)] {
+            let mut b = body.clone();
+            b["time_limit_ms"] = json!(ms);
+            let a = post(&endpoint, &b).await;
+            let named = a.pointers.iter().any(|p| p == "/time_limit_ms");
+            if want_rejected && !(a.status == 422 && named) {
+                failures.push(format!(
+                    "api/{file}: time_limit_ms = {ms} answered {} (pointers {:?}), want 422 at \
+                     /time_limit_ms",
+                    a.status, a.pointers
+                ));
+            }
+            // 1 ms may legitimately run out on a heavy example (a 422 deadline answer); it must
+            // never be rejected as an invalid time_limit_ms.
+            if !want_rejected && (named || (ms == 600_000 && a.status != base)) {
+                failures.push(format!(
+                    "api/{file}: time_limit_ms = {ms} answered {} (pointers {:?}), the example \
+                     alone {base}",
+                    a.status, a.pointers
+                ));
+            }
+        }
+    }
+    let posts = doc["paths"]
+        .as_object()
+        .expect("paths")
+        .iter()
+        .filter(|(_, item)| item.get("post").is_some())
+        .count();
+    assert_eq!(
+        seen.len(),
+        posts,
+        "every POST operation has an api/ example (seen {seen:?})"
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

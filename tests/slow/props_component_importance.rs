@@ -121,6 +121,7 @@ fn request(c: &Case) -> ComponentImportanceRequest {
             reliability: true,
             centralities: false,
         },
+        time_limit_ms: None,
     }
 }
 

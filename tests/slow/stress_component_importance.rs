@@ -167,6 +167,7 @@ fn graph_request(n: usize, edges: &[(usize, usize)]) -> ComponentImportanceReque
         overrides: Vec::new(),
         options: Options::default(),
         outputs: Outputs::default(),
+        time_limit_ms: None,
     }
 }
 

@@ -538,6 +538,9 @@ pub struct HistoryOut {
 
 // The documented bounds: the validator (input.rs) checks the same constants.
 crate::schema_bounds! {
+    BezierMotionRequest {
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
+    },
     SystemIn {
         inertias_kgm2 @items: INERTIA,
         j_eq_kgm2 as "J_eq_kgm2": J_EQ,

@@ -887,8 +887,10 @@ fn grid(v: &mut Validator, ptr: &str, g: &GridSpec) -> (f64, f64) {
 pub fn validate_motor(
     spec: &MotorSpec,
     g: &GridSpec,
+    time_limit_ms: Option<u64>,
 ) -> Result<(MotorInput, (f64, f64)), CalcFailure> {
     let mut v = Validator::new();
+    let _ = crate::calc::common::time_limit(&mut v, time_limit_ms);
     let m = motor(&mut v, 0, spec);
     let gr = grid(&mut v, "/grid", g);
     v.finish().map_err(|mut e| {
@@ -906,6 +908,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
 
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
+        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let shard = crate::calc::common::shard(&mut v, req.shard);
         let veh = vehicle(&mut v, &req.vehicle);
         v.range(

@@ -109,7 +109,7 @@ pub fn run_motor_map(
     req: MotorMapRequest,
     budget: &Budget,
 ) -> Result<MotorMapResponse, CalcFailure> {
-    let (m, grid) = validate_motor(&req.motor, &req.grid)?;
+    let (m, grid) = validate_motor(&req.motor, &req.grid, req.time_limit_ms)?;
     let series = if req.include_components { 9 } else { 2 };
     ResponseSize::fixed(8 * 1024)
         .numbers("/grid", map_points(&m, grid).saturating_mul(series))

@@ -45,6 +45,16 @@ pub struct BusFuelEconomyRequest {
     #[serde(default)]
     #[schema(nullable = false)]
     pub shard: Option<Shard>,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for BusFuelEconomyRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// Vehicle of the backward longitudinal model (§3.1, paper eq. 4-5).
@@ -912,6 +922,16 @@ pub struct MotorMapRequest {
     /// Also return the ipmsm loss components and operating modes.
     #[serde(default)]
     pub include_components: bool,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for MotorMapRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// Maps of one motor; values outside the envelope are null.
@@ -1075,6 +1095,12 @@ pub const SPEED_KMH: Range = Range::closed(0.0, 720.0);
 // The documented bounds of this module's wire types (one source: the validator checks
 // the same ranges, and tests/it/contract_bounds.rs probes both).
 crate::schema_bounds! {
+    BusFuelEconomyRequest {
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
+    },
+    MotorMapRequest {
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
+    },
     VehicleSpec {
         curb_mass_kg: CURB_MASS_KG,
         passengers: PASSENGERS,

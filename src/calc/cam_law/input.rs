@@ -200,6 +200,7 @@ impl TryFrom<EvaluateRequest> for EvaluateInput {
 
     fn try_from(req: EvaluateRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
+        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let mut warnings = Vec::new();
 
         let law = match (&req.coefficients, req.law) {

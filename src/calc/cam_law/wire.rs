@@ -56,6 +56,16 @@ pub struct EvaluateRequest {
     #[serde(default)]
     #[schema(nullable = false)]
     pub units: Option<Units>,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for EvaluateRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// Boundary conditions (spec §2). Every field is optional.
@@ -275,6 +285,7 @@ pub const GRID_COUNT: Range = Range::int(2, MAX_POINTS as i64);
 crate::schema_bounds! {
     EvaluateRequest {
         coefficients @items: COEFFICIENT,
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
     },
     ConstraintsIn {
         t_a: BOUNDARY_VALUE,

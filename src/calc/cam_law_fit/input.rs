@@ -713,6 +713,7 @@ fn with_derived(
 /// conditions admit no representable law of this duration (the initial law overflows f64).
 pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let mut v = Validator::new();
+    let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
     let xs = abscissa(&req, &mut v);
     let n = xs.as_ref().map(Vec::len);
 

@@ -68,13 +68,16 @@ pub fn run(req: FitCamLawRequest, budget: &Budget) -> Result<FitCamLawResponse, 
     Ok(output::respond(&input, out, budget))
 }
 
-/// The request's own wall-clock limit (`optimizer.time_limit_ms`, default 10 000 ms).
+/// The request's own wall-clock limit: the top-level `time_limit_ms` of the wire convention and
+/// `optimizer.time_limit_ms` (the spec's place for it) both limit the run, so the smaller applies;
+/// 10 000 ms when neither is given.
 #[must_use]
 pub fn time_limit(req: &FitCamLawRequest) -> Option<Duration> {
-    let ms = req
-        .optimizer
-        .time_limit_ms
-        .unwrap_or(input::DEFAULT_TIME_LIMIT_MS)
-        .clamp(1, input::MAX_TIME_LIMIT_MS);
+    let ms = match (req.time_limit_ms, req.optimizer.time_limit_ms) {
+        (Some(a), Some(b)) => a.min(b),
+        (Some(a), None) | (None, Some(a)) => a,
+        (None, None) => input::DEFAULT_TIME_LIMIT_MS,
+    }
+    .clamp(1, input::MAX_TIME_LIMIT_MS);
     Some(Duration::from_millis(ms))
 }

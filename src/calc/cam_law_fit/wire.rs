@@ -81,6 +81,16 @@ pub struct FitCamLawRequest {
     #[serde(default)]
     #[schema(nullable = false)]
     pub units: Option<Units>,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for FitCamLawRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// Sample abscissae \[x\]: exactly one of `values` or `grid`.
@@ -484,6 +494,9 @@ pub const PROBABILITY: Range = Range::closed(0.0, 1.0);
 pub const CURVE_COUNT: Range = Range::int(0, MAX_CURVE_COUNT as i64);
 
 crate::schema_bounds! {
+    FitCamLawRequest {
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
+    },
     Channels {
         displacement @items: DATA_VALUE,
         velocity @items: DATA_VALUE,

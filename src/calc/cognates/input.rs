@@ -208,6 +208,7 @@ impl TryFrom<CognatesRequest> for CognatesInput {
 
     fn try_from(req: CognatesRequest) -> Result<Self, Self::Error> {
         let mut v = Validator::new();
+        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let options = validate_options(&req, &mut v);
         if let Some(j) = req.joints {
             joints_mode(&req, &j, options, v)

@@ -112,6 +112,16 @@ pub struct CognatesRequest {
     /// Optional outputs and knobs.
     #[serde(default)]
     pub options: CognatesOptions,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for CognatesRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// Ground pivots. `A` defaults to `[0, 0]`; give either `B` or `length` (with `angle_deg`).
@@ -949,6 +959,7 @@ crate::schema_bounds! {
         crank: LENGTH,
         coupler: LENGTH,
         rocker: LENGTH,
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
     },
     GroundSpec {
         a @items as "A": COORDINATE,

@@ -185,6 +185,7 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
 
     fn try_from(req: ComponentImportanceRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
+        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let mut warnings = Vec::new();
         let n = req.components.len();
         v.ensure(

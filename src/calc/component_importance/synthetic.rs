@@ -118,5 +118,6 @@ pub fn random_request(
         overrides: Vec::new(),
         options: Options::default(),
         outputs: Outputs::default(),
+        time_limit_ms: None,
     }
 }

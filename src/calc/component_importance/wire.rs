@@ -48,6 +48,16 @@ pub struct ComponentImportanceRequest {
     /// Which optional outputs to compute and return.
     #[serde(default)]
     pub outputs: Outputs,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for ComponentImportanceRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// One component (node of the fault graph).
@@ -500,6 +510,7 @@ pub const MAX_SIMPLE_PATHS: Range = Range::closed(1e3, 1e8);
 crate::schema_bounds! {
     ComponentImportanceRequest {
         times_h @items: TIME_H,
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
     },
     Options {
         max_simple_paths: MAX_SIMPLE_PATHS,

@@ -80,7 +80,8 @@ pub const CHILD_INDEX: Range = Range::int(-1, 2_147_483_647);
 pub const COVER: Range = Range::FINITE.min(0.0);
 
 crate::schema_bounds! {
-    TrainRequest { target @items: TARGET },
+    TrainRequest { target @items: TARGET, time_limit_ms: crate::calc::common::TIME_LIMIT_MS },
+    PredictRequest { time_limit_ms: crate::calc::common::TIME_LIMIT_MS },
     TrainParams {
         n_estimators: N_ESTIMATORS,
         max_depth: MAX_DEPTH,
@@ -97,7 +98,7 @@ crate::schema_bounds! {
     ValidationIn { test_fraction: TEST_FRACTION, k_fold: K_FOLD },
     SmognIn { threshold: SMOGN_THRESHOLD, k: SMOGN_K, perturbation: SMOGN_PERTURBATION },
     SmognPreviewIn { threshold: SMOGN_THRESHOLD, k: SMOGN_K, perturbation: SMOGN_PERTURBATION },
-    AnalyzeRequest { target @items: TARGET },
+    AnalyzeRequest { target @items: TARGET, time_limit_ms: crate::calc::common::TIME_LIMIT_MS },
     GraIn { rho: GRA_RHO },
     PcaIn { components: PCA_COMPONENTS },
     GbdtModel { base_score: TARGET, n_features: MODEL_FEATURES },

@@ -49,6 +49,7 @@ impl EfficiencyInput {
     /// buildability (`UNDERCUT`, `ELEMENT_OVERLAP`).
     pub fn try_from_request(req: &IrefcEfficiencyRequest) -> Result<Self, CalcFailure> {
         let mut v = design::validator();
+        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let r2 = design::r2(&mut v, "/r2_mm", req.r2_mm);
         let z2 = design::z2(&mut v, "/Z2", req.z2);
         let chi = design::chi(&mut v, "/chi", req.chi);

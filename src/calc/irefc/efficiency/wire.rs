@@ -93,6 +93,16 @@ pub struct IrefcEfficiencyRequest {
     /// Optional outputs.
     #[schema(nullable = false)]
     pub include: Option<EfficiencyInclude>,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for IrefcEfficiencyRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// One loaded element (efficiency paper Table 1 row).
@@ -285,5 +295,6 @@ crate::schema_bounds! {
         sliding_friction: SLIDING_FRICTION,
         phase_deg: PHASE_DEG,
         n_phase: N_PHASE,
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
     },
 }

@@ -162,6 +162,7 @@ impl StressInput {
     /// `ELEMENT_OVERLAP`) is checked on the geometry by the caller.
     pub fn try_from_request(req: &IrefcStressRequest) -> Result<Self, CalcFailure> {
         let mut v = design::validator();
+        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let mode = match (req.mode, req.sweep.is_some()) {
             (Some(m), _) => m,
             (None, true) => StressMode::Sweep,

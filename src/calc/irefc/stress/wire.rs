@@ -186,6 +186,16 @@ pub struct IrefcStressRequest {
     /// says, equal the unsharded answer.
     #[schema(nullable = false)]
     pub shard: Option<Shard>,
+    /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false, example = 2000)]
+    pub time_limit_ms: Option<u64>,
+}
+
+impl crate::calc::common::TimeLimited for IrefcStressRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
 }
 
 /// One element of the phase-0 set (force paper "temporary array").
@@ -517,5 +527,6 @@ crate::schema_bounds! {
         step_deg: STEP_DEG,
         curves_stride: CURVES_STRIDE,
         profile_points: PROFILE_POINTS,
+        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
     },
 }
