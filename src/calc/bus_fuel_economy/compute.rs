@@ -12,6 +12,7 @@ use super::motor::{
     IpmsmMap, MotorEvaluator, MotorInput, MotorKind, build_ipmsm_map, grid_axes, grid_size,
 };
 use super::sim::{SimOutcome, SimSettings, simulate};
+// Request options carried by the validated input (read only: no wire type is built here).
 use super::wire::MotorEval;
 use crate::calc::common::Shard;
 use crate::numerics::Budget;

@@ -12,7 +12,8 @@ use super::geometry::{
 use super::input::{CognatesInput, SnapshotSpec};
 use super::sampling::{Sweep, circuit_sweeps, fixed_sweeps};
 use super::verify::{ImplicitResult, SyncAcc, hausdorff, implicit_check, segments};
-use super::wire::{CurveMode, MechanismId, Warning, WarningCode};
+// Request options carried by the validated input (read only: no wire type is built here).
+use super::wire::{CurveMode, Spacing};
 
 /// Server cap on sampled points per request (spec §3 suggests 1e6): bounds memory (~50 MB of
 /// curves) and time (~0.1 s) of one request.
@@ -138,6 +139,42 @@ pub struct FiveBar {
     pub snapshot: Option<([f64; 2], [C64; 2], C64, f64)>,
 }
 
+/// Kind of a finding about fragile or special geometry (spec §5; wire code in output.rs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoticeKind {
+    /// Grashof equality within tolerance: folded configurations, ambiguous branches.
+    ChangePoint,
+    /// A mechanism is a parallelogram (or a rhombus).
+    Parallelogram,
+    /// A mechanism is a deltoid (kite).
+    Deltoid,
+    /// Part of the curve is traced while the mechanism's input link stands still.
+    InputLockedSegment,
+    /// P lies on the line DE: the ground pivots are collinear.
+    CollinearCouplerTriangle,
+    /// |k| or |1−k| < 1e-3: a cognate is tiny or huge.
+    NearDegenerateCognate,
+    /// The snapshot is at a toggle: its branch label is ambiguous.
+    SnapshotAtToggle,
+    /// The lengths span more than 6 orders of magnitude.
+    ExtremeAspectRatio,
+    /// `fixed_branch` curves without an assembled snapshot used default branches.
+    FixedBranchDefaultBranches,
+}
+
+/// A finding about fragile or special geometry, with its message in the caller's units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Notice {
+    /// Kind.
+    pub kind: NoticeKind,
+    /// Human explanation naming the mechanism and values.
+    pub message: String,
+    /// The mechanism concerned (index into [`CognatesOutput::mechs`]), if one.
+    pub mechanism: Option<usize>,
+    /// Related absolute input angles \[rad\], e.g. the folded positions of a change point.
+    pub angles_rad: Option<Vec<f64>>,
+}
+
 /// Output of [`compute`], normalised units (see [`CognatesInput`] for the frame).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CognatesOutput {
@@ -153,17 +190,12 @@ pub struct CognatesOutput {
     pub hausdorff: Option<(Option<f64>, Option<f64>, usize)>,
     /// Geared five-bars, if requested.
     pub fivebars: Option<Vec<FiveBar>>,
-    /// Warnings.
-    pub warnings: Vec<Warning>,
+    /// Findings, in order.
+    pub warnings: Vec<Notice>,
     /// Curve points returned.
     pub points_total: usize,
 }
 
-const IDS: [MechanismId; 3] = [
-    MechanismId::Original,
-    MechanismId::Cognate1,
-    MechanismId::Cognate2,
-];
 const NAMES: [&str; 3] = ["original", "cognate 1", "cognate 2"];
 
 /// Runs the computation (pure, deterministic; checks the budget while sampling).
@@ -270,8 +302,8 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
         } else {
             let (branches, defaulted) = fixed_branches(&mechs, input.snapshot);
             if defaulted {
-                warnings.push(warning(
-                    WarningCode::FixedBranchDefaultBranches,
+                warnings.push(notice(
+                    NoticeKind::FixedBranchDefaultBranches,
                     "fixed_branch curves need an assembled snapshot to know each mechanism's branch; used original \
                      `branch`, cognate 1 +1, cognate 2 the opposite of `branch`"
                         .to_string(),
@@ -333,12 +365,12 @@ fn not_assemblable(m: &FourBar, scale: f64) -> CognatesError {
     }
 }
 
-fn warning(code: WarningCode, message: String, mechanism: Option<MechanismId>) -> Warning {
-    Warning {
-        code,
+fn notice(kind: NoticeKind, message: String, mechanism: Option<usize>) -> Notice {
+    Notice {
+        kind,
         message,
         mechanism,
-        angles_deg: None,
+        angles_rad: None,
     }
 }
 
@@ -430,7 +462,7 @@ fn trace(
     family: &Family,
     idx: usize,
     sweeps: &[Sweep],
-    (n, spacing, want_metrics): (usize, super::wire::Spacing, bool),
+    (n, spacing, want_metrics): (usize, Spacing, bool),
     mut sync: Option<&mut SyncAcc>,
     budget: &Budget,
     counter: &mut u64,
@@ -571,48 +603,43 @@ fn collect_warnings(
     input: &CognatesInput,
     family: &Family,
     mechs: &[MechOutput],
-    out: &mut Vec<Warning>,
+    out: &mut Vec<Notice>,
 ) {
     let rtol = input.options.grashof_rtol;
     for (i, m) in mechs.iter().enumerate() {
-        let id = Some(IDS[i]);
+        let id = Some(i);
         let name = NAMES[i];
         if m.grashof.class == GrashofClass::ChangePoint {
-            let folded: Vec<f64> = m
-                .mech
-                .folded_angles(rtol)
-                .into_iter()
-                .map(f64::to_degrees)
-                .collect();
-            out.push(Warning {
-                code: WarningCode::ChangePoint,
+            let folded: Vec<f64> = m.mech.folded_angles(rtol);
+            out.push(Notice {
+                kind: NoticeKind::ChangePoint,
                 message: format!(
                     "{name} is a change-point linkage (s + l = p + q within grashof_rtol, margin {:e}): it can fold \
                      flat at the listed input angles, where both branches meet and the branch labels are ambiguous",
                     m.grashof.margin * input.scale
                 ),
                 mechanism: id,
-                angles_deg: Some(folded),
+                angles_rad: Some(folded),
             });
         }
         match m.grashof.special {
-            Some(Special::Parallelogram) => out.push(warning(
-                WarningCode::Parallelogram,
+            Some(Special::Parallelogram) => out.push(notice(
+                NoticeKind::Parallelogram,
                 format!("{name} is a parallelogram (crank = rocker, coupler = ground): it can switch to the anti-parallelogram mode at the folded positions"),
                 id,
             )),
-            Some(Special::Rhombus) => out.push(warning(
-                WarningCode::Parallelogram,
+            Some(Special::Rhombus) => out.push(notice(
+                NoticeKind::Parallelogram,
                 format!("{name} is a rhombus (all links equal): both a parallelogram and a deltoid"),
                 id,
             )),
-            Some(Special::DeltoidCrankGround) => out.push(warning(
-                WarningCode::Deltoid,
+            Some(Special::DeltoidCrankGround) => out.push(notice(
+                NoticeKind::Deltoid,
                 format!("{name} is a deltoid with crank = ground and coupler = rocker: its crank tip reaches the output pivot"),
                 id,
             )),
-            Some(Special::DeltoidCrankCoupler) => out.push(warning(
-                WarningCode::Deltoid,
+            Some(Special::DeltoidCrankCoupler) => out.push(notice(
+                NoticeKind::Deltoid,
                 format!("{name} is a deltoid with crank = coupler and rocker = ground: the coupler can fold onto the crank"),
                 id,
             )),
@@ -623,21 +650,21 @@ fn collect_warnings(
             Some(Special::DeltoidCrankGround | Special::Rhombus)
         ) {
             let gamma = m.mech.ground_angle();
-            out.push(Warning {
-                code: WarningCode::InputLockedSegment,
+            out.push(Notice {
+                kind: NoticeKind::InputLockedSegment,
                 message: format!(
                     "{name}: at the listed input angle the crank tip sits on the output pivot; coupler and rocker can \
                      then turn about it with the input at rest, so that part of the curve cannot be driven by this \
                      mechanism's input (samples there are excluded or skipped)"
                 ),
                 mechanism: id,
-                angles_deg: Some(vec![wrap_pi(gamma).to_degrees()]),
+                angles_rad: Some(vec![wrap_pi(gamma)]),
             });
         }
     }
     if input.collinear {
-        out.push(warning(
-            WarningCode::CollinearCouplerTriangle,
+        out.push(notice(
+            NoticeKind::CollinearCouplerTriangle,
             "the coupler point lies on the line through the coupler joints: C lies on the line AB and the cognates' \
              coupler triangles are collinear"
                 .to_string(),
@@ -647,33 +674,33 @@ fn collect_warnings(
     let k = family.mechs[0].k;
     let one = C64::new(1.0, 0.0);
     if k.norm() < NEAR_DEGENERATE_K {
-        out.push(warning(
-            WarningCode::NearDegenerateCognate,
+        out.push(notice(
+            NoticeKind::NearDegenerateCognate,
             format!("|k| = {:e} < 1e-3: P is very close to the crank joint; cognate 1 is {:e} times the original", k.norm(), k.norm()),
-            Some(MechanismId::Cognate1),
+            Some(1),
         ));
     }
     if (one - k).norm() < NEAR_DEGENERATE_K {
-        out.push(warning(
-            WarningCode::NearDegenerateCognate,
+        out.push(notice(
+            NoticeKind::NearDegenerateCognate,
             format!(
                 "|1 − k| = {:e} < 1e-3: P is very close to the rocker joint; cognate 2 is {:e} times the original",
                 (one - k).norm(),
                 (one - k).norm()
             ),
-            Some(MechanismId::Cognate2),
+            Some(2),
         ));
     }
     let at_toggle = mechs[0]
         .snapshot
         .is_some_and(|s| s.status == SnapStatus::Toggle);
     if input.joints_at_toggle || at_toggle {
-        out.push(warning(
-            WarningCode::SnapshotAtToggle,
+        out.push(notice(
+            NoticeKind::SnapshotAtToggle,
             "the snapshot is at a toggle of the original (coupler and rocker collinear): both branches meet there, so \
              its branch label is ambiguous"
                 .to_string(),
-            Some(MechanismId::Original),
+            Some(0),
         ));
     }
     let (lo, hi) = family
@@ -683,8 +710,8 @@ fn collect_warnings(
             (lo.min(m.min_length()), hi.max(m.scale()))
         });
     if hi > EXTREME_ASPECT * lo {
-        out.push(warning(
-            WarningCode::ExtremeAspectRatio,
+        out.push(notice(
+            NoticeKind::ExtremeAspectRatio,
             format!(
                 "the lengths of the three mechanisms span {:.3e} (> 1e6): results are exact to rounding but positions \
                  near toggles lose digits in proportion",

@@ -8,12 +8,24 @@ use super::model::{Model, Params};
 use super::modes::{self, ModeResult, ModeSolution};
 use super::newton::{self, Counter, Failed, NewtonFailure, Solution, Stepping};
 use super::sweep::{self, NodeData, NodeStatus, WaveResult};
-use super::wire::{FkStatus, Mode, SeedKind};
+// Request options carried by the validated input (read only: no wire type is built here).
+use super::wire::{Mode, SeedKind};
 use crate::numerics::{Budget, StopReason};
 
 /// Largest condition number of the scaled Jacobian for an FK answer with determinate rod forces
 /// (the sweep default `cond_max` of spec 4.7; straight over-constrained states reach 1e16-1e18).
 pub const FK_COND_MAX: f64 = 1e12;
+
+/// Outcome of an FK solve (wire form in output.rs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FkStatus {
+    /// Converged and well conditioned.
+    Ok,
+    /// Newton did not converge (no pose).
+    NoConvergence,
+    /// Converged, but the Jacobian is singular (rod forces indeterminate).
+    Singular,
+}
 
 /// FK result.
 #[derive(Debug, Clone)]
@@ -47,8 +59,6 @@ pub struct FkOutput {
 /// One wave of a sweep with its metrics.
 #[derive(Debug, Clone)]
 pub struct WaveOutput {
-    /// Seed kind.
-    pub seed_kind: SeedKind,
     /// Seed node.
     pub seed_node: (usize, usize),
     /// Seed inputs.
@@ -574,7 +584,6 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
         }
         let metrics = metrics(model, s.grid, &wave, sw.qt_threshold, sw.union);
         waves.push(WaveOutput {
-            seed_kind: *kind,
             seed_node: node,
             seed_inputs: lam0,
             seed_status,
