@@ -6,12 +6,13 @@
 use std::collections::BTreeMap;
 
 use super::compute::{
-    self, BusFuelEconomyOutput, ComparisonData, MapData, RunResult, fuel_economy,
+    self, BusFuelEconomyOutput, ComparisonData, Histogram, MapData, RunResult, fuel_economy,
 };
 use super::cycles;
 use super::input::BusFuelEconomyInput;
 use super::ipmsm::{self, rad_s_to_rpm};
 use super::motor::{self, MotorInput};
+use super::sim::SimOutcome;
 use super::wire::{
     BusFuelEconomyResponse, Comparison, CycleResult, Desirability, Echo, LossBreakdown,
     LossComponentMaps, ModalBin, Mode, MotorMapData, MotorMapResponse, OpHistogram, Traces,
@@ -100,99 +101,11 @@ fn result_wire(
     let cycle = &input.cycles[r.cycle];
     let fe = fuel_economy(s.distance_m, s.e_in);
     let dist_km = s.distance_m / 1000.0;
-    let mut warnings = Vec::new();
-    if s.n_over > 0 {
-        warnings.push(match o.mode {
-            Mode::Backward => format!(
-                "{} intervals demand more than the motor envelope (mode=backward: trace followed, losses evaluated at the envelope)",
-                s.n_over
-            ),
-            Mode::Clip => format!(
-                "{} intervals demand more than the motor envelope (mode=clip: motor torque clipped, {:.6} kWh of wheel traction dropped)",
-                s.n_over,
-                kwh(s.sums.clipped.value())
-            ),
-            Mode::Forward => format!(
-                "{} intervals demand more than the motor envelope (mode=forward: the bus fell behind, trace miss {:.6} km)",
-                s.n_over,
-                (r.trace_distance_m - s.distance_m) / 1000.0
-            ),
-        });
-    }
-    if s.n_regen_limited > 0 {
-        warnings.push(format!(
-            "{} braking intervals exceed the motor envelope: generating torque limited to -T_max, the rest goes to the friction brakes",
-            s.n_regen_limited
-        ));
-    }
-    if s.n_fallback > 0 {
-        warnings.push(format!(
-            "{} intervals: the dq operating point could not be solved inside the envelope; the envelope point's loss was used",
-            s.n_fallback
-        ));
-    }
-    if s.n_forward_unconverged > 0 {
-        warnings.push(format!(
-            "{} forward-mode intervals: end speed not converged in 50 iterations; last iterate used",
-            s.n_forward_unconverged
-        ));
-    }
-    if fe.is_none() {
-        warnings.push(
-            "net battery energy ≤ 0 (net regeneration): fuel economy undefined (null)".to_owned(),
-        );
-    }
-    let (soc_end, flags) = match &s.ecm {
-        Some(st) => {
-            let mut f = Vec::new();
-            if st.n_power_infeasible > 0 {
-                f.push("battery_power_infeasible".to_owned());
-                warnings.push(format!(
-                    "{} intervals demand more power than the battery can deliver (e²/4R0): current clamped",
-                    st.n_power_infeasible
-                ));
-            }
-            if st.soc_out_of_range {
-                f.push("soc_out_of_range".to_owned());
-                warnings.push("battery state of charge left [0, 1]".to_owned());
-            }
-            (Some(st.soc), Some(f))
-        }
-        None => (None, None),
-    };
+    let mut warnings = sim_warnings(o.mode, &r, fe.is_none());
+    let (soc_end, flags) = battery_out(s, &mut warnings);
     warnings.extend(motor_warnings.iter().cloned());
-    let loss_breakdown = o.breakdown.then(|| {
-        let b = &s.sums;
-        let parts = matches!(motor.kind, motor::MotorKind::Ipmsm(_)).then_some(b.parts);
-        let part = |k: usize| parts.map(|p| kwh(p[k].value()));
-        let den = b.abs_pm_loss.value();
-        LossBreakdown {
-            wheel_kwh: kwh(b.wheel.value()),
-            gear_kwh: kwh(b.gear.value()),
-            friction_brake_kwh: kwh(s.brake),
-            motor_charged_kwh: kwh(b.motor_charged.value()),
-            motor_model_kwh: kwh(b.motor_model.value()),
-            motor_cu_dc_kwh: part(0),
-            motor_cu_ac_extra_kwh: part(1),
-            motor_iron_kwh: part(2),
-            motor_mech_kwh: part(3),
-            inverter_kwh: kwh(b.inverter.value()),
-            battery_kwh: kwh(b.battery.value()),
-            aux_kwh: kwh(b.aux.value()),
-            clipped_traction_kwh: kwh(b.clipped.value()),
-            mean_motor_efficiency: (den > 0.0).then(|| b.abs_pm.value() / den),
-        }
-    });
-    let op_histogram = r.histogram.map(|h| OpHistogram {
-        modal_bin: h.modal.map(|(i, j, share)| ModalBin {
-            rpm: [h.speed_edges[i], h.speed_edges[i + 1]],
-            nm: [h.torque_edges[j], h.torque_edges[j + 1]],
-            share,
-        }),
-        speed_edges_rpm: h.speed_edges,
-        torque_edges_nm: h.torque_edges,
-        share: h.share,
-    });
+    let loss_breakdown = o.breakdown.then(|| loss_breakdown(motor, s));
+    let op_histogram = r.histogram.map(op_histogram);
     let n = s.n_intervals;
     let traces = r.sim.traces.clone().map(|t| Traces {
         t_s: t.t,
@@ -241,6 +154,116 @@ fn result_wire(
         op_histogram,
         traces,
         warnings,
+    }
+}
+
+/// The result's warnings about the simulation, in order: demand over the envelope (worded for
+/// the envelope policy `mode`), limited regeneration, envelope fallbacks, unconverged forward
+/// intervals and an undefined fuel economy.
+fn sim_warnings(mode: Mode, r: &RunResult, fe_undefined: bool) -> Vec<String> {
+    let s = &r.sim;
+    let mut warnings = Vec::new();
+    if s.n_over > 0 {
+        warnings.push(match mode {
+            Mode::Backward => format!(
+                "{} intervals demand more than the motor envelope (mode=backward: trace followed, losses evaluated at the envelope)",
+                s.n_over
+            ),
+            Mode::Clip => format!(
+                "{} intervals demand more than the motor envelope (mode=clip: motor torque clipped, {:.6} kWh of wheel traction dropped)",
+                s.n_over,
+                kwh(s.sums.clipped.value())
+            ),
+            Mode::Forward => format!(
+                "{} intervals demand more than the motor envelope (mode=forward: the bus fell behind, trace miss {:.6} km)",
+                s.n_over,
+                (r.trace_distance_m - s.distance_m) / 1000.0
+            ),
+        });
+    }
+    if s.n_regen_limited > 0 {
+        warnings.push(format!(
+            "{} braking intervals exceed the motor envelope: generating torque limited to -T_max, the rest goes to the friction brakes",
+            s.n_regen_limited
+        ));
+    }
+    if s.n_fallback > 0 {
+        warnings.push(format!(
+            "{} intervals: the dq operating point could not be solved inside the envelope; the envelope point's loss was used",
+            s.n_fallback
+        ));
+    }
+    if s.n_forward_unconverged > 0 {
+        warnings.push(format!(
+            "{} forward-mode intervals: end speed not converged in 50 iterations; last iterate used",
+            s.n_forward_unconverged
+        ));
+    }
+    if fe_undefined {
+        warnings.push(
+            "net battery energy ≤ 0 (net regeneration): fuel economy undefined (null)".to_owned(),
+        );
+    }
+    warnings
+}
+
+/// The battery's end state of charge and flags (ECM battery only), adding their warnings.
+fn battery_out(s: &SimOutcome, warnings: &mut Vec<String>) -> (Option<f64>, Option<Vec<String>>) {
+    match &s.ecm {
+        Some(st) => {
+            let mut f = Vec::new();
+            if st.n_power_infeasible > 0 {
+                f.push("battery_power_infeasible".to_owned());
+                warnings.push(format!(
+                    "{} intervals demand more power than the battery can deliver (e²/4R0): current clamped",
+                    st.n_power_infeasible
+                ));
+            }
+            if st.soc_out_of_range {
+                f.push("soc_out_of_range".to_owned());
+                warnings.push("battery state of charge left [0, 1]".to_owned());
+            }
+            (Some(st.soc), Some(f))
+        }
+        None => (None, None),
+    }
+}
+
+/// The energy breakdown of one result \[kWh\] (motor loss parts for an IPMSM only).
+fn loss_breakdown(motor: &MotorInput, s: &SimOutcome) -> LossBreakdown {
+    let b = &s.sums;
+    let parts = matches!(motor.kind, motor::MotorKind::Ipmsm(_)).then_some(b.parts);
+    let part = |k: usize| parts.map(|p| kwh(p[k].value()));
+    let den = b.abs_pm_loss.value();
+    LossBreakdown {
+        wheel_kwh: kwh(b.wheel.value()),
+        gear_kwh: kwh(b.gear.value()),
+        friction_brake_kwh: kwh(s.brake),
+        motor_charged_kwh: kwh(b.motor_charged.value()),
+        motor_model_kwh: kwh(b.motor_model.value()),
+        motor_cu_dc_kwh: part(0),
+        motor_cu_ac_extra_kwh: part(1),
+        motor_iron_kwh: part(2),
+        motor_mech_kwh: part(3),
+        inverter_kwh: kwh(b.inverter.value()),
+        battery_kwh: kwh(b.battery.value()),
+        aux_kwh: kwh(b.aux.value()),
+        clipped_traction_kwh: kwh(b.clipped.value()),
+        mean_motor_efficiency: (den > 0.0).then(|| b.abs_pm.value() / den),
+    }
+}
+
+/// Wire form of the operating-point histogram.
+fn op_histogram(h: Histogram) -> OpHistogram {
+    OpHistogram {
+        modal_bin: h.modal.map(|(i, j, share)| ModalBin {
+            rpm: [h.speed_edges[i], h.speed_edges[i + 1]],
+            nm: [h.torque_edges[j], h.torque_edges[j + 1]],
+            share,
+        }),
+        speed_edges_rpm: h.speed_edges,
+        torque_edges_nm: h.torque_edges,
+        share: h.share,
     }
 }
 

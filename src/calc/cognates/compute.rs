@@ -9,7 +9,7 @@ use super::geometry::{
     ASSEMBLY_SLACK_REL, C64, Family, FourBar, Grashof, GrashofClass, InputRange, SINGULAR_REL,
     Sign, Solve, Special, TOGGLE_REL, cognate1_branch, cognates, map_pose, wrap_pi,
 };
-use super::input::{CognatesInput, SnapshotSpec};
+use super::input::{CognatesInput, Options, SnapshotSpec};
 use super::sampling::{Sweep, circuit_sweeps, fixed_sweeps};
 use super::verify::{ImplicitResult, SyncAcc, hausdorff, implicit_check, segments};
 // Request options carried by the validated input (read only: no wire type is built here).
@@ -233,23 +233,8 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
         }
     }
 
-    // Work plan and point cap.
     let n = opts.points_per_circuit;
-    let need_circuits = (opts.curves && opts.curve_mode == CurveMode::Circuits)
-        || opts.any_verify()
-        || opts.metrics;
-    let need_fixed = opts.curves && opts.curve_mode == CurveMode::FixedBranch;
-    let n_u64 = u64::try_from(n).unwrap_or(u64::MAX);
-    let circuits: u64 = mechs.iter().map(|m| m.range.circuits().len() as u64).sum();
-    let intervals: u64 = mechs.iter().map(|m| m.range.intervals().len() as u64).sum();
-    let requested = n_u64
-        .saturating_mul(u64::from(need_circuits) * circuits + u64::from(need_fixed) * intervals);
-    if requested > MAX_POINTS_TOTAL {
-        return Err(CognatesError::TooManyPoints {
-            requested,
-            cap: MAX_POINTS_TOTAL,
-        });
-    }
+    let need_circuits = work_plan(opts, &mechs)?;
 
     let mut counter = 0_u64;
     let mut sync = opts.verify_sync.then(|| SyncAcc::new(&family));
@@ -300,29 +285,13 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
                 m.curves = Some(c);
             }
         } else {
-            let (branches, defaulted) = fixed_branches(&mechs, input.snapshot);
-            if defaulted {
-                warnings.push(notice(
-                    NoticeKind::FixedBranchDefaultBranches,
-                    "fixed_branch curves need an assembled snapshot to know each mechanism's branch; used original \
-                     `branch`, cognate 1 +1, cognate 2 the opposite of `branch`"
-                        .to_string(),
-                    None,
-                ));
-            }
-            for (idx, m) in mechs.iter_mut().enumerate() {
-                let sweeps = fixed_sweeps(&m.mech, branches[idx]);
-                let (curves, _) = trace(
-                    &family,
-                    idx,
-                    &sweeps,
-                    (n, opts.spacing, false),
-                    None,
-                    budget,
-                    &mut counter,
-                )?;
-                m.curves = Some(curves);
-            }
+            fixed_branch_curves(
+                input,
+                &family,
+                &mut mechs,
+                (budget, &mut counter),
+                &mut warnings,
+            )?;
         }
     }
     let points_total = mechs
@@ -344,6 +313,64 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
         warnings,
         points_total,
     })
+}
+
+/// Work plan and point cap: whether circuits must be traced (for circuit curves, a verification
+/// or the metrics); [`CognatesError::TooManyPoints`] when the planned samples exceed
+/// [`MAX_POINTS_TOTAL`].
+fn work_plan(opts: &Options, mechs: &[MechOutput]) -> Result<bool, CognatesError> {
+    let need_circuits = (opts.curves && opts.curve_mode == CurveMode::Circuits)
+        || opts.any_verify()
+        || opts.metrics;
+    let need_fixed = opts.curves && opts.curve_mode == CurveMode::FixedBranch;
+    let n_u64 = u64::try_from(opts.points_per_circuit).unwrap_or(u64::MAX);
+    let circuits: u64 = mechs.iter().map(|m| m.range.circuits().len() as u64).sum();
+    let intervals: u64 = mechs.iter().map(|m| m.range.intervals().len() as u64).sum();
+    let requested = n_u64
+        .saturating_mul(u64::from(need_circuits) * circuits + u64::from(need_fixed) * intervals);
+    if requested > MAX_POINTS_TOTAL {
+        return Err(CognatesError::TooManyPoints {
+            requested,
+            cap: MAX_POINTS_TOTAL,
+        });
+    }
+    Ok(need_circuits)
+}
+
+/// Paper-style curves: each mechanism's own input over its range on the branch of the snapshot
+/// (defaults, with a notice, without an assembled snapshot).
+fn fixed_branch_curves(
+    input: &CognatesInput,
+    family: &Family,
+    mechs: &mut [MechOutput],
+    (budget, counter): (&Budget, &mut u64),
+    warnings: &mut Vec<Notice>,
+) -> Result<(), CognatesError> {
+    let opts = &input.options;
+    let (branches, defaulted) = fixed_branches(mechs, input.snapshot);
+    if defaulted {
+        warnings.push(notice(
+            NoticeKind::FixedBranchDefaultBranches,
+            "fixed_branch curves need an assembled snapshot to know each mechanism's branch; used original \
+             `branch`, cognate 1 +1, cognate 2 the opposite of `branch`"
+                .to_string(),
+            None,
+        ));
+    }
+    for (idx, m) in mechs.iter_mut().enumerate() {
+        let sweeps = fixed_sweeps(&m.mech, branches[idx]);
+        let (curves, _) = trace(
+            family,
+            idx,
+            &sweeps,
+            (opts.points_per_circuit, opts.spacing, false),
+            None,
+            budget,
+            counter,
+        )?;
+        m.curves = Some(curves);
+    }
+    Ok(())
 }
 
 fn not_assemblable(m: &FourBar, scale: f64) -> CognatesError {
