@@ -415,6 +415,10 @@ fn sweep_grid(paper: &Set, reference: Option<&Value>) {
 }
 
 /// TreeSHAP time per row against shap's TreeExplainer on the same XGBoost model.
+#[expect(
+    clippy::too_many_lines,
+    reason = "prints the TreeSHAP timing table of benches/RESULTS.md, one row per model and method, against the shap and XGBoost reference timings"
+)]
 fn sweep_shap(paper: &Set, reference: Option<&Value>) {
     println!("\n### TreeSHAP time per row (1 thread) against shap 0.51 / XGBoost 3.2.0\n");
     println!(

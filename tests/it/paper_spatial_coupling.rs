@@ -335,6 +335,10 @@ fn paper_sweep(alpha: f64) -> Value {
 }
 
 #[test]
+#[expect(
+    clippy::too_many_lines,
+    reason = "the paper's statements over one 3601-point revolution checked in sequence on the one computed answer (ratios, signs, oscillation, sign changes, lemniscate boxes)"
+)]
 fn paper_statements_over_a_revolution() {
     let b = paper_sweep(15.0);
     let s = &b["summary"];

@@ -134,6 +134,85 @@ fn matrix_for(
     })
 }
 
+/// Control points, optimizer report and robust results of [`optimize`].
+type Optimized = (Vec<f64>, Option<OptimizerResult>, Option<Vec<FactorResult>>);
+
+/// The zero-vibration law of `Mode::Optimize`: the constrained least-squares
+/// solve for `input.objective` (with the robust variant's two extra stiffness factors), the
+/// reference law's residual, and the robust residuals at the three factors. Returns the
+/// optimal control points, the optimizer's report and the robust results.
+fn optimize(
+    input: &BezierInput,
+    plant: Plant,
+    (h, shape, n): (&ResponseMatrix, &LawShape, usize),
+    matrices: &mut u64,
+    warnings: &mut Vec<Warning>,
+) -> Result<Optimized, BezierMotionError> {
+    let mut rows = vec![residual_rows(&plant, h, shape)];
+    let mut robust_plants = Vec::new();
+    if let Some(d) = input.robust {
+        for f in [1.0 - d, 1.0 + d] {
+            let pf = plant.with_stiffness_factor(f);
+            let hf = matrix_for(&pf, n, input.t, "/optimize/robust_stiffness_rel".into())?;
+            *matrices += 1;
+            rows.push(residual_rows(&pf, &hf, shape));
+            robust_plants.push((f, pf, hf));
+        }
+    }
+    let (hq, f) = objective_terms(input.objective, shape, &input.gamma);
+    let sol = solve(&hq, &f, &rows).map_err(|_| BezierMotionError::ObjectiveSingular {
+        objective: match input.objective {
+            Objective::MinDeviation => "min_deviation",
+            Objective::MinAccelL2 => "min_accel_l2",
+            Objective::MinJerkL2 => "min_jerk_l2",
+        },
+    })?;
+    let ref_law = BezierLaw::new(input.m, input.phi, &input.gamma, input.t);
+    let reference = Residual::of(&plant, h, &ref_law.a, input.t);
+    let law = BezierLaw::new(input.m, input.phi, &sol.gamma, input.t);
+    let robust = input.robust.map(|_| {
+        let mut out: Vec<FactorResult> = robust_plants
+            .iter()
+            .map(|(f, pf, hf)| FactorResult {
+                factor: *f,
+                plant: *pf,
+                residual: Residual::of(pf, hf, &law.a, input.t),
+            })
+            .collect();
+        out.insert(
+            1,
+            FactorResult {
+                factor: 1.0,
+                plant,
+                residual: Residual::of(&plant, h, &law.a, input.t),
+            },
+        );
+        out
+    });
+    if sol.rank < sol.n_constraints {
+        warnings.push(Warning::new(
+            "LEAST_SQUARES_COMPROMISE",
+            format!(
+                "only {} of {} zero-vibration conditions can be met (p = {}): the law \
+                 is the least-squares compromise, not exactly vibration-free",
+                sol.rank, sol.n_constraints, input.p
+            ),
+        ));
+    }
+    Ok((
+        sol.gamma.clone(),
+        Some(OptimizerResult {
+            objective: input.objective,
+            n_constraints: sol.n_constraints,
+            rank: sol.rank,
+            mu: sol.mu,
+            reference_gamma: input.gamma.clone(),
+            reference,
+        }),
+        robust,
+    ))
+}
+
 /// Run the calculation (spec §3).
 ///
 /// # Errors
@@ -160,71 +239,7 @@ pub fn compute(input: &BezierInput, budget: &Budget) -> Result<BezierOutput, Bez
     let mut warnings = input.warnings.clone();
     let (gamma, optimizer, robust) = match input.mode {
         Mode::Simulate => (input.gamma.clone(), None, None),
-        Mode::Optimize => {
-            let mut rows = vec![residual_rows(&plant, &h, &shape)];
-            let mut robust_plants = Vec::new();
-            if let Some(d) = input.robust {
-                for f in [1.0 - d, 1.0 + d] {
-                    let pf = plant.with_stiffness_factor(f);
-                    let hf = matrix_for(&pf, n, input.t, "/optimize/robust_stiffness_rel".into())?;
-                    matrices += 1;
-                    rows.push(residual_rows(&pf, &hf, &shape));
-                    robust_plants.push((f, pf, hf));
-                }
-            }
-            let (hq, f) = objective_terms(input.objective, &shape, &input.gamma);
-            let sol = solve(&hq, &f, &rows).map_err(|_| BezierMotionError::ObjectiveSingular {
-                objective: match input.objective {
-                    Objective::MinDeviation => "min_deviation",
-                    Objective::MinAccelL2 => "min_accel_l2",
-                    Objective::MinJerkL2 => "min_jerk_l2",
-                },
-            })?;
-            let ref_law = BezierLaw::new(input.m, input.phi, &input.gamma, input.t);
-            let reference = Residual::of(&plant, &h, &ref_law.a, input.t);
-            let law = BezierLaw::new(input.m, input.phi, &sol.gamma, input.t);
-            let robust = input.robust.map(|_| {
-                let mut out: Vec<FactorResult> = robust_plants
-                    .iter()
-                    .map(|(f, pf, hf)| FactorResult {
-                        factor: *f,
-                        plant: *pf,
-                        residual: Residual::of(pf, hf, &law.a, input.t),
-                    })
-                    .collect();
-                out.insert(
-                    1,
-                    FactorResult {
-                        factor: 1.0,
-                        plant,
-                        residual: Residual::of(&plant, &h, &law.a, input.t),
-                    },
-                );
-                out
-            });
-            if sol.rank < sol.n_constraints {
-                warnings.push(Warning::new(
-                    "LEAST_SQUARES_COMPROMISE",
-                    format!(
-                        "only {} of {} zero-vibration conditions can be met (p = {}): the law \
-                         is the least-squares compromise, not exactly vibration-free",
-                        sol.rank, sol.n_constraints, input.p
-                    ),
-                ));
-            }
-            (
-                sol.gamma.clone(),
-                Some(OptimizerResult {
-                    objective: input.objective,
-                    n_constraints: sol.n_constraints,
-                    rank: sol.rank,
-                    mu: sol.mu,
-                    reference_gamma: input.gamma.clone(),
-                    reference,
-                }),
-                robust,
-            )
-        }
+        Mode::Optimize => optimize(input, plant, (&h, &shape, n), &mut matrices, &mut warnings)?,
     };
     let law = BezierLaw::new(input.m, input.phi, &gamma, input.t);
     // Recompute the end state from the law itself (never trust the affine model's residual).
@@ -238,31 +253,14 @@ pub fn compute(input: &BezierInput, budget: &Budget) -> Result<BezierOutput, Bez
     let kin = input.kinematics.then(|| kinematics(&law));
     let sensitivity = match &input.sensitivity {
         None => None,
-        Some(factors) => {
-            let mut out = Vec::with_capacity(factors.len());
-            for (i, &f) in factors.iter().enumerate() {
-                if budget.check(matrices).is_some() {
-                    return Err(BezierMotionError::Deadline {
-                        stage: "sensitivity sweep",
-                    });
-                }
-                let pf = plant.with_stiffness_factor(f);
-                let hf = matrix_for(
-                    &pf,
-                    n,
-                    input.t,
-                    format!("/outputs/sensitivity/stiffness_factors/{i}"),
-                )?;
-                matrices += 1;
-                out.push(FactorResult {
-                    factor: f,
-                    plant: pf,
-                    residual: Residual::of(&pf, &hf, &law.a, input.t),
-                });
-                budget.progress((i + 1) as f64 / factors.len() as f64, None);
-            }
-            Some(out)
-        }
+        Some(factors) => Some(sensitivity(
+            &plant,
+            (n, input.t),
+            &law,
+            factors,
+            budget,
+            &mut matrices,
+        )?),
     };
     let history = match &input.history {
         None => None,
@@ -285,6 +283,41 @@ pub fn compute(input: &BezierInput, budget: &Budget) -> Result<BezierOutput, Bez
         warnings,
         matrices,
     })
+}
+
+/// The residual of `law` with the joint stiffness scaled by each of `factors` (the sensitivity
+/// sweep), counting the matrices built in `matrices` and checking the budget before each one.
+fn sensitivity(
+    plant: &Plant,
+    (n, t): (usize, f64),
+    law: &BezierLaw,
+    factors: &[f64],
+    budget: &Budget,
+    matrices: &mut u64,
+) -> Result<Vec<FactorResult>, BezierMotionError> {
+    let mut out = Vec::with_capacity(factors.len());
+    for (i, &f) in factors.iter().enumerate() {
+        if budget.check(*matrices).is_some() {
+            return Err(BezierMotionError::Deadline {
+                stage: "sensitivity sweep",
+            });
+        }
+        let pf = plant.with_stiffness_factor(f);
+        let hf = matrix_for(
+            &pf,
+            n,
+            t,
+            format!("/outputs/sensitivity/stiffness_factors/{i}"),
+        )?;
+        *matrices += 1;
+        out.push(FactorResult {
+            factor: f,
+            plant: pf,
+            residual: Residual::of(&pf, &hf, &law.a, t),
+        });
+        budget.progress((i + 1) as f64 / factors.len() as f64, None);
+    }
+    Ok(out)
 }
 
 /// The law's warnings (spec §3.7, §2): fragile polygon, reversal, negative velocity ordinate,

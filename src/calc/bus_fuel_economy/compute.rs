@@ -12,6 +12,7 @@ use super::motor::{
     IpmsmMap, MotorEvaluator, MotorInput, MotorKind, build_ipmsm_map, grid_axes, grid_size,
 };
 use super::sim::{SimOutcome, SimSettings, simulate};
+// Request options carried by the validated input (read only: no wire type is built here).
 use super::wire::MotorEval;
 use crate::calc::common::Shard;
 use crate::numerics::Budget;
@@ -331,21 +332,7 @@ pub fn compute(
     let (mut n_iv, mut n_eval) = (0u64, 0u64);
     for (mi, m) in input.motors.iter().enumerate() {
         let mut warnings = m.warnings.clone();
-        // An ipmsm must have torque left at every speed the cycles need (spec §8 item 5).
-        if let MotorKind::Ipmsm(im) = &m.kind {
-            for c in &input.cycles {
-                let w_need = input.vehicle.motor_speed(c.max_speed_mps());
-                if im.t_max(w_need) <= 0.0 {
-                    return Err(BusFuelEconomyError::SpeedUnreachable {
-                        motor_index: mi,
-                        motor: m.id.clone(),
-                        cycle: c.name.clone(),
-                        rpm: rad_s_to_rpm(w_need),
-                        limit_rpm: rad_s_to_rpm(reachable_limit(im, w_need)),
-                    });
-                }
-            }
-        }
+        check_reachable(input, mi, m)?;
         let mine = (mi * n_c).max(pairs.start)..((mi + 1) * n_c).min(pairs.end);
         if mine.is_empty() {
             motor_warnings.push(warnings);
@@ -353,19 +340,7 @@ pub fn compute(
         }
         let ipmsm_map: Option<IpmsmMap> = match (&m.kind, o.motor_eval) {
             (MotorKind::Ipmsm(im), MotorEval::LossMap) => {
-                let points = grid_size(m.n_max_rpm, im.t_max(0.0), o.grid.0, o.grid.1);
-                if points > MAX_MAP_POINTS {
-                    return Err(BusFuelEconomyError::MapTooLarge {
-                        motor: m.id.clone(),
-                        points,
-                        limit: MAX_MAP_POINTS,
-                    });
-                }
-                let map = build_ipmsm_map(im, m.n_max_rpm, o.grid.0, o.grid.1, budget).ok_or(
-                    BusFuelEconomyError::Deadline {
-                        elapsed_ms: budget.elapsed_ms(),
-                    },
-                )?;
+                let map = ipmsm_loss_map(m, im, o.grid, budget)?;
                 n_eval += map.evaluations;
                 if map.fallbacks > 0 {
                     warnings.push(format!(
@@ -432,6 +407,50 @@ pub fn compute(
         comparison,
         intervals: n_iv,
         evaluations: n_eval,
+    })
+}
+
+/// An ipmsm must have torque left at every speed the cycles need (spec §8 item 5).
+fn check_reachable(
+    input: &BusFuelEconomyInput,
+    mi: usize,
+    m: &MotorInput,
+) -> Result<(), BusFuelEconomyError> {
+    if let MotorKind::Ipmsm(im) = &m.kind {
+        for c in &input.cycles {
+            let w_need = input.vehicle.motor_speed(c.max_speed_mps());
+            if im.t_max(w_need) <= 0.0 {
+                return Err(BusFuelEconomyError::SpeedUnreachable {
+                    motor_index: mi,
+                    motor: m.id.clone(),
+                    cycle: c.name.clone(),
+                    rpm: rad_s_to_rpm(w_need),
+                    limit_rpm: rad_s_to_rpm(reachable_limit(im, w_need)),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The precomputed loss map of an ipmsm evaluated with `motor_eval = loss_map`, on `grid`
+/// (speed, torque steps), refused above [`MAX_MAP_POINTS`].
+fn ipmsm_loss_map(
+    m: &MotorInput,
+    im: &Ipmsm,
+    grid: (f64, f64),
+    budget: &Budget,
+) -> Result<IpmsmMap, BusFuelEconomyError> {
+    let points = grid_size(m.n_max_rpm, im.t_max(0.0), grid.0, grid.1);
+    if points > MAX_MAP_POINTS {
+        return Err(BusFuelEconomyError::MapTooLarge {
+            motor: m.id.clone(),
+            points,
+            limit: MAX_MAP_POINTS,
+        });
+    }
+    build_ipmsm_map(im, m.n_max_rpm, grid.0, grid.1, budget).ok_or(BusFuelEconomyError::Deadline {
+        elapsed_ms: budget.elapsed_ms(),
     })
 }
 

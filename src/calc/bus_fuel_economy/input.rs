@@ -509,6 +509,10 @@ fn envelope(
     (env, rpm_to_rad_s(n_max))
 }
 
+#[expect(
+    clippy::too_many_lines,
+    reason = "validates the IPMSM block field by field (pole pairs, psi_m or back-EMF, dq inductances, winding, current and voltage limits, torque/power caps, AC factor, iron and mechanical losses, stack scale), each check a few lines with its own pointer, into the one IpmsmParams literal at its end"
+)]
 fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
     let p = format!("{base}/");
     v.uint(
@@ -682,6 +686,10 @@ fn map_axis_warning(loss: &Grid2, env: &Envelope, warnings: &mut Vec<String>) {
     }
 }
 
+#[expect(
+    clippy::too_many_lines,
+    reason = "one match arm per motor model of spec §3 (constant, efficiency map, loss map, ipmsm), each validating that model's envelope and table or parameters into its MotorKind; the id and speed-limit checks around the match apply to all four"
+)]
 fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     let base = format!("/motors/{i}");
     name_ok(v, &format!("{base}/id"), spec.id(), "motor id");
@@ -906,6 +914,10 @@ pub fn validate_motor(
 impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
     type Error = CalcFailure;
 
+    #[expect(
+        clippy::too_many_lines,
+        reason = "validates the whole request in document order (vehicle, battery, cycles and their duplicate names, motors and their duplicate ids, options, desirability weights) into one Validator, so that one 422 lists every offending field; the closing cross-check of every cycle's top speed against every motor's speed limit needs both validated lists"
+    )]
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);

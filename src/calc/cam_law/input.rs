@@ -198,6 +198,10 @@ fn check_coefficients(v: &mut Validator, c: &[f64], normalize: bool) -> Option<(
 impl TryFrom<EvaluateRequest> for EvaluateInput {
     type Error = CalcFailure;
 
+    #[expect(
+        clippy::too_many_lines,
+        reason = "checks the law choice (coefficients xor a named law), its boundary conditions, the abscissa and the requested quantities into one Validator so that one 422 lists every problem; the boundary checks need the law chosen at the top"
+    )]
     fn try_from(req: EvaluateRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);

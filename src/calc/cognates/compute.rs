@@ -9,10 +9,11 @@ use super::geometry::{
     ASSEMBLY_SLACK_REL, C64, Family, FourBar, Grashof, GrashofClass, InputRange, SINGULAR_REL,
     Sign, Solve, Special, TOGGLE_REL, cognate1_branch, cognates, map_pose, wrap_pi,
 };
-use super::input::{CognatesInput, SnapshotSpec};
+use super::input::{CognatesInput, Options, SnapshotSpec};
 use super::sampling::{Sweep, circuit_sweeps, fixed_sweeps};
 use super::verify::{ImplicitResult, SyncAcc, hausdorff, implicit_check, segments};
-use super::wire::{CurveMode, MechanismId, Warning, WarningCode};
+// Request options carried by the validated input (read only: no wire type is built here).
+use super::wire::{CurveMode, Spacing};
 
 /// Server cap on sampled points per request (spec §3 suggests 1e6): bounds memory (~50 MB of
 /// curves) and time (~0.1 s) of one request.
@@ -138,6 +139,42 @@ pub struct FiveBar {
     pub snapshot: Option<([f64; 2], [C64; 2], C64, f64)>,
 }
 
+/// Kind of a finding about fragile or special geometry (spec §5; wire code in output.rs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoticeKind {
+    /// Grashof equality within tolerance: folded configurations, ambiguous branches.
+    ChangePoint,
+    /// A mechanism is a parallelogram (or a rhombus).
+    Parallelogram,
+    /// A mechanism is a deltoid (kite).
+    Deltoid,
+    /// Part of the curve is traced while the mechanism's input link stands still.
+    InputLockedSegment,
+    /// P lies on the line DE: the ground pivots are collinear.
+    CollinearCouplerTriangle,
+    /// |k| or |1−k| < 1e-3: a cognate is tiny or huge.
+    NearDegenerateCognate,
+    /// The snapshot is at a toggle: its branch label is ambiguous.
+    SnapshotAtToggle,
+    /// The lengths span more than 6 orders of magnitude.
+    ExtremeAspectRatio,
+    /// `fixed_branch` curves without an assembled snapshot used default branches.
+    FixedBranchDefaultBranches,
+}
+
+/// A finding about fragile or special geometry, with its message in the caller's units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Notice {
+    /// Kind.
+    pub kind: NoticeKind,
+    /// Human explanation naming the mechanism and values.
+    pub message: String,
+    /// The mechanism concerned (index into [`CognatesOutput::mechs`]), if one.
+    pub mechanism: Option<usize>,
+    /// Related absolute input angles \[rad\], e.g. the folded positions of a change point.
+    pub angles_rad: Option<Vec<f64>>,
+}
+
 /// Output of [`compute`], normalised units (see [`CognatesInput`] for the frame).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CognatesOutput {
@@ -153,17 +190,12 @@ pub struct CognatesOutput {
     pub hausdorff: Option<(Option<f64>, Option<f64>, usize)>,
     /// Geared five-bars, if requested.
     pub fivebars: Option<Vec<FiveBar>>,
-    /// Warnings.
-    pub warnings: Vec<Warning>,
+    /// Findings, in order.
+    pub warnings: Vec<Notice>,
     /// Curve points returned.
     pub points_total: usize,
 }
 
-const IDS: [MechanismId; 3] = [
-    MechanismId::Original,
-    MechanismId::Cognate1,
-    MechanismId::Cognate2,
-];
 const NAMES: [&str; 3] = ["original", "cognate 1", "cognate 2"];
 
 /// Runs the computation (pure, deterministic; checks the budget while sampling).
@@ -201,23 +233,8 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
         }
     }
 
-    // Work plan and point cap.
     let n = opts.points_per_circuit;
-    let need_circuits = (opts.curves && opts.curve_mode == CurveMode::Circuits)
-        || opts.any_verify()
-        || opts.metrics;
-    let need_fixed = opts.curves && opts.curve_mode == CurveMode::FixedBranch;
-    let n_u64 = u64::try_from(n).unwrap_or(u64::MAX);
-    let circuits: u64 = mechs.iter().map(|m| m.range.circuits().len() as u64).sum();
-    let intervals: u64 = mechs.iter().map(|m| m.range.intervals().len() as u64).sum();
-    let requested = n_u64
-        .saturating_mul(u64::from(need_circuits) * circuits + u64::from(need_fixed) * intervals);
-    if requested > MAX_POINTS_TOTAL {
-        return Err(CognatesError::TooManyPoints {
-            requested,
-            cap: MAX_POINTS_TOTAL,
-        });
-    }
+    let need_circuits = work_plan(opts, &mechs)?;
 
     let mut counter = 0_u64;
     let mut sync = opts.verify_sync.then(|| SyncAcc::new(&family));
@@ -268,29 +285,13 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
                 m.curves = Some(c);
             }
         } else {
-            let (branches, defaulted) = fixed_branches(&mechs, input.snapshot);
-            if defaulted {
-                warnings.push(warning(
-                    WarningCode::FixedBranchDefaultBranches,
-                    "fixed_branch curves need an assembled snapshot to know each mechanism's branch; used original \
-                     `branch`, cognate 1 +1, cognate 2 the opposite of `branch`"
-                        .to_string(),
-                    None,
-                ));
-            }
-            for (idx, m) in mechs.iter_mut().enumerate() {
-                let sweeps = fixed_sweeps(&m.mech, branches[idx]);
-                let (curves, _) = trace(
-                    &family,
-                    idx,
-                    &sweeps,
-                    (n, opts.spacing, false),
-                    None,
-                    budget,
-                    &mut counter,
-                )?;
-                m.curves = Some(curves);
-            }
+            fixed_branch_curves(
+                input,
+                &family,
+                &mut mechs,
+                (budget, &mut counter),
+                &mut warnings,
+            )?;
         }
     }
     let points_total = mechs
@@ -314,6 +315,64 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
     })
 }
 
+/// Work plan and point cap: whether circuits must be traced (for circuit curves, a verification
+/// or the metrics); [`CognatesError::TooManyPoints`] when the planned samples exceed
+/// [`MAX_POINTS_TOTAL`].
+fn work_plan(opts: &Options, mechs: &[MechOutput]) -> Result<bool, CognatesError> {
+    let need_circuits = (opts.curves && opts.curve_mode == CurveMode::Circuits)
+        || opts.any_verify()
+        || opts.metrics;
+    let need_fixed = opts.curves && opts.curve_mode == CurveMode::FixedBranch;
+    let n_u64 = u64::try_from(opts.points_per_circuit).unwrap_or(u64::MAX);
+    let circuits: u64 = mechs.iter().map(|m| m.range.circuits().len() as u64).sum();
+    let intervals: u64 = mechs.iter().map(|m| m.range.intervals().len() as u64).sum();
+    let requested = n_u64
+        .saturating_mul(u64::from(need_circuits) * circuits + u64::from(need_fixed) * intervals);
+    if requested > MAX_POINTS_TOTAL {
+        return Err(CognatesError::TooManyPoints {
+            requested,
+            cap: MAX_POINTS_TOTAL,
+        });
+    }
+    Ok(need_circuits)
+}
+
+/// Paper-style curves: each mechanism's own input over its range on the branch of the snapshot
+/// (defaults, with a notice, without an assembled snapshot).
+fn fixed_branch_curves(
+    input: &CognatesInput,
+    family: &Family,
+    mechs: &mut [MechOutput],
+    (budget, counter): (&Budget, &mut u64),
+    warnings: &mut Vec<Notice>,
+) -> Result<(), CognatesError> {
+    let opts = &input.options;
+    let (branches, defaulted) = fixed_branches(mechs, input.snapshot);
+    if defaulted {
+        warnings.push(notice(
+            NoticeKind::FixedBranchDefaultBranches,
+            "fixed_branch curves need an assembled snapshot to know each mechanism's branch; used original \
+             `branch`, cognate 1 +1, cognate 2 the opposite of `branch`"
+                .to_string(),
+            None,
+        ));
+    }
+    for (idx, m) in mechs.iter_mut().enumerate() {
+        let sweeps = fixed_sweeps(&m.mech, branches[idx]);
+        let (curves, _) = trace(
+            family,
+            idx,
+            &sweeps,
+            (opts.points_per_circuit, opts.spacing, false),
+            None,
+            budget,
+            counter,
+        )?;
+        m.curves = Some(curves);
+    }
+    Ok(())
+}
+
 fn not_assemblable(m: &FourBar, scale: f64) -> CognatesError {
     let links = [
         ("ground", m.ground),
@@ -333,12 +392,12 @@ fn not_assemblable(m: &FourBar, scale: f64) -> CognatesError {
     }
 }
 
-fn warning(code: WarningCode, message: String, mechanism: Option<MechanismId>) -> Warning {
-    Warning {
-        code,
+fn notice(kind: NoticeKind, message: String, mechanism: Option<usize>) -> Notice {
+    Notice {
+        kind,
         message,
         mechanism,
-        angles_deg: None,
+        angles_rad: None,
     }
 }
 
@@ -430,7 +489,7 @@ fn trace(
     family: &Family,
     idx: usize,
     sweeps: &[Sweep],
-    (n, spacing, want_metrics): (usize, super::wire::Spacing, bool),
+    (n, spacing, want_metrics): (usize, Spacing, bool),
     mut sync: Option<&mut SyncAcc>,
     budget: &Budget,
     counter: &mut u64,
@@ -571,48 +630,43 @@ fn collect_warnings(
     input: &CognatesInput,
     family: &Family,
     mechs: &[MechOutput],
-    out: &mut Vec<Warning>,
+    out: &mut Vec<Notice>,
 ) {
     let rtol = input.options.grashof_rtol;
     for (i, m) in mechs.iter().enumerate() {
-        let id = Some(IDS[i]);
+        let id = Some(i);
         let name = NAMES[i];
         if m.grashof.class == GrashofClass::ChangePoint {
-            let folded: Vec<f64> = m
-                .mech
-                .folded_angles(rtol)
-                .into_iter()
-                .map(f64::to_degrees)
-                .collect();
-            out.push(Warning {
-                code: WarningCode::ChangePoint,
+            let folded: Vec<f64> = m.mech.folded_angles(rtol);
+            out.push(Notice {
+                kind: NoticeKind::ChangePoint,
                 message: format!(
                     "{name} is a change-point linkage (s + l = p + q within grashof_rtol, margin {:e}): it can fold \
                      flat at the listed input angles, where both branches meet and the branch labels are ambiguous",
                     m.grashof.margin * input.scale
                 ),
                 mechanism: id,
-                angles_deg: Some(folded),
+                angles_rad: Some(folded),
             });
         }
         match m.grashof.special {
-            Some(Special::Parallelogram) => out.push(warning(
-                WarningCode::Parallelogram,
+            Some(Special::Parallelogram) => out.push(notice(
+                NoticeKind::Parallelogram,
                 format!("{name} is a parallelogram (crank = rocker, coupler = ground): it can switch to the anti-parallelogram mode at the folded positions"),
                 id,
             )),
-            Some(Special::Rhombus) => out.push(warning(
-                WarningCode::Parallelogram,
+            Some(Special::Rhombus) => out.push(notice(
+                NoticeKind::Parallelogram,
                 format!("{name} is a rhombus (all links equal): both a parallelogram and a deltoid"),
                 id,
             )),
-            Some(Special::DeltoidCrankGround) => out.push(warning(
-                WarningCode::Deltoid,
+            Some(Special::DeltoidCrankGround) => out.push(notice(
+                NoticeKind::Deltoid,
                 format!("{name} is a deltoid with crank = ground and coupler = rocker: its crank tip reaches the output pivot"),
                 id,
             )),
-            Some(Special::DeltoidCrankCoupler) => out.push(warning(
-                WarningCode::Deltoid,
+            Some(Special::DeltoidCrankCoupler) => out.push(notice(
+                NoticeKind::Deltoid,
                 format!("{name} is a deltoid with crank = coupler and rocker = ground: the coupler can fold onto the crank"),
                 id,
             )),
@@ -623,21 +677,21 @@ fn collect_warnings(
             Some(Special::DeltoidCrankGround | Special::Rhombus)
         ) {
             let gamma = m.mech.ground_angle();
-            out.push(Warning {
-                code: WarningCode::InputLockedSegment,
+            out.push(Notice {
+                kind: NoticeKind::InputLockedSegment,
                 message: format!(
                     "{name}: at the listed input angle the crank tip sits on the output pivot; coupler and rocker can \
                      then turn about it with the input at rest, so that part of the curve cannot be driven by this \
                      mechanism's input (samples there are excluded or skipped)"
                 ),
                 mechanism: id,
-                angles_deg: Some(vec![wrap_pi(gamma).to_degrees()]),
+                angles_rad: Some(vec![wrap_pi(gamma)]),
             });
         }
     }
     if input.collinear {
-        out.push(warning(
-            WarningCode::CollinearCouplerTriangle,
+        out.push(notice(
+            NoticeKind::CollinearCouplerTriangle,
             "the coupler point lies on the line through the coupler joints: C lies on the line AB and the cognates' \
              coupler triangles are collinear"
                 .to_string(),
@@ -647,33 +701,33 @@ fn collect_warnings(
     let k = family.mechs[0].k;
     let one = C64::new(1.0, 0.0);
     if k.norm() < NEAR_DEGENERATE_K {
-        out.push(warning(
-            WarningCode::NearDegenerateCognate,
+        out.push(notice(
+            NoticeKind::NearDegenerateCognate,
             format!("|k| = {:e} < 1e-3: P is very close to the crank joint; cognate 1 is {:e} times the original", k.norm(), k.norm()),
-            Some(MechanismId::Cognate1),
+            Some(1),
         ));
     }
     if (one - k).norm() < NEAR_DEGENERATE_K {
-        out.push(warning(
-            WarningCode::NearDegenerateCognate,
+        out.push(notice(
+            NoticeKind::NearDegenerateCognate,
             format!(
                 "|1 − k| = {:e} < 1e-3: P is very close to the rocker joint; cognate 2 is {:e} times the original",
                 (one - k).norm(),
                 (one - k).norm()
             ),
-            Some(MechanismId::Cognate2),
+            Some(2),
         ));
     }
     let at_toggle = mechs[0]
         .snapshot
         .is_some_and(|s| s.status == SnapStatus::Toggle);
     if input.joints_at_toggle || at_toggle {
-        out.push(warning(
-            WarningCode::SnapshotAtToggle,
+        out.push(notice(
+            NoticeKind::SnapshotAtToggle,
             "the snapshot is at a toggle of the original (coupler and rocker collinear): both branches meet there, so \
              its branch label is ambiguous"
                 .to_string(),
-            Some(MechanismId::Original),
+            Some(0),
         ));
     }
     let (lo, hi) = family
@@ -683,8 +737,8 @@ fn collect_warnings(
             (lo.min(m.min_length()), hi.max(m.scale()))
         });
     if hi > EXTREME_ASPECT * lo {
-        out.push(warning(
-            WarningCode::ExtremeAspectRatio,
+        out.push(notice(
+            NoticeKind::ExtremeAspectRatio,
             format!(
                 "the lengths of the three mechanisms span {:.3e} (> 1e6): results are exact to rounding but positions \
                  near toggles lose digits in proportion",

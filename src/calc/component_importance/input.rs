@@ -183,6 +183,10 @@ fn weight_pair(v: &mut Validator, pointer: &str, w: &[f64]) -> Option<[f64; 2]> 
 impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
     type Error = CalcFailure;
 
+    #[expect(
+        clippy::too_many_lines,
+        reason = "validates ids, times, overrides, component data, edges and options of the request into one Validator (one 422 listing every offending field); every later section resolves component references through the id map built by the first"
+    )]
     fn try_from(req: ComponentImportanceRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);

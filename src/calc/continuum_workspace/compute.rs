@@ -8,12 +8,24 @@ use super::model::{Model, Params};
 use super::modes::{self, ModeResult, ModeSolution};
 use super::newton::{self, Counter, Failed, NewtonFailure, Solution, Stepping};
 use super::sweep::{self, NodeData, NodeStatus, WaveResult};
-use super::wire::{FkStatus, Mode, SeedKind};
+// Request options carried by the validated input (read only: no wire type is built here).
+use super::wire::{Mode, SeedKind};
 use crate::numerics::{Budget, StopReason};
 
 /// Largest condition number of the scaled Jacobian for an FK answer with determinate rod forces
 /// (the sweep default `cond_max` of spec 4.7; straight over-constrained states reach 1e16-1e18).
 pub const FK_COND_MAX: f64 = 1e12;
+
+/// Outcome of an FK solve (wire form in output.rs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FkStatus {
+    /// Converged and well conditioned.
+    Ok,
+    /// Newton did not converge (no pose).
+    NoConvergence,
+    /// Converged, but the Jacobian is singular (rod forces indeterminate).
+    Singular,
+}
 
 /// FK result.
 #[derive(Debug, Clone)]
@@ -47,8 +59,6 @@ pub struct FkOutput {
 /// One wave of a sweep with its metrics.
 #[derive(Debug, Clone)]
 pub struct WaveOutput {
-    /// Seed kind.
-    pub seed_kind: SeedKind,
     /// Seed node.
     pub seed_node: (usize, usize),
     /// Seed inputs.
@@ -196,111 +206,8 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
     let target = &input.params;
     let mut counter = Counter::default();
     let mut warnings = input.warnings.clone();
-    let mut continuation_steps = 0usize;
-    let mut continuation = None;
-    let mut total_iterations = 0usize;
-    let result: Result<Solution, Failed> = match &input.start {
-        Start::Guess(v) => newton::solve(model, target, v, input.newton, budget, &mut counter)
-            .inspect(|s| {
-                total_iterations = s.iterations;
-            }),
-        Start::AssemblyMode(index) => {
-            let res = modes::search(
-                model,
-                target,
-                input.modes,
-                input.newton,
-                input.segments,
-                budget,
-                &mut counter,
-            );
-            warnings.push(format!(
-                "assembly_mode_search: non-certified grid search found {} solution(s) ({} stable)",
-                res.solutions.len(),
-                res.solutions.iter().filter(|s| s.stable).count()
-            ));
-            match res.solutions.get(*index) {
-                Some(ModeSolution { solution, .. }) => Ok(solution.clone()),
-                None => {
-                    return Err(ContinuumError::AssemblyModeNotFound {
-                        index: *index,
-                        found: res.solutions.len(),
-                        pointer: "/start/index",
-                    });
-                }
-            }
-        }
-        Start::Home => match resolve_home(model) {
-            Some(home) => {
-                let k = input
-                    .continuation_steps
-                    .unwrap_or_else(|| fk::continuation_steps(model, &home.lambda, &target.lambda));
-                continuation = Some(input.stepping);
-                fk::from_home(
-                    model,
-                    &home,
-                    target,
-                    k,
-                    input.stepping,
-                    input.newton,
-                    budget,
-                    &mut counter,
-                )
-                .map(|r| {
-                    continuation_steps = r.steps;
-                    total_iterations = r.newton_iterations;
-                    continuation = Some(r.walked);
-                    if let Some(at) = r.fell_back_at {
-                        warnings.push(format!(
-                            "continuation_fallback: the adaptive path from home stalled at {:.1} % of the way; the spec's {k} equal steps were walked instead",
-                            100.0 * at
-                        ));
-                    }
-                    r.solution
-                })
-            }
-            None => {
-                let res = modes::search(
-                    model,
-                    target,
-                    input.home_fallback_modes,
-                    input.newton,
-                    input.segments,
-                    budget,
-                    &mut counter,
-                );
-                match smallest_angle_stable(model, &res) {
-                    Some(f) => {
-                        warnings.push(format!(
-                            "no_stress_free_home: started from assembly mode {} (the stable solution with the smallest |theta_EE| of a non-certified search with N_grid {}, Tol {}, spec 4.3)",
-                            f.index,
-                            input.home_fallback_modes.n_grid,
-                            input.home_fallback_modes.tol
-                        ));
-                        Ok(f.solution)
-                    }
-                    None => {
-                        warnings.push(
-                            "no_stress_free_home: the design has no stress-free home and the assembly-mode search found no stable solution"
-                                .to_string(),
-                        );
-                        Err(Failed {
-                            reason: match res.stop {
-                                StopReason::Deadline | StopReason::MaxEvaluations => {
-                                    NewtonFailure::Budget(res.stop)
-                                }
-                                _ => NewtonFailure::LineSearch,
-                            },
-                            v: model.home_state([0.0, 0.0]),
-                            residual_inf: f64::INFINITY,
-                            iterations: 0,
-                            progress: 0.0,
-                        })
-                    }
-                }
-            }
-        },
-    };
+    let mut walk = Walk::default();
+    let result = fk_start(input, budget, &mut counter, &mut warnings, &mut walk)?;
     match result {
         Err(f) => {
             if input.start == Start::Home
@@ -328,9 +235,9 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 },
                 cond: crate::numerics::dense::COND_CAP,
                 newton_iterations: f.iterations,
-                total_iterations: total_iterations.max(f.iterations),
-                continuation_steps,
-                continuation,
+                total_iterations: walk.total_iterations.max(f.iterations),
+                continuation_steps: walk.continuation_steps,
+                continuation: walk.continuation,
                 segments: None,
                 warnings,
                 evaluations: counter.evaluations,
@@ -374,9 +281,9 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
                 residual_inf: sol.eval.norm_inf(),
                 cond,
                 newton_iterations: sol.iterations,
-                total_iterations: total_iterations.max(sol.iterations),
-                continuation_steps,
-                continuation,
+                total_iterations: walk.total_iterations.max(sol.iterations),
+                continuation_steps: walk.continuation_steps,
+                continuation: walk.continuation,
                 segments,
                 solution: Some((sol, described)),
                 warnings,
@@ -385,6 +292,135 @@ fn run_fk(input: &Input, budget: &Budget) -> Result<FkOutput, ContinuumError> {
             })
         }
     }
+}
+
+/// Continuation statistics of an FK solve.
+#[derive(Debug, Default)]
+struct Walk {
+    /// Continuation steps taken from home.
+    continuation_steps: usize,
+    /// Step control of the continuation walked from home (None: no continuation from home).
+    continuation: Option<Stepping>,
+    /// Newton iterations over all solves so far.
+    total_iterations: usize,
+}
+
+/// The FK solve from the requested start (spec 4.3): Newton from a guess, assembly mode `index`
+/// of a search, or continuation from the stress-free home (without one: the stable mode with
+/// the smallest |theta_EE|). The inner result is the solve's; the outer error a missing mode.
+fn fk_start(
+    input: &Input,
+    budget: &Budget,
+    counter: &mut Counter,
+    warnings: &mut Vec<String>,
+    walk: &mut Walk,
+) -> Result<Result<Solution, Failed>, ContinuumError> {
+    let model = &input.model;
+    let target = &input.params;
+    let result = match &input.start {
+        Start::Guess(v) => {
+            newton::solve(model, target, v, input.newton, budget, counter).inspect(|s| {
+                walk.total_iterations = s.iterations;
+            })
+        }
+        Start::AssemblyMode(index) => {
+            let res = modes::search(
+                model,
+                target,
+                input.modes,
+                input.newton,
+                input.segments,
+                budget,
+                counter,
+            );
+            warnings.push(format!(
+                "assembly_mode_search: non-certified grid search found {} solution(s) ({} stable)",
+                res.solutions.len(),
+                res.solutions.iter().filter(|s| s.stable).count()
+            ));
+            match res.solutions.get(*index) {
+                Some(ModeSolution { solution, .. }) => Ok(solution.clone()),
+                None => {
+                    return Err(ContinuumError::AssemblyModeNotFound {
+                        index: *index,
+                        found: res.solutions.len(),
+                        pointer: "/start/index",
+                    });
+                }
+            }
+        }
+        Start::Home => match resolve_home(model) {
+            Some(home) => {
+                let k = input
+                    .continuation_steps
+                    .unwrap_or_else(|| fk::continuation_steps(model, &home.lambda, &target.lambda));
+                walk.continuation = Some(input.stepping);
+                fk::from_home(
+                    model,
+                    &home,
+                    target,
+                    k,
+                    input.stepping,
+                    input.newton,
+                    budget,
+                    counter,
+                )
+                .map(|r| {
+                    walk.continuation_steps = r.steps;
+                    walk.total_iterations = r.newton_iterations;
+                    walk.continuation = Some(r.walked);
+                    if let Some(at) = r.fell_back_at {
+                        warnings.push(format!(
+                            "continuation_fallback: the adaptive path from home stalled at {:.1} % of the way; the spec's {k} equal steps were walked instead",
+                            100.0 * at
+                        ));
+                    }
+                    r.solution
+                })
+            }
+            None => {
+                let res = modes::search(
+                    model,
+                    target,
+                    input.home_fallback_modes,
+                    input.newton,
+                    input.segments,
+                    budget,
+                    counter,
+                );
+                match smallest_angle_stable(model, &res) {
+                    Some(f) => {
+                        warnings.push(format!(
+                            "no_stress_free_home: started from assembly mode {} (the stable solution with the smallest |theta_EE| of a non-certified search with N_grid {}, Tol {}, spec 4.3)",
+                            f.index,
+                            input.home_fallback_modes.n_grid,
+                            input.home_fallback_modes.tol
+                        ));
+                        Ok(f.solution)
+                    }
+                    None => {
+                        warnings.push(
+                            "no_stress_free_home: the design has no stress-free home and the assembly-mode search found no stable solution"
+                                .to_string(),
+                        );
+                        Err(Failed {
+                            reason: match res.stop {
+                                StopReason::Deadline | StopReason::MaxEvaluations => {
+                                    NewtonFailure::Budget(res.stop)
+                                }
+                                _ => NewtonFailure::LineSearch,
+                            },
+                            v: model.home_state([0.0, 0.0]),
+                            residual_inf: f64::INFINITY,
+                            iterations: 0,
+                            progress: 0.0,
+                        })
+                    }
+                }
+            }
+        },
+    };
+    Ok(result)
 }
 
 /// Seed candidates of the sweep: (kind, mode index, solution or failure status).
@@ -419,12 +455,7 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
     let mut warnings = input.warnings.clone();
     let mut counter = Counter::default();
     let home = resolve_home(model);
-    let SeedInput {
-        kind,
-        inputs,
-        state,
-        index,
-    } = &sw.seed;
+    let SeedInput { inputs, .. } = &sw.seed;
     let seed_x = inputs.unwrap_or_else(|| match &home {
         Some(h) => [h.lambda[0], h.lambda[1]],
         None => [
@@ -439,93 +470,15 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
         force: input.params.force,
         moment: input.params.moment,
     };
-    let fail = |f: Failed| match f.reason {
-        NewtonFailure::Budget(_) => NodeStatus::Unvisited,
-        _ => NodeStatus::NoConvergence,
-    };
-    let mut seeds: Vec<SeedResult> = Vec::new();
-    let search = |counter: &mut Counter, settings: modes::ModeSearch| {
-        modes::search(
-            model,
-            &params0,
-            settings,
-            input.newton,
-            input.segments,
-            budget,
-            counter,
-        )
-    };
-    match kind {
-        SeedKind::Home => {
-            match &home {
-                Some(h) => {
-                    let k = fk::continuation_steps(model, &h.lambda, &lam0);
-                    let r = fk::from_home(
-                        model,
-                        h,
-                        &params0,
-                        k,
-                        input.stepping,
-                        input.newton,
-                        budget,
-                        &mut counter,
-                    );
-                    seeds.push((None, r.map(|r| r.solution).map_err(fail)));
-                }
-                None => {
-                    let res = search(&mut counter, input.home_fallback_modes);
-                    match smallest_angle_stable(model, &res) {
-                        Some(f) => {
-                            warnings.push(format!(
-                            "no_stress_free_home: the wave starts from assembly mode {} (stable, smallest |theta_EE|, non-certified search with N_grid {}, Tol {})",
-                            f.index,
-                            input.home_fallback_modes.n_grid,
-                            input.home_fallback_modes.tol
-                        ));
-                            seeds.push((Some(f.index), Ok(f.solution)));
-                        }
-                        None => {
-                            warnings.push("no_stress_free_home: no stable assembly mode found at the seed node".to_string());
-                            seeds.push((None, Err(NodeStatus::Unstable)));
-                        }
-                    }
-                }
-            }
-        }
-        SeedKind::Guess => {
-            let v0 = state
-                .clone()
-                .unwrap_or_else(|| model.home_state([0.0, 0.0]));
-            let r = newton::solve(model, &params0, &v0, input.newton, budget, &mut counter);
-            seeds.push((None, r.map_err(fail)));
-        }
-        SeedKind::AssemblyMode => {
-            let res = search(&mut counter, input.modes);
-            match res.solutions.get(*index) {
-                Some(m) => seeds.push((Some(*index), Ok(m.solution.clone()))),
-                None => {
-                    return Err(ContinuumError::AssemblyModeNotFound {
-                        index: *index,
-                        found: res.solutions.len(),
-                        pointer: "/workspace/seed/index",
-                    });
-                }
-            }
-        }
-        SeedKind::AllStableModes => {
-            let res = search(&mut counter, input.modes);
-            for (i, m) in res.solutions.iter().enumerate().filter(|(_, m)| m.stable) {
-                seeds.push((Some(i), Ok(m.solution.clone())));
-            }
-            if seeds.is_empty() {
-                warnings.push(
-                    "all_stable_modes: the non-certified search found no stable assembly mode"
-                        .to_string(),
-                );
-                seeds.push((None, Err(NodeStatus::Unstable)));
-            }
-        }
-    }
+    let seeds = workspace_seeds(
+        input,
+        &sw.seed,
+        home.as_ref(),
+        (lam0, &params0),
+        budget,
+        &mut counter,
+        &mut warnings,
+    )?;
     let n = s.grid[0] * s.grid[1];
     let mut waves = Vec::with_capacity(seeds.len());
     let mut evaluations = counter.evaluations;
@@ -574,7 +527,6 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
         }
         let metrics = metrics(model, s.grid, &wave, sw.qt_threshold, sw.union);
         waves.push(WaveOutput {
-            seed_kind: *kind,
             seed_node: node,
             seed_inputs: lam0,
             seed_status,
@@ -600,6 +552,112 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
         attempts,
         stop,
     })
+}
+
+/// The seeds of the sweep's waves at the seed node (spec 4.7), by seed kind: continuation from
+/// home (without a home: the stable assembly mode with the smallest |theta_EE|), Newton from a
+/// given state, one assembly mode, or every stable assembly mode (one wave each).
+fn workspace_seeds(
+    input: &Input,
+    seed: &SeedInput,
+    home: Option<&Home>,
+    (lam0, p0): ([f64; 2], &Params),
+    budget: &Budget,
+    counter: &mut Counter,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<SeedResult>, ContinuumError> {
+    let model = &input.model;
+    let SeedInput {
+        kind, state, index, ..
+    } = seed;
+    let fail = |f: Failed| match f.reason {
+        NewtonFailure::Budget(_) => NodeStatus::Unvisited,
+        _ => NodeStatus::NoConvergence,
+    };
+    let mut seeds: Vec<SeedResult> = Vec::new();
+    let search = |counter: &mut Counter, settings: modes::ModeSearch| {
+        modes::search(
+            model,
+            p0,
+            settings,
+            input.newton,
+            input.segments,
+            budget,
+            counter,
+        )
+    };
+    match kind {
+        SeedKind::Home => {
+            match home {
+                Some(h) => {
+                    let k = fk::continuation_steps(model, &h.lambda, &lam0);
+                    let r = fk::from_home(
+                        model,
+                        h,
+                        p0,
+                        k,
+                        input.stepping,
+                        input.newton,
+                        budget,
+                        counter,
+                    );
+                    seeds.push((None, r.map(|r| r.solution).map_err(fail)));
+                }
+                None => {
+                    let res = search(counter, input.home_fallback_modes);
+                    match smallest_angle_stable(model, &res) {
+                        Some(f) => {
+                            warnings.push(format!(
+                            "no_stress_free_home: the wave starts from assembly mode {} (stable, smallest |theta_EE|, non-certified search with N_grid {}, Tol {})",
+                            f.index,
+                            input.home_fallback_modes.n_grid,
+                            input.home_fallback_modes.tol
+                        ));
+                            seeds.push((Some(f.index), Ok(f.solution)));
+                        }
+                        None => {
+                            warnings.push("no_stress_free_home: no stable assembly mode found at the seed node".to_string());
+                            seeds.push((None, Err(NodeStatus::Unstable)));
+                        }
+                    }
+                }
+            }
+        }
+        SeedKind::Guess => {
+            let v0 = state
+                .clone()
+                .unwrap_or_else(|| model.home_state([0.0, 0.0]));
+            let r = newton::solve(model, p0, &v0, input.newton, budget, counter);
+            seeds.push((None, r.map_err(fail)));
+        }
+        SeedKind::AssemblyMode => {
+            let res = search(counter, input.modes);
+            match res.solutions.get(*index) {
+                Some(m) => seeds.push((Some(*index), Ok(m.solution.clone()))),
+                None => {
+                    return Err(ContinuumError::AssemblyModeNotFound {
+                        index: *index,
+                        found: res.solutions.len(),
+                        pointer: "/workspace/seed/index",
+                    });
+                }
+            }
+        }
+        SeedKind::AllStableModes => {
+            let res = search(counter, input.modes);
+            for (i, m) in res.solutions.iter().enumerate().filter(|(_, m)| m.stable) {
+                seeds.push((Some(i), Ok(m.solution.clone())));
+            }
+            if seeds.is_empty() {
+                warnings.push(
+                    "all_stable_modes: the non-certified search found no stable assembly mode"
+                        .to_string(),
+                );
+                seeds.push((None, Err(NodeStatus::Unstable)));
+            }
+        }
+    }
+    Ok(seeds)
 }
 
 /// Metrics of one wave (spec 4.8).

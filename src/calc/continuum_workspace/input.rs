@@ -165,6 +165,10 @@ fn usize_of(x: u32) -> usize {
 }
 
 /// Validate the design part; returns the design (possibly partial when invalid).
+#[expect(
+    clippy::too_many_lines,
+    reason = "a preset, or the explicit design: actuators, then rods with their checks against the actuators just validated (actuator index, slenderness), then the home inputs; returns the (possibly partial) design with every problem pushed to the shared Validator"
+)]
 fn design_of(
     req: &ContinuumWorkspaceRequest,
     v: &mut Validator,
@@ -365,6 +369,10 @@ fn design_of(
 impl TryFrom<&ContinuumWorkspaceRequest> for Input {
     type Error = CalcFailure;
 
+    #[expect(
+        clippy::too_many_lines,
+        reason = "validates every section of spec 3 in request order (design, loads, inputs, start, outputs, mode search, time limit, workspace) into one Validator so one 422 lists every offending field; the start, the workspace seed and the decision to run the mode search depend on the model and home built by the earlier sections"
+    )]
     fn try_from(req: &ContinuumWorkspaceRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let mut warnings = Vec::new();

@@ -170,20 +170,31 @@ pub fn combinations(n_grid: usize, n_rods: usize) -> f64 {
     (2.0 * n_grid as f64).powi(i32::try_from(2 * n_rods).unwrap_or(i32::MAX))
 }
 
-/// Run the search at `params`.
-pub fn search(
+/// The candidates of the grid scan (spec 4.6): every combination of tabulated rod solutions whose
+/// force and moment balance and platform fit are within `tol`, the best one per cell.
+struct Scan {
+    /// Best candidate per cell key.
+    best: BTreeMap<Vec<u32>, Candidate>,
+    /// Combinations within tolerance.
+    candidates: u64,
+    /// Combinations examined.
+    combos: u64,
+    /// Completed, or the budget's stop reason.
+    stop: StopReason,
+}
+
+/// Scan the combinations of the rods' grid tables `tables` (odometer over all rods but the
+/// last, a window query on the sorted force of the last rod) and keep the best candidate per
+/// cell.
+fn scan_grid(
     model: &Model,
     params: &Params,
+    tables: &[Vec<GridPoint>],
     settings: ModeSearch,
-    opts: NewtonOptions,
-    segments: usize,
     budget: &Budget,
     counter: &mut Counter,
-) -> ModeResult {
+) -> Scan {
     let nr = model.n_rods();
-    let tables: Vec<Vec<GridPoint>> = (0..nr)
-        .map(|i| table(model, i, &params.lambda, settings.n_grid))
-        .collect();
     let attach: Vec<[f64; 2]> = model.design.rods.iter().map(|r| r.attach).collect();
     let (l_ref, f_ref) = (model.l_ref, model.f_ref);
     let tol = settings.tol;
@@ -292,7 +303,32 @@ pub fn search(
             }
         }
     }
-    let mut cands: Vec<Candidate> = best.into_values().collect();
+    Scan {
+        best,
+        candidates,
+        combos,
+        stop,
+    }
+}
+
+/// Run the search at `params`.
+pub fn search(
+    model: &Model,
+    params: &Params,
+    settings: ModeSearch,
+    opts: NewtonOptions,
+    segments: usize,
+    budget: &Budget,
+    counter: &mut Counter,
+) -> ModeResult {
+    let nr = model.n_rods();
+    let tables: Vec<Vec<GridPoint>> = (0..nr)
+        .map(|i| table(model, i, &params.lambda, settings.n_grid))
+        .collect();
+    let l_ref = model.l_ref;
+    let scan = scan_grid(model, params, &tables, settings, budget, counter);
+    let (candidates, combos, mut stop) = (scan.candidates, scan.combos, scan.stop);
+    let mut cands: Vec<Candidate> = scan.best.into_values().collect();
     cands.sort_by(|a, b| a.residual.total_cmp(&b.residual));
     let mut solutions: Vec<ModeSolution> = Vec::new();
     let mut refined = 0u64;

@@ -47,6 +47,7 @@ pub mod efficiency;
 pub mod error;
 pub mod geometry;
 pub mod input;
+pub mod output;
 pub mod stress;
 pub mod wire;
 

@@ -317,28 +317,10 @@ pub struct StructureIssue {
 /// every SHAP term) far from overflow.
 pub const MAX_ABS_VALUE: f64 = 1e100;
 
-/// Validates a document tree and returns it in breadth-first order. `at` is the pointer of the
-/// tree object; `n_features` bounds the feature indices.
-///
-/// Checks: equal array lengths; the root exists; every node reached from the root has either two
-/// children in range or none (−1, −1); no node is reached twice (a cycle or a shared child);
-/// depth ≤ [`MAX_TREE_DEPTH`]; features of internal nodes in `0..n_features`; thresholds finite;
-/// values finite with |v| ≤ [`MAX_ABS_VALUE`]; covers finite and ≥ 0. Nodes not reachable from
-/// the root (XGBoost keeps pruned nodes in its arrays) are ignored.
-///
-/// # Errors
-/// The first defect found, with its pointer.
-pub fn build_tree(
-    raw: &RawTree,
-    names: RawNames,
-    at: &str,
-    n_features: usize,
-) -> Result<Tree, StructureIssue> {
+/// The number of nodes of a document tree: every node array as long as the left-child array,
+/// and at least the root.
+fn node_count(raw: &RawTree, names: RawNames, at: &str) -> Result<usize, StructureIssue> {
     let n = raw.left.len();
-    let issue = |field: &str, i: usize, detail: String| StructureIssue {
-        pointer: format!("{at}/{field}/{i}"),
-        detail,
-    };
     let lengths = [
         (names.right, raw.right.len()),
         (names.feature, raw.feature.len()),
@@ -360,6 +342,31 @@ pub fn build_tree(
             detail: "a tree needs at least its root node".to_owned(),
         });
     }
+    Ok(n)
+}
+
+/// Validates a document tree and returns it in breadth-first order. `at` is the pointer of the
+/// tree object; `n_features` bounds the feature indices.
+///
+/// Checks: equal array lengths; the root exists; every node reached from the root has either two
+/// children in range or none (−1, −1); no node is reached twice (a cycle or a shared child);
+/// depth ≤ [`MAX_TREE_DEPTH`]; features of internal nodes in `0..n_features`; thresholds finite;
+/// values finite with |v| ≤ [`MAX_ABS_VALUE`]; covers finite and ≥ 0. Nodes not reachable from
+/// the root (XGBoost keeps pruned nodes in its arrays) are ignored.
+///
+/// # Errors
+/// The first defect found, with its pointer.
+pub fn build_tree(
+    raw: &RawTree,
+    names: RawNames,
+    at: &str,
+    n_features: usize,
+) -> Result<Tree, StructureIssue> {
+    let n = node_count(raw, names, at)?;
+    let issue = |field: &str, i: usize, detail: String| StructureIssue {
+        pointer: format!("{at}/{field}/{i}"),
+        detail,
+    };
     let optional = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(0.0);
     let mut seen = vec![false; n];
     seen[0] = true;

@@ -5,11 +5,12 @@ use crate::calc::common::Warning;
 use crate::numerics::{Budget, SolverReport, StopReason};
 
 use super::boost::{BoostParams, Method};
-use super::compute::{AnalyzeOutput, PredictOutput, ShapSummary, TrainOutput};
+use super::compute::{AnalyzeOutput, Importance, PredictOutput, ShapSummary, TrainOutput};
 use super::data::{Metrics, mean_sd};
 use super::document::{FORMAT, OBJECTIVE};
 use super::input::{AnalyzeInput, PredictInput, TrainInput};
 use super::model::{Model, ModelSource, Routing, Tree};
+use super::pca::Pca;
 use super::smogn::Smogn;
 use super::wire::{
     AnalyzeResponse, ConstantColumn, CvMetrics, FeatureImportance, FeatureShap, GbdtModel,
@@ -214,15 +215,16 @@ fn off_grid_warning(s: &SmognOut, pointer: &str) -> Option<Warning> {
     })
 }
 
-/// The `/train` response.
-#[must_use]
-pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> TrainResponse {
-    let p = &input.params;
-    let model = &out.model;
-    let rounds = model.trees.len();
-    let effective = model.effective_trees();
+/// The training run's warnings, in order: rounds stopped early (a zero-leaf round) or
+/// interrupted, and too few trees with a split.
+fn training_warnings(
+    p: &BoostParams,
+    rounds: usize,
+    effective: usize,
+    stop: StopReason,
+) -> Vec<Warning> {
     let mut warnings = Vec::new();
-    match out.stop {
+    match stop {
         StopReason::Converged => warnings.push(Warning::new(
             "ROUNDS_STOPPED_EARLY",
             format!(
@@ -253,6 +255,37 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
             ),
         ));
     }
+    warnings
+}
+
+/// Feature importances by name, with the per-split means and the share of the total gain.
+fn importance_out(imp: &[Importance], names: &[String]) -> Vec<FeatureImportance> {
+    let total: f64 = imp.iter().map(|i| i.gain).sum();
+    imp.iter()
+        .zip(names)
+        .map(|(i, name)| {
+            let w = f64::from(i.weight.max(1));
+            FeatureImportance {
+                feature: name.clone(),
+                weight: i.weight,
+                gain: i.gain,
+                gain_mean: if i.weight > 0 { i.gain / w } else { 0.0 },
+                gain_share: if total > 0.0 { i.gain / total } else { 0.0 },
+                cover: i.cover,
+                cover_mean: if i.weight > 0 { i.cover / w } else { 0.0 },
+            }
+        })
+        .collect()
+}
+
+/// The `/train` response.
+#[must_use]
+pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> TrainResponse {
+    let p = &input.params;
+    let model = &out.model;
+    let rounds = model.trees.len();
+    let effective = model.effective_trees();
+    let mut warnings = training_warnings(p, rounds, effective, out.stop);
     let cv = out.cv.as_ref().and_then(|cv| {
         if let Some(stop) = cv.stopped {
             warnings.push(Warning::at(
@@ -310,24 +343,10 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
         }
         o
     });
-    let importance = out.importance.as_ref().map(|imp| {
-        let total: f64 = imp.iter().map(|i| i.gain).sum();
-        imp.iter()
-            .zip(&input.names)
-            .map(|(i, name)| {
-                let w = f64::from(i.weight.max(1));
-                FeatureImportance {
-                    feature: name.clone(),
-                    weight: i.weight,
-                    gain: i.gain,
-                    gain_mean: if i.weight > 0 { i.gain / w } else { 0.0 },
-                    gain_share: if total > 0.0 { i.gain / total } else { 0.0 },
-                    cover: i.cover,
-                    cover_mean: if i.weight > 0 { i.cover / w } else { 0.0 },
-                }
-            })
-            .collect()
-    });
+    let importance = out
+        .importance
+        .as_ref()
+        .map(|imp| importance_out(imp, &input.names));
     let test_predictions = input.outputs.test_predictions.then(|| TestPredictions {
         rows: out.test_rows.clone(),
         target: out.test_rows.iter().map(|&r| input.y[r as usize]).collect(),
@@ -429,6 +448,62 @@ pub fn respond_predict(
     }
 }
 
+/// The PCA section with its warnings (components clamped to the varying features, near-equal
+/// kept eigenvalues) and the cumulative contribution rates.
+fn pca_out(
+    input: &AnalyzeInput,
+    out: &AnalyzeOutput,
+    p: &Pca,
+    warnings: &mut Vec<Warning>,
+) -> PcaOut {
+    let asked = input.pca.and_then(|(k, _)| k);
+    if let Some(k) = asked.filter(|&k| k > out.varying.len()) {
+        warnings.push(Warning::at(
+            "PCA_COMPONENTS_CLAMPED",
+            "/pca/components",
+            format!(
+                "{k} components asked, {} non-constant features: all of them are kept",
+                out.varying.len()
+            ),
+        ));
+    }
+    let kept = p.loadings.len();
+    let gap = p.eigenvalues[..kept.min(p.eigenvalues.len())]
+        .windows(2)
+        .map(|w| (w[0] - w[1]) / w[0].max(f64::MIN_POSITIVE))
+        .fold(f64::INFINITY, f64::min);
+    if gap < NEAR_EQUAL_EIGEN {
+        warnings.push(Warning::at(
+            "NEAR_EQUAL_EIGENVALUES",
+            "/pca",
+            format!(
+                "kept eigenvalues differ by as little as {:.1} %: those components are not \
+                 well defined and the composite score depends on rounding (spec §8 hazard 8)",
+                100.0 * gap
+            ),
+        ));
+    }
+    let mut cumulative = Vec::with_capacity(p.rates.len());
+    let mut acc = 0.0;
+    for r in &p.rates {
+        acc += r;
+        cumulative.push(acc);
+    }
+    PcaOut {
+        features: out
+            .varying
+            .iter()
+            .map(|&f| input.names[f].clone())
+            .collect(),
+        eigenvalues: p.eigenvalues.clone(),
+        contribution_rates: p.rates.clone(),
+        cumulative_rates: cumulative,
+        loadings: p.loadings.clone(),
+        composite_scores: p.composite.clone(),
+        scores: p.scores.clone(),
+    }
+}
+
 /// The `/analyze` response.
 #[must_use]
 pub fn respond_analyze(
@@ -444,50 +519,10 @@ pub fn respond_analyze(
             "every feature is constant: PCA and GRA have nothing to analyse",
         ));
     }
-    let pca = out.pca.as_ref().map(|p| {
-        let asked = input.pca.and_then(|(k, _)| k);
-        if let Some(k) = asked.filter(|&k| k > out.varying.len()) {
-            warnings.push(Warning::at(
-                "PCA_COMPONENTS_CLAMPED",
-                "/pca/components",
-                format!(
-                    "{k} components asked, {} non-constant features: all of them are kept",
-                    out.varying.len()
-                ),
-            ));
-        }
-        let kept = p.loadings.len();
-        let gap = p.eigenvalues[..kept.min(p.eigenvalues.len())]
-            .windows(2)
-            .map(|w| (w[0] - w[1]) / w[0].max(f64::MIN_POSITIVE))
-            .fold(f64::INFINITY, f64::min);
-        if gap < NEAR_EQUAL_EIGEN {
-            warnings.push(Warning::at(
-                "NEAR_EQUAL_EIGENVALUES",
-                "/pca",
-                format!(
-                    "kept eigenvalues differ by as little as {:.1} %: those components are not \
-                     well defined and the composite score depends on rounding (spec §8 hazard 8)",
-                    100.0 * gap
-                ),
-            ));
-        }
-        let mut cumulative = Vec::with_capacity(p.rates.len());
-        let mut acc = 0.0;
-        for r in &p.rates {
-            acc += r;
-            cumulative.push(acc);
-        }
-        PcaOut {
-            features: out.varying.iter().map(|&f| names[f].clone()).collect(),
-            eigenvalues: p.eigenvalues.clone(),
-            contribution_rates: p.rates.clone(),
-            cumulative_rates: cumulative,
-            loadings: p.loadings.clone(),
-            composite_scores: p.composite.clone(),
-            scores: p.scores.clone(),
-        }
-    });
+    let pca = out
+        .pca
+        .as_ref()
+        .map(|p| pca_out(input, out, p, &mut warnings));
     let gra = out
         .gra
         .as_ref()

@@ -56,6 +56,10 @@ pub struct CmaParams {
 /// One CMA-ES run from `x0` (free genes) with the given settings. Returns the best point of the
 /// run (folded genes) and why it stopped.
 // Hansen's default constants read best in their published form.
+#[expect(
+    clippy::too_many_lines,
+    reason = "one CMA-ES run in the order of Hansen's tutorial (sample the generation, rank, recombine, update the evolution paths, covariance and step size, decompose, termination tests); every step updates the same strategy state"
+)]
 pub fn run<M: CurveModel, R: Rng>(
     ctx: &mut Ctx<'_, M>,
     free: &FreeGenes,

@@ -2,6 +2,7 @@
 //! "Algorithm"; efficiency paper eqs 7–23).
 
 use super::input::EfficiencyInput;
+// Request options carried by the validated input (read only: no wire type is built here).
 use super::wire::EfficiencyModel;
 use crate::calc::irefc::error::IrefcError;
 use crate::calc::irefc::geometry::Geometry;

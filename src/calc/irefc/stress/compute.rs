@@ -6,6 +6,7 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::input::{Design, StressParams, SweepInput};
+// Request options carried by the validated input (read only: no wire type is built here).
 use super::wire::{LoadSharing, OutputLink};
 use crate::calc::irefc::error::IrefcError;
 use crate::calc::irefc::geometry::{AnglePoint, Geometry, Trig, Wheel};
