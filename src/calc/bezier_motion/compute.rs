@@ -249,8 +249,8 @@ pub fn compute(input: &BezierInput, budget: &Budget) -> Result<BezierOutput, Bez
             what: "residual energy",
         });
     }
-    law_warnings(input, &plant, &law, &gamma, &mut warnings);
     let kin = input.kinematics.then(|| kinematics(&law));
+    law_warnings(input, &plant, &law, (&gamma, kin.as_ref()), &mut warnings);
     let sensitivity = match &input.sensitivity {
         None => None,
         Some(factors) => Some(sensitivity(
@@ -326,7 +326,7 @@ fn law_warnings(
     input: &BezierInput,
     plant: &Plant,
     law: &BezierLaw,
-    gamma: &[f64],
+    (gamma, kin): (&[f64], Option<&Kinematics>),
     warnings: &mut Vec<Warning>,
 ) {
     let gmax = gamma.iter().fold(0.0_f64, |m, g| m.max(g.abs())) / input.phi.abs();
@@ -340,7 +340,8 @@ fn law_warnings(
         ));
     }
     if polygon_against_motion(law) {
-        if reverses(law) {
+        // The peaks' own check when they were computed (the same samples and refinements).
+        if kin.map_or_else(|| reverses(law), |k| k.motion_reversal) {
             warnings.push(Warning::new(
                 "MOTION_REVERSAL",
                 "the motor velocity changes sign during the move (the law reverses)",

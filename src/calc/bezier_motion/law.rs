@@ -96,11 +96,24 @@ pub fn de_casteljau(c: &[f64], lam: f64) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    let mut b: [f64; 64] = [0.0; 64];
-    if n > b.len() {
-        return bernstein_sum(c, lam);
+    // A small stack buffer for the usual degrees (zeroing 64 slots per call cost more than the
+    // recurrence itself at N ≈ 6), the large one up to 63, the basis sum beyond.
+    if n <= 16 {
+        let mut b = [0.0; 16];
+        b[..n].copy_from_slice(c);
+        casteljau_in_place(&mut b[..n], lam)
+    } else if n <= 64 {
+        let mut b = [0.0; 64];
+        b[..n].copy_from_slice(c);
+        casteljau_in_place(&mut b[..n], lam)
+    } else {
+        bernstein_sum(c, lam)
     }
-    b[..n].copy_from_slice(c);
+}
+
+/// De Casteljau's recurrence on `b` (overwritten); returns the value at `λ`.
+fn casteljau_in_place(b: &mut [f64], lam: f64) -> f64 {
+    let n = b.len();
     let mu = 1.0 - lam;
     for r in 1..n {
         for i in 0..n - r {
