@@ -9,8 +9,9 @@ use super::motor::{MotorInput, MotorKind};
 use super::sim::Vehicle;
 use super::wire as w;
 use super::wire::{
-    AcFactorSpec, BatteryModel, BatterySpec, BusFuelEconomyRequest, CycleSpec, EnvelopeTable,
-    GridSpec, IpmsmMotor, Mode, MotorEval, MotorSpec, OutputKind, PowerConvention, VehicleSpec,
+    AcFactorSpec, BatteryModel, BatterySpec, BusFuelEconomyRequest, CycleSpec, EfficiencyMapMotor,
+    EnvelopeTable, GridSpec, IpmsmMotor, LossMapMotor, Mode, MotorEval, MotorSpec, OptionsSpec,
+    OutputKind, PowerConvention, VehicleSpec,
 };
 use crate::calc::{CalcFailure, ProblemClass, Range, Validator};
 
@@ -509,20 +510,10 @@ fn envelope(
     (env, rpm_to_rad_s(n_max))
 }
 
-#[expect(
-    clippy::too_many_lines,
-    reason = "validates the IPMSM block field by field (pole pairs, psi_m or back-EMF, dq inductances, winding, current and voltage limits, torque/power caps, AC factor, iron and mechanical losses, stack scale), each check a few lines with its own pointer, into the one IpmsmParams literal at its end"
-)]
-fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
-    let p = format!("{base}/");
-    v.uint(
-        &format!("{p}pole_pairs"),
-        "",
-        u64::from(m.pole_pairs),
-        w::POLE_PAIRS,
-    );
-    let pp = f64::from(m.pole_pairs).clamp(w::POLE_PAIRS.lo, w::POLE_PAIRS.hi);
-    let psi = match (m.psi_m_wb, &m.back_emf) {
+/// ψ_m of an IPMSM (`p` = `{base}/`), given directly or from the back-EMF at `pp` pole pairs
+/// (NaN when neither or both are given).
+fn psi_m(v: &mut Validator, base: &str, p: &str, m: &IpmsmMotor, pp: f64) -> f64 {
+    match (m.psi_m_wb, &m.back_emf) {
         (Some(psi), None) => {
             v.range(&format!("{p}psi_m_wb"), "", psi, w::PSI_M_WB);
             psi
@@ -555,40 +546,15 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
             v.push(base, "needs psi_m_wb or back_emf".to_owned());
             f64::NAN
         }
-    };
-    let ld_ok = v.range(&format!("{p}ld_h"), "", m.ld_h, w::INDUCTANCE_H);
-    let lq_ok = v.range(&format!("{p}lq_h"), "", m.lq_h, w::INDUCTANCE_H);
-    if ld_ok && lq_ok && m.lq_h < m.ld_h {
-        v.push(
-            format!("{p}lq_h"),
-            format!("must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}", m.ld_h, m.lq_h),
-        );
     }
-    let temp = m.winding_temp_c.unwrap_or(100.0);
-    let util = m.voltage_utilization.unwrap_or(1.0);
-    let fields = [
-        ("r_phase_20c_ohm", m.r_phase_20c_ohm, w::R_PHASE_OHM),
-        ("winding_temp_c", temp, w::WINDING_TEMP_C),
-        ("i_max_arms", m.i_max_arms, w::ELECTRIC_LIMIT),
-        ("v_dc", m.v_dc, w::ELECTRIC_LIMIT),
-        ("voltage_utilization", util, w::VOLTAGE_UTILIZATION),
-        ("n_max_rpm", m.n_max_rpm, w::N_MAX_RPM),
-    ];
-    for (name, x, range) in fields {
-        v.range(&format!("{p}{name}"), "", x, range);
-    }
-    let t_cap = m.t_cap_nm.unwrap_or(f64::INFINITY);
-    if m.t_cap_nm.is_some() {
-        v.range(&format!("{p}t_cap_nm"), "", t_cap, w::TORQUE_NM);
-    }
-    let p_cap = m.p_cap_w.unwrap_or(f64::INFINITY);
-    if m.p_cap_w.is_some() {
-        v.range(&format!("{p}p_cap_w"), "", p_cap, w::POWER_W);
-    }
-    let ac = match &m.ac_factor {
+}
+
+/// The AC resistance factor of an IPMSM (`p` = `{base}/`).
+fn ac_factor(v: &mut Validator, p: &str, spec: Option<&AcFactorSpec>) -> AcFactor {
+    let ap = format!("{p}ac_factor");
+    match spec {
         None | Some(AcFactorSpec::NoAc(_)) => AcFactor::None,
         Some(AcFactorSpec::Table(t)) => {
-            let ap = format!("{p}ac_factor");
             axis(v, &format!("{ap}/freq_hz"), &t.freq_hz, 1, w::FREQ_HZ);
             if t.k_ac.len() != t.freq_hz.len() {
                 v.push(
@@ -608,7 +574,6 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
             }
         }
         Some(AcFactorSpec::Dowell(d)) => {
-            let ap = format!("{p}ac_factor");
             let fields = [
                 (
                     "conductor_height_m",
@@ -631,7 +596,71 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
                 end_length_m: d.end_length_m,
             })
         }
-    };
+    }
+}
+
+/// The scalar fields of an IPMSM after ψ_m (`p` = `{base}/`): dq inductances, winding, current
+/// and voltage limits, speed limit; returns the winding temperature and voltage utilization
+/// with their defaults applied.
+fn ipmsm_ratings(v: &mut Validator, p: &str, m: &IpmsmMotor) -> (f64, f64) {
+    let ld_ok = v.range(&format!("{p}ld_h"), "", m.ld_h, w::INDUCTANCE_H);
+    let lq_ok = v.range(&format!("{p}lq_h"), "", m.lq_h, w::INDUCTANCE_H);
+    if ld_ok && lq_ok && m.lq_h < m.ld_h {
+        v.push(
+            format!("{p}lq_h"),
+            format!("must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}", m.ld_h, m.lq_h),
+        );
+    }
+    let temp = m.winding_temp_c.unwrap_or(100.0);
+    let util = m.voltage_utilization.unwrap_or(1.0);
+    let fields = [
+        ("r_phase_20c_ohm", m.r_phase_20c_ohm, w::R_PHASE_OHM),
+        ("winding_temp_c", temp, w::WINDING_TEMP_C),
+        ("i_max_arms", m.i_max_arms, w::ELECTRIC_LIMIT),
+        ("v_dc", m.v_dc, w::ELECTRIC_LIMIT),
+        ("voltage_utilization", util, w::VOLTAGE_UTILIZATION),
+        ("n_max_rpm", m.n_max_rpm, w::N_MAX_RPM),
+    ];
+    for (name, x, range) in fields {
+        v.range(&format!("{p}{name}"), "", x, range);
+    }
+    (temp, util)
+}
+
+/// An optional field of an IPMSM checked against `range` when given; `default` when absent.
+fn optional(v: &mut Validator, ptr: &str, x: Option<f64>, range: Range, default: f64) -> f64 {
+    if let Some(x) = x {
+        v.range(ptr, "", x, range);
+    }
+    x.unwrap_or(default)
+}
+
+fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
+    let p = format!("{base}/");
+    v.uint(
+        &format!("{p}pole_pairs"),
+        "",
+        u64::from(m.pole_pairs),
+        w::POLE_PAIRS,
+    );
+    let pp = f64::from(m.pole_pairs).clamp(w::POLE_PAIRS.lo, w::POLE_PAIRS.hi);
+    let psi = psi_m(v, base, &p, m, pp);
+    let (temp, util) = ipmsm_ratings(v, &p, m);
+    let t_cap = optional(
+        v,
+        &format!("{p}t_cap_nm"),
+        m.t_cap_nm,
+        w::TORQUE_NM,
+        f64::INFINITY,
+    );
+    let p_cap = optional(
+        v,
+        &format!("{p}p_cap_w"),
+        m.p_cap_w,
+        w::POWER_W,
+        f64::INFINITY,
+    );
+    let ac = ac_factor(v, &p, m.ac_factor.as_ref());
     let iron = m.iron.clone().unwrap_or_default();
     let mech = m.mech.clone().unwrap_or_default();
     for (name, x) in [
@@ -642,16 +671,19 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
     ] {
         v.range(&format!("{p}{name}"), "", x, w::LOSS_COEFF);
     }
-    let scale = m.stack_scale.unwrap_or(1.0);
-    if m.stack_scale.is_some() {
-        v.range(&format!("{p}stack_scale"), "", scale, w::STACK_SCALE);
-        if !matches!(ac, AcFactor::Dowell(_)) {
-            v.push(
-                format!("{p}stack_scale"),
-                "needs ac_factor model \"dowell\" (its stack/end lengths split the resistance)"
-                    .to_owned(),
-            );
-        }
+    let scale = optional(
+        v,
+        &format!("{p}stack_scale"),
+        m.stack_scale,
+        w::STACK_SCALE,
+        1.0,
+    );
+    if m.stack_scale.is_some() && !matches!(ac, AcFactor::Dowell(_)) {
+        v.push(
+            format!("{p}stack_scale"),
+            "needs ac_factor model \"dowell\" (its stack/end lengths split the resistance)"
+                .to_owned(),
+        );
     }
     Ipmsm::new(&IpmsmParams {
         pole_pairs: pp,
@@ -686,16 +718,133 @@ fn map_axis_warning(loss: &Grid2, env: &Envelope, warnings: &mut Vec<String>) {
     }
 }
 
-#[expect(
-    clippy::too_many_lines,
-    reason = "one match arm per motor model of spec §3 (constant, efficiency map, loss map, ipmsm), each validating that model's envelope and table or parameters into its MotorKind; the id and speed-limit checks around the match apply to all four"
-)]
+/// The loss grid of an efficiency-map motor (`base` = `/motors/{i}`); empty when invalid.
+fn efficiency_map(
+    v: &mut Validator,
+    base: &str,
+    m: &EfficiencyMapMotor,
+    env: &Envelope,
+    warnings: &mut Vec<String>,
+) -> Grid2 {
+    let ok_s = axis(
+        v,
+        &format!("{base}/speed_rpm"),
+        &m.speed_rpm,
+        2,
+        w::SPEED_AXIS_RPM,
+    );
+    let ok_t = axis(
+        v,
+        &format!("{base}/torque_nm"),
+        &m.torque_nm,
+        2,
+        w::TORQUE_AXIS_NM,
+    );
+    let shape = (m.speed_rpm.len(), m.torque_nm.len());
+    let mut ok = ok_s && ok_t;
+    if ok {
+        ok &= table(
+            v,
+            &format!("{base}/efficiency"),
+            &m.efficiency,
+            shape,
+            w::MAP_EFFICIENCY,
+        );
+        if let Some(g) = &m.efficiency_gen {
+            ok &= table(
+                v,
+                &format!("{base}/efficiency_gen"),
+                g,
+                shape,
+                w::MAP_EFFICIENCY,
+            );
+        }
+    }
+    if !ok {
+        return Grid2 {
+            speed: vec![],
+            torque: vec![],
+            values: vec![],
+        };
+    }
+    let speed: Vec<f64> = m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect();
+    let conv = efficiency_to_loss(
+        &speed,
+        &m.torque_nm,
+        &m.efficiency,
+        m.efficiency_gen.as_deref(),
+    );
+    warnings.extend(conv.warnings);
+    map_axis_warning(&conv.loss, env, warnings);
+    conv.loss
+}
+
+/// The loss grid of a loss-map motor (`base` = `/motors/{i}`); without values when invalid.
+fn loss_map(
+    v: &mut Validator,
+    base: &str,
+    m: &LossMapMotor,
+    env: &Envelope,
+    warnings: &mut Vec<String>,
+) -> Grid2 {
+    let ok_s = axis(
+        v,
+        &format!("{base}/speed_rpm"),
+        &m.speed_rpm,
+        2,
+        w::SPEED_AXIS_RPM,
+    );
+    let ok_t = axis(
+        v,
+        &format!("{base}/torque_nm"),
+        &m.torque_nm,
+        2,
+        w::SIGNED_TORQUE_AXIS_NM,
+    );
+    if ok_t && !m.torque_nm.iter().any(|&t| t.abs() <= 0.0) {
+        v.push(
+            format!("{base}/torque_nm"),
+            "signed torque axis must contain 0".to_owned(),
+        );
+    }
+    let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
+    let ok = ok_s && ok_t && table(v, &format!("{base}/loss_w"), &m.loss_w, (ns, nt), w::LOSS_W);
+    let loss = Grid2 {
+        speed: m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
+        torque: m.torque_nm.clone(),
+        values: if ok {
+            m.loss_w.iter().flatten().copied().collect()
+        } else {
+            vec![]
+        },
+    };
+    if ok {
+        map_axis_warning(&loss, env, warnings);
+    }
+    loss
+}
+
+/// The admissible speed of a motor in rpm as given (axes of maps are built from it without a
+/// round trip): `n_max_rpm` (default [`DEFAULT_N_MAX`]), for maps at most their last speed.
+fn n_max_rpm(spec: &MotorSpec) -> f64 {
+    let map = |n_max: Option<f64>, speed_rpm: &[f64]| {
+        n_max
+            .unwrap_or(DEFAULT_N_MAX)
+            .min(speed_rpm.last().copied().unwrap_or(0.0))
+    };
+    match spec {
+        MotorSpec::Constant(m) => m.n_max_rpm.unwrap_or(DEFAULT_N_MAX),
+        MotorSpec::EfficiencyMap(m) => map(m.n_max_rpm, &m.speed_rpm),
+        MotorSpec::LossMap(m) => map(m.n_max_rpm, &m.speed_rpm),
+        MotorSpec::Ipmsm(m) => m.n_max_rpm,
+    }
+}
+
 fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     let base = format!("/motors/{i}");
     name_ok(v, &format!("{base}/id"), spec.id(), "motor id");
     let mut warnings = Vec::new();
-    // The second element (admissible speed in rad/s) is recomputed below from the rpm values.
-    let (kind, _) = match spec {
+    let kind = match spec {
         MotorSpec::Constant(m) => {
             v.range(
                 &format!("{base}/efficiency"),
@@ -703,7 +852,7 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 m.efficiency,
                 w::EFFICIENCY,
             );
-            let (env, w) = envelope(
+            let (env, _) = envelope(
                 v,
                 &base,
                 m.t_peak_nm,
@@ -711,16 +860,13 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 m.n_max_rpm,
                 m.envelope.as_ref(),
             );
-            (
-                MotorKind::Constant {
-                    eta: m.efficiency,
-                    envelope: env,
-                },
-                w,
-            )
+            MotorKind::Constant {
+                eta: m.efficiency,
+                envelope: env,
+            }
         }
         MotorSpec::EfficiencyMap(m) => {
-            let (env, w) = envelope(
+            let (env, _) = envelope(
                 v,
                 &base,
                 m.t_peak_nm,
@@ -728,71 +874,14 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 m.n_max_rpm,
                 m.envelope.as_ref(),
             );
-            let ok_s = axis(
-                v,
-                &format!("{base}/speed_rpm"),
-                &m.speed_rpm,
-                2,
-                w::SPEED_AXIS_RPM,
-            );
-            let ok_t = axis(
-                v,
-                &format!("{base}/torque_nm"),
-                &m.torque_nm,
-                2,
-                w::TORQUE_AXIS_NM,
-            );
-            let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
-            let mut ok = ok_s && ok_t;
-            if ok {
-                ok &= table(
-                    v,
-                    &format!("{base}/efficiency"),
-                    &m.efficiency,
-                    (ns, nt),
-                    w::MAP_EFFICIENCY,
-                );
-                if let Some(g) = &m.efficiency_gen {
-                    ok &= table(
-                        v,
-                        &format!("{base}/efficiency_gen"),
-                        g,
-                        (ns, nt),
-                        w::MAP_EFFICIENCY,
-                    );
-                }
+            let loss = efficiency_map(v, &base, m, &env, &mut warnings);
+            MotorKind::Map {
+                loss,
+                envelope: env,
             }
-            let loss = if ok {
-                let speed: Vec<f64> = m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect();
-                let conv = efficiency_to_loss(
-                    &speed,
-                    &m.torque_nm,
-                    &m.efficiency,
-                    m.efficiency_gen.as_deref(),
-                );
-                warnings.extend(conv.warnings);
-                conv.loss
-            } else {
-                Grid2 {
-                    speed: vec![],
-                    torque: vec![],
-                    values: vec![],
-                }
-            };
-            if ok {
-                map_axis_warning(&loss, &env, &mut warnings);
-            }
-            let w_map = m.speed_rpm.last().map_or(0.0, |&n| rpm_to_rad_s(n));
-            (
-                MotorKind::Map {
-                    loss,
-                    envelope: env,
-                },
-                w.min(w_map),
-            )
         }
         MotorSpec::LossMap(m) => {
-            let (env, w) = envelope(
+            let (env, _) = envelope(
                 v,
                 &base,
                 m.t_peak_nm,
@@ -800,69 +889,15 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 m.n_max_rpm,
                 m.envelope.as_ref(),
             );
-            let ok_s = axis(
-                v,
-                &format!("{base}/speed_rpm"),
-                &m.speed_rpm,
-                2,
-                w::SPEED_AXIS_RPM,
-            );
-            let ok_t = axis(
-                v,
-                &format!("{base}/torque_nm"),
-                &m.torque_nm,
-                2,
-                w::SIGNED_TORQUE_AXIS_NM,
-            );
-            if ok_t && !m.torque_nm.iter().any(|&t| t.abs() <= 0.0) {
-                v.push(
-                    format!("{base}/torque_nm"),
-                    "signed torque axis must contain 0".to_owned(),
-                );
+            let loss = loss_map(v, &base, m, &env, &mut warnings);
+            MotorKind::Map {
+                loss,
+                envelope: env,
             }
-            let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
-            let ok =
-                ok_s && ok_t && table(v, &format!("{base}/loss_w"), &m.loss_w, (ns, nt), w::LOSS_W);
-            let loss = Grid2 {
-                speed: m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
-                torque: m.torque_nm.clone(),
-                values: if ok {
-                    m.loss_w.iter().flatten().copied().collect()
-                } else {
-                    vec![]
-                },
-            };
-            if ok {
-                map_axis_warning(&loss, &env, &mut warnings);
-            }
-            let w_map = m.speed_rpm.last().map_or(0.0, |&n| rpm_to_rad_s(n));
-            (
-                MotorKind::Map {
-                    loss,
-                    envelope: env,
-                },
-                w.min(w_map),
-            )
         }
-        MotorSpec::Ipmsm(m) => {
-            let im = ipmsm(v, &base, m);
-            let w = im.omega_max;
-            (MotorKind::Ipmsm(Box::new(im)), w)
-        }
+        MotorSpec::Ipmsm(m) => MotorKind::Ipmsm(Box::new(ipmsm(v, &base, m))),
     };
-    // The admissible speed in rpm as given (axes of maps are built from it without a round trip).
-    let n_max_rpm = match spec {
-        MotorSpec::Constant(m) => m.n_max_rpm.unwrap_or(DEFAULT_N_MAX),
-        MotorSpec::EfficiencyMap(m) => m
-            .n_max_rpm
-            .unwrap_or(DEFAULT_N_MAX)
-            .min(m.speed_rpm.last().copied().unwrap_or(0.0)),
-        MotorSpec::LossMap(m) => m
-            .n_max_rpm
-            .unwrap_or(DEFAULT_N_MAX)
-            .min(m.speed_rpm.last().copied().unwrap_or(0.0)),
-        MotorSpec::Ipmsm(m) => m.n_max_rpm,
-    };
+    let n_max_rpm = n_max_rpm(spec);
     MotorInput {
         id: spec.id().to_owned(),
         kind,
@@ -911,13 +946,146 @@ pub fn validate_motor(
     Ok((m, gr))
 }
 
+/// The cycles (at most [`MAX_CYCLES`] checked), each valid one with its index; zero distance and
+/// duplicate names are reported.
+fn cycles(v: &mut Validator, specs: &[CycleSpec]) -> Vec<(usize, Cycle)> {
+    if specs.is_empty() || specs.len() > MAX_CYCLES {
+        v.push(
+            "/cycles",
+            format!("must have 1..{MAX_CYCLES} entries, got {}", specs.len()),
+        );
+    }
+    let mut cycles_ok: Vec<(usize, Cycle)> = Vec::new();
+    for (j, c) in specs.iter().enumerate().take(MAX_CYCLES) {
+        if let Some(cy) = cycle(v, j, c) {
+            if cy.distance_m() <= 0.0 {
+                v.push(
+                    format!("/cycles/{j}"),
+                    format!(
+                        "cycle '{}' has zero distance (fuel economy undefined)",
+                        cy.name
+                    ),
+                );
+            } else if let Some((k, _)) = cycles_ok.iter().find(|(_, o)| o.name == cy.name) {
+                v.push(
+                    format!("/cycles/{j}"),
+                    format!("duplicate cycle name '{}' (also /cycles/{k})", cy.name),
+                );
+            }
+            cycles_ok.push((j, cy));
+        }
+    }
+    cycles_ok
+}
+
+/// The motors (at most [`MAX_MOTORS`] checked), with duplicate ids reported.
+fn motors(v: &mut Validator, specs: &[MotorSpec]) -> Vec<MotorInput> {
+    if specs.is_empty() || specs.len() > MAX_MOTORS {
+        v.push(
+            "/motors",
+            format!("must have 1..{MAX_MOTORS} entries, got {}", specs.len()),
+        );
+    }
+    let mut motors = Vec::new();
+    for (i, m) in specs.iter().enumerate().take(MAX_MOTORS) {
+        if let Some(k) = specs[..i].iter().position(|o| o.id() == m.id()) {
+            v.push(
+                format!("/motors/{i}/id"),
+                format!("duplicate motor id '{}' (also /motors/{k})", m.id()),
+            );
+        }
+        motors.push(motor(v, i, m));
+    }
+    motors
+}
+
+/// The desirability weights of `n_cycles` cycles, normalised (equal weights when absent or
+/// invalid).
+fn desirability(v: &mut Validator, weights: Option<&[f64]>, n_cycles: usize) -> Vec<f64> {
+    let n_cyc = n_cycles.max(1);
+    let equal = vec![1.0 / n_cyc as f64; n_cyc];
+    let Some(w) = weights else {
+        return equal;
+    };
+    let p = "/options/desirability_weights";
+    if w.len() != n_cycles {
+        v.push(
+            p,
+            format!(
+                "must have one weight per cycle ({n_cycles}), got {}",
+                w.len()
+            ),
+        );
+        return equal;
+    }
+    if !v.all_in(p, "", w, w::DESIRABILITY_WEIGHT) {
+        return equal;
+    }
+    let s: f64 = w.iter().sum();
+    if s > 0.0 {
+        w.iter().map(|x| x / s).collect()
+    } else {
+        v.push(p, "weights must not all be 0".to_owned());
+        equal
+    }
+}
+
+/// The options: substeps, loss-map grid, histogram bins and desirability weights; returns the
+/// grid and the normalised weights.
+fn options(v: &mut Validator, o: &OptionsSpec, n_cycles: usize) -> ((f64, f64), Vec<f64>) {
+    v.uint("/options/substeps", "", u64::from(o.substeps), w::SUBSTEPS);
+    let gr = grid(v, "/options/loss_map_grid", &o.loss_map_grid);
+    v.range(
+        "/options/op_histogram/speed_bin_rpm",
+        "",
+        o.op_histogram.speed_bin_rpm,
+        w::SPEED_BIN_RPM,
+    );
+    v.range(
+        "/options/op_histogram/torque_bin_nm",
+        "",
+        o.op_histogram.torque_bin_nm,
+        w::TORQUE_BIN_NM,
+    );
+    let weights = desirability(v, o.desirability_weights.as_deref(), n_cycles);
+    (gr, weights)
+}
+
+/// Every cycle's top speed within every motor's speed limit (spec §3.7, §8 item 4).
+fn speed_limits(
+    v: &mut Validator,
+    veh: &Vehicle,
+    (motors, specs): (&[MotorInput], &[MotorSpec]),
+    cycles: &[(usize, Cycle)],
+) {
+    for (i, m) in motors.iter().enumerate() {
+        for (j, c) in cycles {
+            let w_need = veh.motor_speed(c.max_speed_mps());
+            if w_need.is_finite() && w_need > m.omega_max * (1.0 + SPEED_CHECK_SLACK) {
+                let field = match specs.get(i) {
+                    Some(MotorSpec::EfficiencyMap(_) | MotorSpec::LossMap(_)) => {
+                        "n_max_rpm (or the map's last speed_rpm)"
+                    }
+                    _ => "n_max_rpm",
+                };
+                v.push(
+                    format!("/motors/{i}/n_max_rpm"),
+                    format!(
+                        "cycle '{}' (/cycles/{j}) needs {:.1} rpm at its top speed {:.3} km/h, above the motor's {field} {:.1} rpm",
+                        c.name,
+                        super::ipmsm::rad_s_to_rpm(w_need),
+                        c.max_speed_mps() * 3.6,
+                        super::ipmsm::rad_s_to_rpm(m.omega_max)
+                    ),
+                );
+            }
+        }
+    }
+}
+
 impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
     type Error = CalcFailure;
 
-    #[expect(
-        clippy::too_many_lines,
-        reason = "validates the whole request in document order (vehicle, battery, cycles and their duplicate names, motors and their duplicate ids, options, desirability weights) into one Validator, so that one 422 lists every offending field; the closing cross-check of every cycle's top speed against every motor's speed limit needs both validated lists"
-    )]
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
@@ -930,130 +1098,13 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
             w::EFFICIENCY,
         );
         let bat = battery(&mut v, &req.battery);
-
-        // Cycles.
-        if req.cycles.is_empty() || req.cycles.len() > MAX_CYCLES {
-            v.push(
-                "/cycles",
-                format!(
-                    "must have 1..{MAX_CYCLES} entries, got {}",
-                    req.cycles.len()
-                ),
-            );
-        }
-        let mut cycles_ok: Vec<(usize, Cycle)> = Vec::new();
-        for (j, c) in req.cycles.iter().enumerate().take(MAX_CYCLES) {
-            if let Some(cy) = cycle(&mut v, j, c) {
-                if cy.distance_m() <= 0.0 {
-                    v.push(
-                        format!("/cycles/{j}"),
-                        format!(
-                            "cycle '{}' has zero distance (fuel economy undefined)",
-                            cy.name
-                        ),
-                    );
-                } else if let Some((k, _)) = cycles_ok.iter().find(|(_, o)| o.name == cy.name) {
-                    v.push(
-                        format!("/cycles/{j}"),
-                        format!("duplicate cycle name '{}' (also /cycles/{k})", cy.name),
-                    );
-                }
-                cycles_ok.push((j, cy));
-            }
-        }
-
-        // Motors.
-        if req.motors.is_empty() || req.motors.len() > MAX_MOTORS {
-            v.push(
-                "/motors",
-                format!(
-                    "must have 1..{MAX_MOTORS} entries, got {}",
-                    req.motors.len()
-                ),
-            );
-        }
-        let mut motors = Vec::new();
-        for (i, m) in req.motors.iter().enumerate().take(MAX_MOTORS) {
-            if let Some(k) = req.motors[..i].iter().position(|o| o.id() == m.id()) {
-                v.push(
-                    format!("/motors/{i}/id"),
-                    format!("duplicate motor id '{}' (also /motors/{k})", m.id()),
-                );
-            }
-            motors.push(motor(&mut v, i, m));
-        }
-
-        // Options.
-        let o = &req.options;
-        v.uint("/options/substeps", "", u64::from(o.substeps), w::SUBSTEPS);
-        let gr = grid(&mut v, "/options/loss_map_grid", &o.loss_map_grid);
-        v.range(
-            "/options/op_histogram/speed_bin_rpm",
-            "",
-            o.op_histogram.speed_bin_rpm,
-            w::SPEED_BIN_RPM,
-        );
-        v.range(
-            "/options/op_histogram/torque_bin_nm",
-            "",
-            o.op_histogram.torque_bin_nm,
-            w::TORQUE_BIN_NM,
-        );
-        let n_cyc = req.cycles.len().max(1);
-        let weights = match &o.desirability_weights {
-            None => vec![1.0 / n_cyc as f64; n_cyc],
-            Some(w) => {
-                let p = "/options/desirability_weights";
-                if w.len() != req.cycles.len() {
-                    v.push(
-                        p,
-                        format!(
-                            "must have one weight per cycle ({}), got {}",
-                            req.cycles.len(),
-                            w.len()
-                        ),
-                    );
-                    vec![1.0 / n_cyc as f64; n_cyc]
-                } else if !v.all_in(p, "", w, w::DESIRABILITY_WEIGHT) {
-                    vec![1.0 / n_cyc as f64; n_cyc]
-                } else {
-                    let s: f64 = w.iter().sum();
-                    if s > 0.0 {
-                        w.iter().map(|x| x / s).collect()
-                    } else {
-                        v.push(p, "weights must not all be 0".to_owned());
-                        vec![1.0 / n_cyc as f64; n_cyc]
-                    }
-                }
-            }
-        };
-
-        // Cycle speed vs motor speed limit (spec §3.7, §8 item 4).
-        for (i, m) in motors.iter().enumerate() {
-            for (j, c) in &cycles_ok {
-                let w_need = veh.motor_speed(c.max_speed_mps());
-                if w_need.is_finite() && w_need > m.omega_max * (1.0 + SPEED_CHECK_SLACK) {
-                    let field = match req.motors.get(i) {
-                        Some(MotorSpec::EfficiencyMap(_) | MotorSpec::LossMap(_)) => {
-                            "n_max_rpm (or the map's last speed_rpm)"
-                        }
-                        _ => "n_max_rpm",
-                    };
-                    v.push(
-                        format!("/motors/{i}/n_max_rpm"),
-                        format!(
-                            "cycle '{}' (/cycles/{j}) needs {:.1} rpm at its top speed {:.3} km/h, above the motor's {field} {:.1} rpm",
-                            c.name,
-                            super::ipmsm::rad_s_to_rpm(w_need),
-                            c.max_speed_mps() * 3.6,
-                            super::ipmsm::rad_s_to_rpm(m.omega_max)
-                        ),
-                    );
-                }
-            }
-        }
+        let cycles_ok = cycles(&mut v, &req.cycles);
+        let motors = motors(&mut v, &req.motors);
+        let (gr, weights) = options(&mut v, &req.options, req.cycles.len());
+        speed_limits(&mut v, &veh, (&motors, &req.motors), &cycles_ok);
         v.finish()?;
 
+        let o = &req.options;
         let substeps = usize::try_from(o.substeps).unwrap_or(1);
         let total: usize = cycles_ok.iter().map(|(_, c)| c.intervals(substeps)).sum();
         if total > MAX_TOTAL_INTERVALS {

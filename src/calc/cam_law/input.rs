@@ -7,7 +7,8 @@ use super::law::{
     normalize_coefficients,
 };
 use super::wire::{
-    AbscissaIn, BOUNDARY_VALUE, COEFFICIENT, EvaluateRequest, GRID_COUNT, MAX_POINTS, Units,
+    AbscissaIn, BOUNDARY_VALUE, COEFFICIENT, ConstraintsIn, EvaluateRequest, GRID_COUNT,
+    MAX_POINTS, Units,
 };
 use crate::calc::{CalcFailure, Validator};
 
@@ -195,154 +196,178 @@ fn check_coefficients(v: &mut Validator, c: &[f64], normalize: bool) -> Option<(
     }
 }
 
+/// The law: coefficients (validated as given) xor a named law; a renormalization warning goes to
+/// `warnings`.
+fn law(
+    v: &mut Validator,
+    req: &EvaluateRequest,
+    warnings: &mut Vec<LawNotice>,
+) -> Option<LawChoice> {
+    match (&req.coefficients, req.law) {
+        (Some(_), Some(_)) => {
+            v.push(
+                "/law",
+                "give exactly one of `coefficients` or `law`, got both",
+            );
+            None
+        }
+        (None, None) => {
+            v.push(
+                "/coefficients",
+                "give exactly one of `coefficients` or `law`, got neither",
+            );
+            None
+        }
+        (Some(c), None) => check_coefficients(v, c, req.normalize).map(|(coefficients, warn)| {
+            if warn {
+                warnings.push(LawNotice::CoefficientsRenormalized);
+            }
+            LawChoice::SevenSegment {
+                coefficients,
+                named: None,
+            }
+        }),
+        (None, Some(named)) => Some(match named.seven_segment_coefficients() {
+            Some(coefficients) => LawChoice::SevenSegment {
+                coefficients,
+                named: Some(named),
+            },
+            None => LawChoice::ClosedForm(named),
+        }),
+    }
+}
+
+/// The boundary conditions, defaults applied (`t_a`, `t_b` from the abscissa's `ends` where
+/// given); returns them and whether they are valid.
+fn boundary(
+    v: &mut Validator,
+    c: &ConstraintsIn,
+    ends: Option<(f64, f64)>,
+) -> (BoundaryConditions, bool) {
+    let bc = BoundaryConditions {
+        t_a: c.t_a.or(ends.map(|e| e.0)).unwrap_or(0.0),
+        t_b: c.t_b.or(ends.map(|e| e.1)).unwrap_or(1.0),
+        s_a: c.s_a.unwrap_or(0.0),
+        s_b: c.s_b.unwrap_or(1.0),
+        v_a: c.v_a.unwrap_or(0.0),
+        v_b: c.v_b.unwrap_or(0.0),
+        a_a: c.a_a.unwrap_or(0.0),
+        a_b: c.a_b.unwrap_or(0.0),
+    };
+    let mut bc_ok = true;
+    for (name, value) in bc.named_values() {
+        let p = format!("/constraints/{name}");
+        bc_ok &= v.range(&p, name, value, BOUNDARY_VALUE);
+    }
+    if !bc_ok {
+        return (bc, false);
+    }
+    let defaulted = |given: Option<f64>, what: &str| {
+        if given.is_some() {
+            String::new()
+        } else {
+            format!(" (defaulted to the {what})")
+        }
+    };
+    if bc.t_b <= bc.t_a {
+        v.push(
+            "/constraints/t_b",
+            format!(
+                "t_b must be > t_a = {}{}, got {}{}",
+                bc.t_a,
+                defaulted(c.t_a, "first abscissa"),
+                bc.t_b,
+                defaulted(c.t_b, "last abscissa")
+            ),
+        );
+        bc_ok = false;
+    } else if bc.t_b - bc.t_a <= MIN_RELATIVE_INTERVAL * bc.t_a.abs().max(bc.t_b.abs()) {
+        v.push(
+            "/constraints/t_b",
+            format!(
+                "t_b - t_a = {:e} is too short to resolve knots at this offset (must exceed {MIN_RELATIVE_INTERVAL:e}·max(|t_a|, |t_b|))",
+                bc.t_b - bc.t_a
+            ),
+        );
+        bc_ok = false;
+    }
+    (bc, bc_ok)
+}
+
+/// A named law outside the 7-segment class has zero end rates only.
+fn closed_form_rates(v: &mut Validator, law: Option<&LawChoice>, bc: &BoundaryConditions) {
+    let Some(LawChoice::ClosedForm(named)) = law else {
+        return;
+    };
+    for (name, value) in [
+        ("v_a", bc.v_a),
+        ("v_b", bc.v_b),
+        ("a_a", bc.a_a),
+        ("a_b", bc.a_b),
+    ] {
+        v.ensure(
+            value == 0.0 || !value.is_finite(),
+            format!("/constraints/{name}"),
+            || {
+                format!(
+                    "must be 0 for the named law `{}`, which is outside the 7-segment class (only zero end rates), got {value}",
+                    named.wire_name()
+                )
+            },
+        );
+    }
+}
+
+/// Every abscissa within `[t_a, t_b]` (to [`ABSCISSA_TOL`]·Δt).
+fn abscissa_within(v: &mut Validator, a: &Abscissa, bc: &BoundaryConditions) {
+    let tol = ABSCISSA_TOL * (bc.t_b - bc.t_a);
+    let (lo, hi) = (bc.t_a - tol, bc.t_b + tol);
+    let range = || format!("[t_a, t_b] = [{}, {}] (tolerance {tol:e})", bc.t_a, bc.t_b);
+    match a {
+        Abscissa::Values(xs) => {
+            let mut bad = xs
+                .iter()
+                .enumerate()
+                .filter(|(_, x)| !(lo..=hi).contains(*x));
+            if let Some((i, x)) = bad.next() {
+                let more = bad.count();
+                let tail = if more > 0 {
+                    format!(" ({more} more outside)")
+                } else {
+                    String::new()
+                };
+                v.push(
+                    format!("/abscissa/values/{i}"),
+                    format!("abscissa {x} lies outside {}{tail}", range()),
+                );
+            }
+        }
+        Abscissa::Grid { start, end, .. } => {
+            v.ensure(*start >= lo, "/abscissa/grid/start", || {
+                format!("grid start {start} lies outside {}", range())
+            });
+            v.ensure(*end <= hi, "/abscissa/grid/end", || {
+                format!("grid end {end} lies outside {}", range())
+            });
+        }
+    }
+}
+
 impl TryFrom<EvaluateRequest> for EvaluateInput {
     type Error = CalcFailure;
 
-    #[expect(
-        clippy::too_many_lines,
-        reason = "checks the law choice (coefficients xor a named law), its boundary conditions, the abscissa and the requested quantities into one Validator so that one 422 lists every problem; the boundary checks need the law chosen at the top"
-    )]
     fn try_from(req: EvaluateRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let mut warnings = Vec::new();
-
-        let law = match (&req.coefficients, req.law) {
-            (Some(_), Some(_)) => {
-                v.push(
-                    "/law",
-                    "give exactly one of `coefficients` or `law`, got both",
-                );
-                None
-            }
-            (None, None) => {
-                v.push(
-                    "/coefficients",
-                    "give exactly one of `coefficients` or `law`, got neither",
-                );
-                None
-            }
-            (Some(c), None) => {
-                check_coefficients(&mut v, c, req.normalize).map(|(coefficients, warn)| {
-                    if warn {
-                        warnings.push(LawNotice::CoefficientsRenormalized);
-                    }
-                    LawChoice::SevenSegment {
-                        coefficients,
-                        named: None,
-                    }
-                })
-            }
-            (None, Some(named)) => Some(match named.seven_segment_coefficients() {
-                Some(coefficients) => LawChoice::SevenSegment {
-                    coefficients,
-                    named: Some(named),
-                },
-                None => LawChoice::ClosedForm(named),
-            }),
-        };
-
+        let law = law(&mut v, &req, &mut warnings);
         let abscissa = check_abscissa(&mut v, req.abscissa);
         let ends = abscissa.as_ref().and_then(Abscissa::first_last);
-
-        let c = req.constraints;
-        let bc = BoundaryConditions {
-            t_a: c.t_a.or(ends.map(|e| e.0)).unwrap_or(0.0),
-            t_b: c.t_b.or(ends.map(|e| e.1)).unwrap_or(1.0),
-            s_a: c.s_a.unwrap_or(0.0),
-            s_b: c.s_b.unwrap_or(1.0),
-            v_a: c.v_a.unwrap_or(0.0),
-            v_b: c.v_b.unwrap_or(0.0),
-            a_a: c.a_a.unwrap_or(0.0),
-            a_b: c.a_b.unwrap_or(0.0),
-        };
-        let mut bc_ok = true;
-        for (name, value) in bc.named_values() {
-            let p = format!("/constraints/{name}");
-            bc_ok &= v.range(&p, name, value, BOUNDARY_VALUE);
-        }
-        if bc_ok {
-            let defaulted = |given: Option<f64>, what: &str| {
-                if given.is_some() {
-                    String::new()
-                } else {
-                    format!(" (defaulted to the {what})")
-                }
-            };
-            if bc.t_b <= bc.t_a {
-                v.push(
-                    "/constraints/t_b",
-                    format!(
-                        "t_b must be > t_a = {}{}, got {}{}",
-                        bc.t_a,
-                        defaulted(c.t_a, "first abscissa"),
-                        bc.t_b,
-                        defaulted(c.t_b, "last abscissa")
-                    ),
-                );
-                bc_ok = false;
-            } else if bc.t_b - bc.t_a <= MIN_RELATIVE_INTERVAL * bc.t_a.abs().max(bc.t_b.abs()) {
-                v.push(
-                    "/constraints/t_b",
-                    format!(
-                        "t_b - t_a = {:e} is too short to resolve knots at this offset (must exceed {MIN_RELATIVE_INTERVAL:e}·max(|t_a|, |t_b|))",
-                        bc.t_b - bc.t_a
-                    ),
-                );
-                bc_ok = false;
-            }
-        }
-
-        if let Some(LawChoice::ClosedForm(named)) = law {
-            for (name, value) in [
-                ("v_a", bc.v_a),
-                ("v_b", bc.v_b),
-                ("a_a", bc.a_a),
-                ("a_b", bc.a_b),
-            ] {
-                v.ensure(value == 0.0 || !value.is_finite(), format!("/constraints/{name}"), || {
-                    format!(
-                        "must be 0 for the named law `{}`, which is outside the 7-segment class (only zero end rates), got {value}",
-                        named.wire_name()
-                    )
-                });
-            }
-        }
-
+        let (bc, bc_ok) = boundary(&mut v, &req.constraints, ends);
+        closed_form_rates(&mut v, law.as_ref(), &bc);
         if let (true, Some(a)) = (bc_ok, &abscissa) {
-            let tol = ABSCISSA_TOL * (bc.t_b - bc.t_a);
-            let (lo, hi) = (bc.t_a - tol, bc.t_b + tol);
-            let range = || format!("[t_a, t_b] = [{}, {}] (tolerance {tol:e})", bc.t_a, bc.t_b);
-            match a {
-                Abscissa::Values(xs) => {
-                    let mut bad = xs
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, x)| !(lo..=hi).contains(*x));
-                    if let Some((i, x)) = bad.next() {
-                        let more = bad.count();
-                        let tail = if more > 0 {
-                            format!(" ({more} more outside)")
-                        } else {
-                            String::new()
-                        };
-                        v.push(
-                            format!("/abscissa/values/{i}"),
-                            format!("abscissa {x} lies outside {}{tail}", range()),
-                        );
-                    }
-                }
-                Abscissa::Grid { start, end, .. } => {
-                    v.ensure(*start >= lo, "/abscissa/grid/start", || {
-                        format!("grid start {start} lies outside {}", range())
-                    });
-                    v.ensure(*end <= hi, "/abscissa/grid/end", || {
-                        format!("grid end {end} lies outside {}", range())
-                    });
-                }
-            }
+            abscissa_within(&mut v, a, &bc);
         }
-
         if let Some(u) = &req.units {
             u.validate(&mut v);
         }
