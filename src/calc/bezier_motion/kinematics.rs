@@ -49,16 +49,34 @@ fn sampled(c: &[f64], samples: usize) -> Vec<f64> {
     // reversed polygon in 1 − λ above (each term then ≤ C(n, j)·max|c|: round-off ~2^n ε).
     let rev: Vec<f64> = c.iter().rev().copied().collect();
     let (lo, hi) = (power_basis(c), power_basis(&rev));
-    let horner = |a: &[f64], x: f64| a.iter().rev().fold(0.0, |acc, aj| acc * x + aj);
-    (0..=last)
-        .map(|k| {
-            if 2 * k <= last {
-                horner(&lo, k as f64 / lf)
-            } else {
-                horner(&hi, (last - k) as f64 / lf)
+    let mut out = vec![0.0; last + 1];
+    let mid = last / 2 + 1;
+    horner_at(&lo, (0..mid).map(|k| k as f64 / lf), &mut out[..mid]);
+    horner_at(
+        &hi,
+        (mid..=last).map(|k| (last - k) as f64 / lf),
+        &mut out[mid..],
+    );
+    out
+}
+
+/// `out[i] = Σ a_j x_i^j` by Horner, eight points at a time (independent lanes the compiler
+/// vectorises).
+fn horner_at(a: &[f64], xs: impl Iterator<Item = f64>, out: &mut [f64]) {
+    const LANES: usize = 8;
+    let xs: Vec<f64> = xs.collect();
+    for (xc, oc) in xs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        let mut x = [0.0; LANES];
+        x[..xc.len()].copy_from_slice(xc);
+        let top = a.last().copied().unwrap_or(0.0);
+        let mut acc = [top; LANES];
+        for &aj in a.iter().rev().skip(1) {
+            for (acc, x) in acc.iter_mut().zip(&x) {
+                *acc = *acc * x + aj;
             }
-        })
-        .collect()
+        }
+        oc.copy_from_slice(&acc[..oc.len()]);
+    }
 }
 
 /// Power-basis coefficients `a_j = C(n, j)·Δ^j c_0` of the Bezier polynomial with ordinates `c`.
@@ -129,6 +147,11 @@ fn maximise(c: &[f64], goal: Goal, values: &[f64]) -> (f64, f64) {
             let d2 = differences(&d1);
             let curvature = |l: f64| sigma * (d1.len() - 1) as f64 * de_casteljau(&d2, l);
             newton_peak(slope, curvature, (a, b), lam_k)
+        } else if best_k == 0 && sigma_polygon_sign(&d1, sigma, b, true) {
+            // g falls on all of [0, b] (convex hull of the slope's polygon there): the peak is λ = 0.
+            vec![0.0]
+        } else if best_k == last && sigma_polygon_sign(&d1, -sigma, a, false) {
+            vec![1.0]
         } else {
             golden(&g, a, b)
         }
@@ -144,6 +167,22 @@ fn maximise(c: &[f64], goal: Goal, values: &[f64]) -> (f64, f64) {
         }
     }
     (lam, best)
+}
+
+/// Whether every ordinate of `s·d` restricted to [0, x] (`left`) or [x, 1] is ≤ 0, so that
+/// `s·d` ≤ 0 there (the convex-hull property); the restriction by de Casteljau subdivision.
+fn sigma_polygon_sign(d: &[f64], s: f64, x: f64, left: bool) -> bool {
+    let n = d.len();
+    let mut b = d.to_vec();
+    let mut part = Vec::with_capacity(n);
+    let mu = 1.0 - x;
+    for r in 0..n {
+        part.push(if left { b[0] } else { b[n - 1 - r] });
+        for i in 0..n - 1 - r {
+            b[i] = mu * b[i] + x * b[i + 1];
+        }
+    }
+    part.iter().all(|p| s * p <= 0.0)
 }
 
 /// The root of `slope` in (a, b) (positive at a, negative at b) by Newton steps with bisection
