@@ -51,23 +51,20 @@ fn sampled(c: &[f64], samples: usize) -> Vec<f64> {
     let (lo, hi) = (power_basis(c), power_basis(&rev));
     let mut out = vec![0.0; last + 1];
     let mid = last / 2 + 1;
-    horner_at(&lo, (0..mid).map(|k| k as f64 / lf), &mut out[..mid]);
-    horner_at(
-        &hi,
-        (mid..=last).map(|k| (last - k) as f64 / lf),
-        &mut out[mid..],
-    );
+    horner_at(&lo, |i| i as f64 / lf, &mut out[..mid]);
+    horner_at(&hi, |i| (last - mid - i) as f64 / lf, &mut out[mid..]);
     out
 }
 
-/// `out[i] = Σ a_j x_i^j` by Horner, eight points at a time (independent lanes the compiler
+/// `out[i] = Σ a_j x(i)^j` by Horner, eight points at a time (independent lanes the compiler
 /// vectorises).
-fn horner_at(a: &[f64], xs: impl Iterator<Item = f64>, out: &mut [f64]) {
+fn horner_at(a: &[f64], x_of: impl Fn(usize) -> f64, out: &mut [f64]) {
     const LANES: usize = 8;
-    let xs: Vec<f64> = xs.collect();
-    for (xc, oc) in xs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+    for (c, oc) in out.chunks_mut(LANES).enumerate() {
         let mut x = [0.0; LANES];
-        x[..xc.len()].copy_from_slice(xc);
+        for (l, x) in x.iter_mut().enumerate().take(oc.len()) {
+            *x = x_of(c * LANES + l);
+        }
         let top = a.last().copied().unwrap_or(0.0);
         let mut acc = [top; LANES];
         for &aj in a.iter().rev().skip(1) {
@@ -102,13 +99,26 @@ enum Goal {
     Signed(f64),
 }
 
+/// Index of the first largest value (0 when empty or all NaN).
+fn first_max(values: impl Iterator<Item = f64>) -> usize {
+    let mut best_k = 0;
+    let mut top = f64::NEG_INFINITY;
+    for (k, v) in values.enumerate() {
+        if v > top {
+            top = v;
+            best_k = k;
+        }
+    }
+    best_k
+}
+
 /// First differences of a polygon (the derivative polygon up to the factor n/T).
 fn differences(c: &[f64]) -> Vec<f64> {
     c.windows(2).map(|w| w[1] - w[0]).collect()
 }
 
 /// `(λ*, g(λ*))` maximising `g` = |f| or s·f over [0, 1], `f` the Bezier polynomial with
-/// ordinates `c`: the best of `values` (≈ g at uniform samples) chooses the bracket, its two
+/// ordinates `c`: the best of `values` (≈ f at uniform samples) chooses the bracket, its two
 /// neighbouring intervals; where the slope of `g` changes sign across the bracket the critical
 /// point is found by safeguarded Newton on the next-derivative polygon (spec §3.9), otherwise
 /// (a peak at an end, or a flat stretch) by golden section, both to |Δλ| < 1e-12. Every value
@@ -123,14 +133,10 @@ fn maximise(c: &[f64], goal: Goal, values: &[f64]) -> (f64, f64) {
     };
     let last = values.len().max(2) - 1;
     let lf = last as f64;
-    let mut best_k = 0;
-    let mut top = f64::NEG_INFINITY;
-    for (k, &v) in values.iter().enumerate() {
-        if v > top {
-            top = v;
-            best_k = k;
-        }
-    }
+    let best_k = match goal {
+        Goal::Abs => first_max(values.iter().map(|f| f.abs())),
+        Goal::Signed(s) => first_max(values.iter().map(|f| s * f)),
+    };
     let lam_k = best_k as f64 / lf;
     let mut best = g(lam_k);
     let a = (best_k.saturating_sub(1)) as f64 / lf;
@@ -254,8 +260,7 @@ pub fn kinematics(law: &BezierLaw) -> Kinematics {
     let samples = samples(law);
     let t = law.t;
     let peak = |c: &[f64], values: &[f64]| {
-        let abs: Vec<f64> = values.iter().map(|v| v.abs()).collect();
-        let (lam, v) = maximise(c, Goal::Abs, &abs);
+        let (lam, v) = maximise(c, Goal::Abs, values);
         (v, lam * t)
     };
     let sign = if law.s.last().copied().unwrap_or(1.0) < 0.0 {
@@ -284,8 +289,7 @@ fn samples(law: &BezierLaw) -> usize {
 
 /// `(min sign·φ', t)` from φ' sampled at the §3.9 points; exactly 0 at the ends.
 fn min_velocity(law: &BezierLaw, sign: f64, v_samples: &[f64]) -> (f64, f64) {
-    let neg: Vec<f64> = v_samples.iter().map(|v| -sign * v).collect();
-    let (lam, v) = maximise(&law.v, Goal::Signed(-sign), &neg);
+    let (lam, v) = maximise(&law.v, Goal::Signed(-sign), v_samples);
     (-v, lam * law.t)
 }
 
@@ -306,8 +310,7 @@ pub fn reverses(law: &BezierLaw) -> bool {
     let sign = law.s.last().copied().unwrap_or(1.0).signum();
     let v_samples = sampled(&law.v, samples(law));
     let (minv, _) = min_velocity(law, sign, &v_samples);
-    let abs: Vec<f64> = v_samples.iter().map(|v| v.abs()).collect();
-    let (peak, _) = maximise(&law.v, Goal::Abs, &abs);
+    let (peak, _) = maximise(&law.v, Goal::Abs, &v_samples);
     minv < -REVERSAL_REL * peak
 }
 
@@ -352,7 +355,7 @@ mod tests {
     fn peaks_are_de_casteljau_values_at_their_refined_times() {
         for seed in 0..50 {
             let c = polygon(8, seed);
-            let values: Vec<f64> = sampled(&c, 449).iter().map(|v| v.abs()).collect();
+            let values = sampled(&c, 449);
             let (lam, v) = maximise(&c, Goal::Abs, &values);
             assert_eq!(v.to_bits(), de_casteljau(&c, lam).abs().to_bits());
             // No sample of the exact curve is above the refined peak.
@@ -372,7 +375,7 @@ mod tests {
             for seed in 0..40 {
                 let c = polygon(len, 1000 + seed);
                 let scale = c.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-                let values: Vec<f64> = sampled(&c, 64 * len + 1).iter().map(|v| v.abs()).collect();
+                let values = sampled(&c, 64 * len + 1);
                 let (lam, v) = maximise(&c, Goal::Abs, &values);
                 let g = |l: f64| de_casteljau(&c, l).abs();
                 let lf = (values.len() - 1) as f64;
