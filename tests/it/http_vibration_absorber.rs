@@ -327,3 +327,28 @@ async fn harmonics_list_is_validated_per_component() {
     assert_eq!(r.status, 422);
     assert!(r.pointers().contains(&"/excitation/harmonics".to_owned()));
 }
+
+/// Found by the contract fuzzer: every field in range, but a subnormal thickness makes w·t³/12
+/// underflow to 0, so the beam has no natural frequency. The answer is a typed 422, not a 500.
+#[tokio::test]
+async fn a_section_whose_second_moment_underflows_is_refused_not_a_500() {
+    let tiny = json!({
+        "beam": {"youngs_modulus_pa": 7_880_847_593_003.108,
+                 "section": {"width_m": 89.653_966_131_005_42, "thickness_m": 2.225_073_858_5e-313}},
+        "control": {}, "excitation": {}
+    });
+    let r = post_json("/v1/vibration-absorber", &tiny).await;
+    assert_eq!(r.status.as_u16(), 422, "{}", r.json());
+    assert_eq!(r.json()["code"], "NON_FINITE_RESPONSE");
+    // Extreme but representable sections still answer.
+    for (w, t) in [(1e-6, 1e-6), (1e2, 1e2), (1e-6, 1e2)] {
+        let body = json!({"beam": {"section": {"width_m": w, "thickness_m": t}}});
+        let r = post_json("/v1/vibration-absorber", &body).await;
+        assert!(
+            matches!(r.status.as_u16(), 200 | 422),
+            "w = {w}, t = {t}: {} {}",
+            r.status,
+            r.json()
+        );
+    }
+}

@@ -140,6 +140,37 @@ pub fn build_model(input: &VibrationAbsorberInput) -> (Model, Vec<f64>, Option<G
     (model, freqs, gains)
 }
 
+/// Valid fields can still combine into a beam with no finite, positive natural frequency (e.g. a
+/// subnormal thickness whose t³ underflows to 0, or E·I overflowing).
+fn check_beam(input: &VibrationAbsorberInput, freqs: &[f64]) -> Result<(), Error> {
+    match freqs.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        None => Ok(()),
+        Some(f) => Err(Error::NonFinite {
+            stage: "beam model",
+            detail: format!(
+                "natural frequency {f:e} Hz from E·I/(ρ·A·L⁴) = {:e}·{:e}/({:e}·{:e}·{:e}⁴)",
+                input.beam.youngs,
+                input.beam.inertia,
+                input.beam.density,
+                input.beam.area,
+                input.beam.length
+            ),
+        }),
+    }
+}
+
+/// The coupled state-space matrices are finite (else a 422, never a non-finite answer).
+fn check_state_space(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<(), Error> {
+    if a.iter().chain(b.iter()).all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::NonFinite {
+            stage: "coupled state-space model",
+            detail: "a matrix entry overflows double precision at these unit scales".to_owned(),
+        })
+    }
+}
+
 /// Runs the requested analyses (spec §3.D).
 ///
 /// # Errors
@@ -150,6 +181,7 @@ pub fn compute(
     budget: &Budget,
 ) -> Result<VibrationAbsorberOutput, Error> {
     let (model, freqs, gains) = build_model(input);
+    check_beam(input, &freqs)?;
     let mut warnings = Vec::new();
     let mut evaluations = 0_u64;
     let mut iterations = 0_u64;
@@ -163,6 +195,7 @@ pub fn compute(
 
     let a = model.a_matrix();
     let b = model.b_vector();
+    check_state_space(&a, &b)?;
     let need_eig = o.eigenvalues || o.frf.is_some();
     let eigen = if need_eig {
         evaluations += 1;
