@@ -718,6 +718,25 @@ fn map_axis_warning(loss: &Grid2, env: &Envelope, warnings: &mut Vec<String>) {
     }
 }
 
+/// The speed and torque axes of a map motor (`base` = `/motors/{i}`), at least 2 points each:
+/// whether each is valid.
+fn map_axes(
+    v: &mut Validator,
+    base: &str,
+    (speed_rpm, torque_nm): (&[f64], &[f64]),
+    torque_range: Range,
+) -> (bool, bool) {
+    let ok_s = axis(
+        v,
+        &format!("{base}/speed_rpm"),
+        speed_rpm,
+        2,
+        w::SPEED_AXIS_RPM,
+    );
+    let ok_t = axis(v, &format!("{base}/torque_nm"), torque_nm, 2, torque_range);
+    (ok_s, ok_t)
+}
+
 /// The loss grid of an efficiency-map motor (`base` = `/motors/{i}`); empty when invalid.
 fn efficiency_map(
     v: &mut Validator,
@@ -726,20 +745,7 @@ fn efficiency_map(
     env: &Envelope,
     warnings: &mut Vec<String>,
 ) -> Grid2 {
-    let ok_s = axis(
-        v,
-        &format!("{base}/speed_rpm"),
-        &m.speed_rpm,
-        2,
-        w::SPEED_AXIS_RPM,
-    );
-    let ok_t = axis(
-        v,
-        &format!("{base}/torque_nm"),
-        &m.torque_nm,
-        2,
-        w::TORQUE_AXIS_NM,
-    );
+    let (ok_s, ok_t) = map_axes(v, base, (&m.speed_rpm, &m.torque_nm), w::TORQUE_AXIS_NM);
     let shape = (m.speed_rpm.len(), m.torque_nm.len());
     let mut ok = ok_s && ok_t;
     if ok {
@@ -787,18 +793,10 @@ fn loss_map(
     env: &Envelope,
     warnings: &mut Vec<String>,
 ) -> Grid2 {
-    let ok_s = axis(
+    let (ok_s, ok_t) = map_axes(
         v,
-        &format!("{base}/speed_rpm"),
-        &m.speed_rpm,
-        2,
-        w::SPEED_AXIS_RPM,
-    );
-    let ok_t = axis(
-        v,
-        &format!("{base}/torque_nm"),
-        &m.torque_nm,
-        2,
+        base,
+        (&m.speed_rpm, &m.torque_nm),
         w::SIGNED_TORQUE_AXIS_NM,
     );
     if ok_t && !m.torque_nm.iter().any(|&t| t.abs() <= 0.0) {
