@@ -111,6 +111,34 @@ pub fn de_casteljau(c: &[f64], lam: f64) -> f64 {
     }
 }
 
+/// Value and first derivative d/dλ of the Bezier polynomial with ordinates `c` at `λ` ∈ [0, 1]
+/// from one de Casteljau pass: the last two points `b0`, `b1` of the penultimate level give the
+/// value `(1−λ)·b0 + λ·b1` and the derivative `n·(b1 − b0)` (`(c_0, 0)` for a single ordinate,
+/// `(0, 0)` for none).
+#[must_use]
+pub fn de_casteljau_slope(c: &[f64], lam: f64) -> (f64, f64) {
+    let n = c.len();
+    if n < 2 {
+        return (c.first().copied().unwrap_or(0.0), 0.0);
+    }
+    let mut small = [0.0; 16];
+    let mut large = Vec::new();
+    let b = if n <= small.len() {
+        small[..n].copy_from_slice(c);
+        &mut small[..n]
+    } else {
+        large.extend_from_slice(c);
+        &mut large[..]
+    };
+    let mu = 1.0 - lam;
+    for r in 1..n - 1 {
+        for i in 0..n - r {
+            b[i] = mu * b[i] + lam * b[i + 1];
+        }
+    }
+    (mu * b[0] + lam * b[1], (n - 1) as f64 * (b[1] - b[0]))
+}
+
 /// De Casteljau's recurrence on `b` (overwritten); returns the value at `λ`.
 fn casteljau_in_place(b: &mut [f64], lam: f64) -> f64 {
     let n = b.len();
@@ -174,6 +202,33 @@ pub fn bernstein_all(n: usize, lam: f64, out: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One pass gives de Casteljau's value and n times the value of the difference polygon
+    /// (the derivative), for short polygons and past the stack buffer.
+    #[test]
+    fn value_and_slope_match_the_difference_polygon() {
+        for len in 0..=20_usize {
+            let c: Vec<f64> = (0..len)
+                .map(|i| ((i * 7 + 3) % 11) as f64 - 5.0 + 0.1 * i as f64)
+                .collect();
+            let scale = c.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
+            let d: Vec<f64> = c.windows(2).map(|w| w[1] - w[0]).collect();
+            for k in 0..=16 {
+                let lam = f64::from(k) / 16.0;
+                let (v, s) = de_casteljau_slope(&c, lam);
+                assert_eq!(
+                    v.to_bits(),
+                    de_casteljau(&c, lam).to_bits(),
+                    "len {len} λ {lam}"
+                );
+                let exact = len.saturating_sub(1) as f64 * de_casteljau(&d, lam);
+                assert!(
+                    (s - exact).abs() <= 1e-12 * scale * len.max(1) as f64,
+                    "len {len} λ {lam}: {s} vs {exact}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn basis_sums_to_one_and_matches_binomials() {
