@@ -3,13 +3,11 @@
 use super::area::{self, Quad};
 use super::error::ContinuumError;
 use super::fk::{self, Described, HOME_REL_TOL, Home};
-use super::input::{Input, SeedInput, Start};
+use super::input::{Input, Mode, SeedInput, SeedKind, Start};
 use super::model::{Model, Params};
 use super::modes::{self, ModeResult, ModeSolution};
 use super::newton::{self, Counter, Failed, NewtonFailure, Solution, Stepping};
 use super::sweep::{self, NodeData, NodeStatus, WaveResult};
-// Request options carried by the validated input (read only: no wire type is built here).
-use super::wire::{Mode, SeedKind};
 use crate::numerics::{Budget, StopReason};
 
 /// Largest condition number of the scaled Jacobian for an FK answer with determinate rod forces

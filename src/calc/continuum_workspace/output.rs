@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use super::compute::{self, FkOutput, ModesOutput, Output, WaveOutput, WorkspaceOutput};
 use super::fk;
-use super::input::Input;
+use super::input::{self as domain, Input};
 use super::newton;
 use super::presets::Preset;
 use super::sweep::{self, NodeStatus};
@@ -32,13 +32,13 @@ const NODE_BYTES: u64 = 24 + 8 * 25;
 pub fn response_size(input: &Input) -> ResponseSize {
     let rods = input.model.design.rods.len() as u64;
     let mut size = ResponseSize::fixed(16 * 1024 + rods * 1024);
-    if input.mode == Mode::Fk && input.shape_points > 0 {
+    if input.mode == domain::Mode::Fk && input.shape_points > 0 {
         size = size.numbers(
             "/outputs/rod_shape_points",
             rods * 4 * input.shape_points as u64,
         );
     }
-    if let (Mode::Workspace, Some(sw)) = (input.mode, &input.sweep) {
+    if let (domain::Mode::Workspace, Some(sw)) = (input.mode, &input.sweep) {
         let [n1, n2] = sw.settings.grid.map(|n| n as u64);
         size = size.numbers("/workspace/grid", n1 + n2);
         if sw.return_nodes {
@@ -198,6 +198,16 @@ fn fk_status(s: compute::FkStatus) -> wire::FkStatus {
     }
 }
 
+/// The echoed seed kind of a wave.
+fn wire_seed_kind(k: domain::SeedKind) -> wire::SeedKind {
+    match k {
+        domain::SeedKind::Home => wire::SeedKind::Home,
+        domain::SeedKind::Guess => wire::SeedKind::Guess,
+        domain::SeedKind::AssemblyMode => wire::SeedKind::AssemblyMode,
+        domain::SeedKind::AllStableModes => wire::SeedKind::AllStableModes,
+    }
+}
+
 fn wave_out(
     input: &Input,
     w: &WaveOutput,
@@ -293,7 +303,7 @@ fn workspace_response(input: &Input, w: WorkspaceOutput, budget: &Budget) -> Wor
                         .collect(),
                 },
                 sw.return_nodes,
-                sw.seed.kind,
+                wire_seed_kind(sw.seed.kind),
             )
         }
         // No sweep settings: the computation returns no wave.
