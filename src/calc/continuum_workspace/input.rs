@@ -13,6 +13,7 @@ use super::wire::{
     PresetName, RodCrossing, RodRequest, SeedRequest, SolverState, StabilityCheckName, StartKind,
     StartRequest, WorkspaceRequest,
 };
+use crate::calc::common::{self, Shard};
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
 use super::wire::{
@@ -168,6 +169,9 @@ pub struct Input {
     pub home_fallback_modes: ModeSearch,
     /// Sweep, for mode = workspace.
     pub sweep: Option<SweepInput>,
+    /// The block of the sweep's waves this request runs (mode workspace only; `None`: the
+    /// whole sweep, answered in the unsharded shape).
+    pub shard: Option<Shard>,
     /// Warnings found during validation.
     pub warnings: Vec<String>,
     /// Request time limit.
@@ -887,6 +891,24 @@ fn workspace(
     (Some(sweep), too_large)
 }
 
+/// The request's `shard` (validated by [`common::shard`]), which only a workspace sweep takes:
+/// its items are the waves, one per seed (see the `shard` field of the request).
+fn shard(v: &mut Validator, req: &ContinuumWorkspaceRequest) -> Option<Shard> {
+    let shard = common::shard(v, req.shard);
+    let one_job = match req.mode {
+        wire::Mode::Workspace => None,
+        wire::Mode::Fk => Some("fk"),
+        wire::Mode::AssemblyModes => Some("assembly_modes"),
+    };
+    if let (Some(mode), Some(_)) = (one_job, req.shard) {
+        v.push(
+            "/shard",
+            format!("shard splits the waves of a workspace sweep; mode \"{mode}\" has no sweep"),
+        );
+    }
+    shard
+}
+
 /// Whether the mode search runs: when asked for, or when there is no stress-free home
 /// (`has_home`) to start from.
 fn search_needed(
@@ -946,7 +968,8 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         let (start, continuation_steps, stepping) = start(&mut v, req.start.as_ref(), nr);
         let (stability, segments, shape_points) = outputs(&mut v, req);
         let (modes, home_fallback_modes) = mode_search(&mut v, req, nr);
-        let time_limit = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
+        let time_limit = common::time_limit(&mut v, req.time_limit_ms);
+        let shard = shard(&mut v, req);
         let (sweep, too_large) = workspace(&mut v, req, &model);
         let has_home = model.design.home.is_some()
             || fk::home_fit(&model, None).residual <= HOME_REL_TOL * model.l_ref;
@@ -977,6 +1000,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             modes,
             home_fallback_modes,
             sweep,
+            shard,
             warnings,
             time_limit,
         })
