@@ -21,7 +21,9 @@ use crate::calc::continuum_workspace::{
 /// grid, one wave per assembly mode, stopping at unstable, singular or limit-violating nodes;
 /// reachable points, parasitic-angle map, union area of the (possibly folded) cell map, stresses.
 /// Presets (`design.preset`) use ASSUMED geometry and say so. Heavy work honours `time_limit_ms`;
-/// a spent budget returns the partial result with `report.stop_reason = deadline`.
+/// a spent budget returns the partial result with `report.stop_reason = deadline`. A sweep with
+/// several waves (seed kind `all_stable_modes`) can be split by wave with `shard`; the answers of
+/// the shards merge into the unsharded answer as their `shard` says.
 #[utoipa::path(
     post,
     path = "/v1/continuum-workspace",
@@ -29,7 +31,7 @@ use crate::calc::continuum_workspace::{
     operation_id = "solve_continuum_workspace",
     request_body = ContinuumWorkspaceRequest,
     responses(
-        (status = 200, description = "FK result, assembly modes or workspace sweep (shape by `mode`)", body = ContinuumWorkspaceResponse),
+        (status = 200, description = "FK result, assembly modes or workspace sweep (shape by `mode`; a sharded sweep lists its block of waves)", body = ContinuumWorkspaceResponse),
         ProblemResponses
     )
 )]

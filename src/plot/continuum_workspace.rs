@@ -118,8 +118,13 @@ fn fk(answer: &Value) -> Result<String, PlotError> {
     Ok(svg)
 }
 
+/// The nodes of the answer's first wave: at the top level, or the first of `waves` in a
+/// sharded answer.
 fn workspace(answer: &Value) -> Result<String, PlotError> {
-    let nodes = &answer["nodes"];
+    let nodes = match answer.get("nodes") {
+        Some(n) => n,
+        None => &answer["waves"][0]["nodes"],
+    };
     let px = numbers(&nodes["px_m"]);
     let py = numbers(&nodes["py_m"]);
     let ang = numbers(&nodes["parasitic_angle_deg"]);

@@ -1,4 +1,5 @@
-//! `shard: {index, count}` on the sweeps: for count ∈ {1, 2, 3, 7} the shards' answers, merged by
+//! `shard: {index, count}` on the sweeps: for count ∈ {1, 2, 3, 7} (and, for the continuum
+//! workspace's waves, one more than the waves) the shards' answers, merged by
 //! the rule documented on each answer's `shard` (concatenate the per-item arrays in shard order,
 //! add the counters, recompute the named reductions), equal the unsharded answer exactly — the
 //! per-item numbers compared as JSON text, i.e. bit for bit. Bad shards are 422 with the
@@ -7,6 +8,12 @@
 use crate::common;
 
 use mechcalc::calc::bus_fuel_economy::{self, BusFuelEconomyRequest, BusFuelEconomyResponse};
+use mechcalc::calc::continuum_workspace::wire::{
+    WaveOut, WorkspaceResponse, WorkspaceShardResponse,
+};
+use mechcalc::calc::continuum_workspace::{
+    self, ContinuumWorkspaceRequest, ContinuumWorkspaceResponse,
+};
 use mechcalc::calc::irefc::stress::wire::StressSweepResponse;
 use mechcalc::calc::irefc::{IrefcStressRequest, IrefcStressResponse, run_stress};
 use mechcalc::calc::machining_size::wire::SplitMetrics;
@@ -232,6 +239,151 @@ fn machining_cv_fold_shards_merge_into_the_whole_cross_validation() {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Continuum workspace: the waves of a sweep
+// ---------------------------------------------------------------------------------------------
+
+const CONTINUUM: &str = "/v1/continuum-workspace";
+
+/// Design 1, one wave per stable assembly mode at (-0.22, 0.2425) (a node of the 5 x 5 grid):
+/// the N_grid 4 search finds three stable modes there (tests/it/http_continuum_workspace.rs).
+fn continuum_body() -> Value {
+    json!({"mode": "workspace", "design": {"preset": "keops_d1"}, "assembly_modes": {"n_grid": 4},
+           "workspace": {"grid": [5, 5], "ranges_m": [[-0.26, -0.18], [0.2025, 0.2825]],
+                         "seed": {"kind": "all_stable_modes", "inputs_m": [-0.22, 0.2425]},
+                         "stability_segments": 10, "return_nodes": true}})
+}
+
+fn continuum(body: &Value) -> ContinuumWorkspaceResponse {
+    let req: ContinuumWorkspaceRequest =
+        serde_json::from_value(body.clone()).expect("valid request");
+    continuum_workspace::run(req, &Budget::unlimited()).expect("sweep runs")
+}
+
+fn continuum_whole(body: &Value) -> WorkspaceResponse {
+    match continuum(body) {
+        ContinuumWorkspaceResponse::Workspace(r) => *r,
+        _ => panic!("an unsharded sweep answered in another shape"),
+    }
+}
+
+fn continuum_shard(body: &Value) -> WorkspaceShardResponse {
+    match continuum(body) {
+        ContinuumWorkspaceResponse::WorkspaceShard(r) => *r,
+        _ => panic!("a sharded sweep answered in another shape"),
+    }
+}
+
+/// The merge rule of `WorkspaceShardResponse::shard`: waves concatenated in shard order, the
+/// first at the top level and the rest as `other_waves`; `grid` and `preset` from any shard;
+/// warnings the union in order of first appearance; `timing_ms` and `report` (per shard) taken
+/// from `like`, the answer compared with.
+fn merge_waves(parts: &[WorkspaceShardResponse], like: &WorkspaceResponse) -> WorkspaceResponse {
+    let mut waves: Vec<WaveOut> = parts.iter().flat_map(|p| p.waves.clone()).collect();
+    let mut warnings: Vec<String> = Vec::new();
+    for w in parts.iter().flat_map(|p| &p.warnings) {
+        if !warnings.contains(w) {
+            warnings.push(w.clone());
+        }
+    }
+    let first = waves.remove(0);
+    WorkspaceResponse {
+        mode: parts[0].mode,
+        grid: parts[0].grid.clone(),
+        wave: first,
+        other_waves: (!waves.is_empty()).then_some(waves),
+        timing_ms: like.timing_ms,
+        warnings,
+        preset: parts[0].preset.clone(),
+        report: like.report.clone(),
+    }
+}
+
+#[test]
+fn continuum_wave_shards_merge_into_the_whole_sweep() {
+    let body = continuum_body();
+    let whole = continuum_whole(&body);
+    let n = 1 + whole.other_waves.as_ref().map_or(0, Vec::len);
+    assert!(n >= 2, "the sweep has one wave per stable mode, got {n}");
+    assert!(
+        whole.wave.metrics.n_accepted > 1,
+        "the first wave spreads beyond its seed"
+    );
+    assert!(
+        !text(&whole).contains("\"shard\""),
+        "no shard statement without a shard"
+    );
+    for count in [1, 2, 3, n as u32 + 1, 7] {
+        let parts: Vec<WorkspaceShardResponse> = (0..count)
+            .map(|i| continuum_shard(&with_shard(&body, i, count)))
+            .collect();
+        let mut next = 0u64;
+        for (i, p) in parts.iter().enumerate() {
+            let s = p.shard;
+            assert_eq!(
+                (s.index, s.count, s.total, s.start),
+                (i as u32, count, n as u64, next),
+                "count {count}"
+            );
+            assert_eq!(s.end - s.start, p.waves.len() as u64);
+            assert_eq!(text(&p.grid), text(&whole.grid));
+            next = s.end;
+        }
+        assert_eq!(next, n as u64, "count {count}: the blocks cover the waves");
+        if count as usize > n {
+            assert!(
+                parts[n..].iter().all(|p| p.waves.is_empty()),
+                "count {count}: shards beyond the waves are empty"
+            );
+        }
+        assert_eq!(
+            text(&merge_waves(&parts, &whole)),
+            text(&whole),
+            "count {count}: the merged answer"
+        );
+    }
+}
+
+/// The single-seed sweep is one wave: shard 0 holds it, the others are empty; every sharded
+/// answer (an empty one too) is described by the published document.
+#[tokio::test]
+async fn a_single_seed_sweep_is_one_wave_and_sharded_answers_follow_the_document() {
+    let body = json!({"mode": "workspace", "design": {"preset": "keops_d1"},
+                      "workspace": {"grid": [5, 5], "stability_check": "none"}});
+    let whole = common::post_json(CONTINUUM, &body).await.json();
+    let doc = crate::contract::doc();
+    let op = &doc["paths"][CONTINUUM]["post"];
+    let answers = &op["responses"]["200"]["content"]["application/json"]["schema"];
+    let requests = &op["requestBody"]["content"]["application/json"]["schema"];
+    for index in 0..3 {
+        let req = with_shard(&body, index, 3);
+        assert_eq!(
+            crate::contract::violations(&doc, requests, &req),
+            Vec::<String>::new()
+        );
+        let r = common::post_json(CONTINUUM, &req).await;
+        assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+        let b = r.json();
+        assert_eq!(
+            crate::contract::violations(&doc, answers, &b),
+            Vec::<String>::new()
+        );
+        let (start, end) = if index == 0 { (0, 1) } else { (1, 1) };
+        assert_eq!(
+            b["shard"],
+            json!({"index": index, "count": 3, "start": start, "end": end, "total": 1})
+        );
+        let waves = b["waves"].as_array().expect("waves");
+        assert_eq!(waves.len(), end - start);
+        assert!(b.get("seed").is_none() && b.get("other_waves").is_none());
+        if let Some(w) = waves.first() {
+            for key in ["seed", "metrics", "failures"] {
+                assert_eq!(w[key], whole[key], "{key}");
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Bad shards over HTTP
 // ---------------------------------------------------------------------------------------------
 
@@ -241,6 +393,7 @@ async fn bad_shards_are_422_with_the_fields_pointer() {
         ("/v1/irefc-stress", irefc_body()),
         ("/v1/bus-fuel-economy", bus_body()),
         ("/v1/machining-size/train", train_body()),
+        (CONTINUUM, continuum_body()),
     ];
     let cases = [
         (2, 2, "/shard/index"),
@@ -271,6 +424,19 @@ async fn bad_shards_are_422_with_the_fields_pointer() {
     let r = common::post_json("/v1/machining-size/train", &with_shard(&no_cv, 0, 2)).await;
     r.problem(422);
     assert_eq!(r.pointers(), vec!["/shard"]);
+    // The continuum modes fk and assembly_modes are one job: any shard (even the whole, count
+    // 1) is refused, as IREFC's mode "single" does.
+    let fk = json!({"mode": "fk", "design": {"preset": "keops_d1"}, "inputs_m": [-0.15, 0.2225]});
+    let modes = json!({"mode": "assembly_modes", "design": {"preset": "keops_d1"},
+                       "inputs_m": [-0.22, 0.2425], "assembly_modes": {"n_grid": 2}});
+    for body in [fk, modes] {
+        for count in [1, 2] {
+            let r = common::post_json(CONTINUUM, &with_shard(&body, 0, count)).await;
+            let p = r.problem(422);
+            assert_eq!(p["type"], "/problems/invalid-input", "{p}");
+            assert_eq!(r.pointers(), vec!["/shard"], "{p}");
+        }
+    }
 }
 
 #[tokio::test]

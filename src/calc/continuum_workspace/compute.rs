@@ -3,13 +3,12 @@
 use super::area::{self, Quad};
 use super::error::ContinuumError;
 use super::fk::{self, Described, HOME_REL_TOL, Home};
-use super::input::{Input, SeedInput, Start};
+use super::input::{Input, Mode, SeedInput, SeedKind, Start, SweepInput};
 use super::model::{Model, Params};
 use super::modes::{self, ModeResult, ModeSolution};
 use super::newton::{self, Counter, Failed, NewtonFailure, Solution, Stepping};
 use super::sweep::{self, NodeData, NodeStatus, WaveResult};
-// Request options carried by the validated input (read only: no wire type is built here).
-use super::wire::{Mode, SeedKind};
+use crate::calc::common::Shard;
 use crate::numerics::{Budget, StopReason};
 
 /// Largest condition number of the scaled Jacobian for an FK answer with determinate rod forces
@@ -101,8 +100,11 @@ pub struct Metrics {
 /// Sweep result.
 #[derive(Debug, Clone)]
 pub struct WorkspaceOutput {
-    /// One entry per wave.
+    /// One entry per wave run, in seed order: every wave, or with `input.shard` the waves of
+    /// the shard's block (`Shard::range(n_waves)`).
     pub waves: Vec<WaveOutput>,
+    /// Waves of the whole sweep (one per seed found at the seed node).
+    pub n_waves: usize,
     /// Warnings.
     pub warnings: Vec<String>,
     /// Evaluations.
@@ -440,11 +442,15 @@ fn nearest_node(s: &sweep::SweepSettings, x: [f64; 2]) -> (usize, usize) {
     (pick(0), pick(1))
 }
 
+/// The workspace sweep (spec 4.7): the seeds at the seed node, then one wave per seed, in
+/// seed order; with `input.shard` only the waves of the shard's block run (the seeds are found
+/// in every shard: they say how many waves there are and where each starts).
 fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, ContinuumError> {
     let model = &input.model;
     let Some(sw) = &input.sweep else {
         return Ok(WorkspaceOutput {
             waves: Vec::new(),
+            n_waves: 0,
             warnings: input.warnings.clone(),
             evaluations: 0,
             attempts: 0,
@@ -479,62 +485,20 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
         &mut counter,
         &mut warnings,
     )?;
-    let n = s.grid[0] * s.grid[1];
-    let mut waves = Vec::with_capacity(seeds.len());
+    let n_waves = seeds.len();
+    let mine = input.shard.unwrap_or(Shard::WHOLE).range(n_waves);
+    let mut waves = Vec::with_capacity(mine.len());
     let mut evaluations = counter.evaluations;
     let mut attempts = 0u64;
     let mut stop = StopReason::Completed;
-    for (mode_index, seed) in seeds {
-        let seed_pose = seed
-            .as_ref()
-            .ok()
-            .map(|sol| (model.position(&sol.v), model.angle(&sol.v)));
-        let accepted: Result<NodeData, NodeStatus> = seed.and_then(|sol| {
-            if let Some(st) = sweep::input_limits(model, s, &lam0) {
-                return Err(st);
-            }
-            sweep::accept(model, s, &lam0, &sol, None)
-        });
-        let (seed_status, wave) = match accepted {
-            Ok(d) => {
-                let w = sweep::wave(model, &input.params, s, node, d, input.newton, budget);
-                (NodeStatus::Ok, w)
-            }
-            Err(st) => {
-                let mut status = vec![NodeStatus::Unvisited; n];
-                status[node.0 * s.grid[1] + node.1] = st;
-                let stop = if budget.expired() {
-                    StopReason::Deadline
-                } else {
-                    StopReason::Completed
-                };
-                (
-                    st,
-                    WaveResult {
-                        status,
-                        nodes: vec![None; n],
-                        stop,
-                        attempts: 0,
-                        evaluations: 0,
-                    },
-                )
-            }
-        };
-        evaluations += wave.evaluations;
-        attempts += wave.attempts;
-        if wave.stop != StopReason::Completed {
-            stop = wave.stop;
+    for (mode_index, seed) in seeds.into_iter().skip(mine.start).take(mine.len()) {
+        let w = seed_wave(input, sw, (node, lam0), (mode_index, seed), budget);
+        evaluations += w.wave.evaluations;
+        attempts += w.wave.attempts;
+        if w.wave.stop != StopReason::Completed {
+            stop = w.wave.stop;
         }
-        let metrics = metrics(model, s.grid, &wave, sw.qt_threshold, sw.union);
-        waves.push(WaveOutput {
-            seed_node: node,
-            seed_inputs: lam0,
-            seed_status,
-            seed_mode_index: mode_index,
-            seed_pose,
-            wave,
-            metrics,
-        });
+        waves.push(w);
     }
     if budget.expired() && stop == StopReason::Completed {
         stop = StopReason::Deadline;
@@ -547,11 +511,73 @@ fn run_workspace(input: &Input, budget: &Budget) -> Result<WorkspaceOutput, Cont
     }
     Ok(WorkspaceOutput {
         waves,
+        n_waves,
         warnings,
         evaluations,
         attempts,
         stop,
     })
+}
+
+/// One wave from its seed at the seed node `(node, lam0)`: an accepted seed (input limits,
+/// conditioning, stability) spreads the wave over the grid; otherwise the wave is the seed
+/// node alone, with the reason it failed. Depends on nothing but the input and its seed, so
+/// every wave is the same in a shard as in the whole sweep.
+fn seed_wave(
+    input: &Input,
+    sw: &SweepInput,
+    (node, lam0): ((usize, usize), [f64; 2]),
+    (mode_index, seed): SeedResult,
+    budget: &Budget,
+) -> WaveOutput {
+    let model = &input.model;
+    let s = &sw.settings;
+    let n = s.grid[0] * s.grid[1];
+    let seed_pose = seed
+        .as_ref()
+        .ok()
+        .map(|sol| (model.position(&sol.v), model.angle(&sol.v)));
+    let accepted: Result<NodeData, NodeStatus> = seed.and_then(|sol| {
+        if let Some(st) = sweep::input_limits(model, s, &lam0) {
+            return Err(st);
+        }
+        sweep::accept(model, s, &lam0, &sol, None)
+    });
+    let (seed_status, wave) = match accepted {
+        Ok(d) => {
+            let w = sweep::wave(model, &input.params, s, node, d, input.newton, budget);
+            (NodeStatus::Ok, w)
+        }
+        Err(st) => {
+            let mut status = vec![NodeStatus::Unvisited; n];
+            status[node.0 * s.grid[1] + node.1] = st;
+            let stop = if budget.expired() {
+                StopReason::Deadline
+            } else {
+                StopReason::Completed
+            };
+            (
+                st,
+                WaveResult {
+                    status,
+                    nodes: vec![None; n],
+                    stop,
+                    attempts: 0,
+                    evaluations: 0,
+                },
+            )
+        }
+    };
+    let metrics = metrics(model, s.grid, &wave, sw.qt_threshold, sw.union);
+    WaveOutput {
+        seed_node: node,
+        seed_inputs: lam0,
+        seed_status,
+        seed_mode_index: mode_index,
+        seed_pose,
+        wave,
+        metrics,
+    }
 }
 
 /// The seeds of the sweep's waves at the seed node (spec 4.7), by seed kind: continuation from

@@ -9,10 +9,11 @@ use super::newton::{NewtonOptions, Stepping};
 use super::presets::Preset;
 use super::sweep::{Limits, StabilityCheck, SweepSettings};
 use super::wire::{
-    ActuatorRequest, AreaMethod, ContinuationKind, ContinuumWorkspaceRequest, DesignRequest, Mode,
-    PresetName, RodCrossing, RodRequest, SeedKind, SeedRequest, SolverState, StabilityCheckName,
-    StartKind, StartRequest, WorkspaceRequest,
+    self, ActuatorRequest, AreaMethod, ContinuationKind, ContinuumWorkspaceRequest, DesignRequest,
+    PresetName, RodCrossing, RodRequest, SeedRequest, SolverState, StabilityCheckName, StartKind,
+    StartRequest, WorkspaceRequest,
 };
+use crate::calc::common::{self, Shard};
 use crate::calc::{CalcFailure, ProblemClass, Validator};
 
 use super::wire::{
@@ -47,6 +48,53 @@ const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
 /// Upper limit on worker threads of the sweep: none of its own, the job's budget decides (the
 /// compute pool's threads per job); results do not depend on it.
 pub const SWEEP_THREADS: usize = usize::MAX;
+
+/// What the request computes (the domain form of the wire `mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Forward kinematics at one input.
+    Fk,
+    /// Workspace sweep over the 2-D input grid, one wave per seed.
+    Workspace,
+    /// Assembly-mode search at one input.
+    AssemblyModes,
+}
+
+impl From<wire::Mode> for Mode {
+    fn from(m: wire::Mode) -> Self {
+        match m {
+            wire::Mode::Fk => Self::Fk,
+            wire::Mode::Workspace => Self::Workspace,
+            wire::Mode::AssemblyModes => Self::AssemblyModes,
+        }
+    }
+}
+
+/// How the waves of a sweep are seeded at the seed node (the domain form of the wire
+/// `workspace.seed.kind`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeedKind {
+    /// Continuation from the stress-free home (without one: the stable assembly mode with the
+    /// smallest |theta_EE|): one wave.
+    Home,
+    /// Newton from a given state: one wave.
+    Guess,
+    /// One assembly mode of the search: one wave.
+    AssemblyMode,
+    /// Every stable assembly mode of the search: one wave each.
+    AllStableModes,
+}
+
+impl From<wire::SeedKind> for SeedKind {
+    fn from(k: wire::SeedKind) -> Self {
+        match k {
+            wire::SeedKind::Home => Self::Home,
+            wire::SeedKind::Guess => Self::Guess,
+            wire::SeedKind::AssemblyMode => Self::AssemblyMode,
+            wire::SeedKind::AllStableModes => Self::AllStableModes,
+        }
+    }
+}
 
 /// How the FK starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -121,6 +169,9 @@ pub struct Input {
     pub home_fallback_modes: ModeSearch,
     /// Sweep, for mode = workspace.
     pub sweep: Option<SweepInput>,
+    /// The block of the sweep's waves this request runs (mode workspace only; `None`: the
+    /// whole sweep, answered in the unsharded shape).
+    pub shard: Option<Shard>,
     /// Warnings found during validation.
     pub warnings: Vec<String>,
     /// Request time limit.
@@ -479,7 +530,7 @@ fn load(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> ([
 fn inputs(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> Vec<f64> {
     let n_act = model.n_act();
     let mut lambda = vec![0.0; n_act];
-    if !matches!(req.mode, Mode::Fk | Mode::AssemblyModes) {
+    if !matches!(req.mode, wire::Mode::Fk | wire::Mode::AssemblyModes) {
         return lambda;
     }
     match &req.inputs_m {
@@ -785,7 +836,8 @@ fn seed(v: &mut Validator, seed: Option<&SeedRequest>, nr: usize) -> SeedInput {
     if let Some(i) = &s.inputs_m {
         coords(v, "/workspace/seed/inputs_m", i);
     }
-    let state = match (s.kind, &s.state) {
+    let kind = SeedKind::from(s.kind);
+    let state = match (kind, &s.state) {
         (SeedKind::Guess, None) => {
             v.push("/workspace/seed/state", "required when seed.kind = guess");
             None
@@ -794,7 +846,7 @@ fn seed(v: &mut Validator, seed: Option<&SeedRequest>, nr: usize) -> SeedInput {
         _ => None,
     };
     SeedInput {
-        kind: s.kind,
+        kind,
         inputs: s.inputs_m,
         state,
         index: s.index.unwrap_or(0),
@@ -807,7 +859,7 @@ fn workspace(
     req: &ContinuumWorkspaceRequest,
     model: &Model,
 ) -> (Option<SweepInput>, Option<CalcFailure>) {
-    if req.mode != Mode::Workspace {
+    if req.mode != wire::Mode::Workspace {
         return (None, None);
     }
     let n_act = model.n_act();
@@ -839,6 +891,24 @@ fn workspace(
     (Some(sweep), too_large)
 }
 
+/// The request's `shard` (validated by [`common::shard`]), which only a workspace sweep takes:
+/// its items are the waves, one per seed (see the `shard` field of the request).
+fn shard(v: &mut Validator, req: &ContinuumWorkspaceRequest) -> Option<Shard> {
+    let shard = common::shard(v, req.shard);
+    let one_job = match req.mode {
+        wire::Mode::Workspace => None,
+        wire::Mode::Fk => Some("fk"),
+        wire::Mode::AssemblyModes => Some("assembly_modes"),
+    };
+    if let (Some(mode), Some(_)) = (one_job, req.shard) {
+        v.push(
+            "/shard",
+            format!("shard splits the waves of a workspace sweep; mode \"{mode}\" has no sweep"),
+        );
+    }
+    shard
+}
+
 /// Whether the mode search runs: when asked for, or when there is no stress-free home
 /// (`has_home`) to start from.
 fn search_needed(
@@ -847,7 +917,7 @@ fn search_needed(
     sweep: Option<&SweepInput>,
     has_home: bool,
 ) -> bool {
-    req.mode == Mode::AssemblyModes
+    req.mode == wire::Mode::AssemblyModes
         || matches!(start, Start::AssemblyMode(_))
         || sweep.is_some_and(|s| {
             matches!(
@@ -855,7 +925,7 @@ fn search_needed(
                 SeedKind::AssemblyMode | SeedKind::AllStableModes
             ) || (s.seed.kind == SeedKind::Home && !has_home)
         })
-        || (req.mode == Mode::Fk && *start == Start::Home && !has_home)
+        || (req.mode == wire::Mode::Fk && *start == Start::Home && !has_home)
 }
 
 /// The mode search of `n_grid` for `nr` rods within [`MAX_COMBINATIONS`].
@@ -898,7 +968,8 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         let (start, continuation_steps, stepping) = start(&mut v, req.start.as_ref(), nr);
         let (stability, segments, shape_points) = outputs(&mut v, req);
         let (modes, home_fallback_modes) = mode_search(&mut v, req, nr);
-        let time_limit = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
+        let time_limit = common::time_limit(&mut v, req.time_limit_ms);
+        let shard = shard(&mut v, req);
         let (sweep, too_large) = workspace(&mut v, req, &model);
         let has_home = model.design.home.is_some()
             || fk::home_fit(&model, None).residual <= HOME_REL_TOL * model.l_ref;
@@ -911,7 +982,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             search_size(modes.n_grid, nr, has_home)?;
         }
         Ok(Self {
-            mode: req.mode,
+            mode: Mode::from(req.mode),
             model,
             preset,
             params: Params {
@@ -929,6 +1000,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             modes,
             home_fallback_modes,
             sweep,
+            shard,
             warnings,
             time_limit,
         })

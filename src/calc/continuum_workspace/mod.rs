@@ -23,6 +23,26 @@
 //!   unstable, singular or limit-violating nodes ([`sweep`], 4.7), and the derived metrics (union
 //!   area of the possibly folded cell map, parasitic angle, stresses; [`area`], 4.8).
 //!
+//! # Sharding (`shard`, mode `workspace`)
+//! The independent items of a sweep are its WAVES, not blocks of grid nodes: a wave spreads
+//! breadth-first from its seed and every node is solved from an already accepted neighbour
+//! (whose state starts the Newton solve and whose tangent predicts it; the neighbour that
+//! reaches a node first decides its branch), so no block of nodes can be computed without the
+//! nodes before it. A sweep has one wave per seed: seed kind `all_stable_modes` one per stable
+//! assembly mode at the seed node, every other kind exactly one. A single-seed sweep therefore
+//! cannot be split: shard 0 of it holds the one wave and shards 1.. are empty. Every shard runs
+//! the seed search (the same in each; it gives the number of waves and their seeds), then only
+//! the waves `Shard::range(n_waves)`, each exactly as in the whole sweep. A sharded answer
+//! ([`wire::WorkspaceShardResponse`]) lists its waves and says which they are (`shard`, with
+//! `total` = waves of the sweep). Merge rule: concatenate the `waves` of shards 0..count in
+//! order; the first wave overall is the unsharded answer's top-level wave (`seed`, `nodes`,
+//! `metrics`, `failures`) and the rest, in order, its `other_waves` (omitted for one wave);
+//! `grid` and `preset` are the same in every shard; `warnings` are the union of the shards'
+//! warnings in order of first appearance; `timing_ms` and `report` are per shard. Every metric
+//! belongs to one wave, so nothing is added up or recomputed. Modes `fk` and `assembly_modes`
+//! are one job with nothing to split: a `shard` there is a 422 at `/shard`, as on the other
+//! endpoints' modes without a sweep.
+//!
 //! # References
 //! * Planar continuum Keops-Delta workspace paper (`shared/papers/planar-continuum-delta-workspace.txt`):
 //!   Kirchhoff rods, shooting FK, elliptic-integral full FK, wave-propagation workspace, parasitic

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use super::compute::{self, FkOutput, ModesOutput, Output, WaveOutput, WorkspaceOutput};
 use super::fk;
-use super::input::Input;
+use super::input::{self as domain, Input};
 use super::newton;
 use super::presets::Preset;
 use super::sweep::{self, NodeStatus};
@@ -14,7 +14,7 @@ use super::wire::{
     self, ActuatorRequest, AssemblyModeOut, AssemblyModesResponse, ContinuumWorkspaceResponse,
     DiagnosticsOut, FkResponse, GridOut, MetricsOut, Mode, ModeSearchOut, NodesOut, PlatformOut,
     PresetName, PresetOut, RodOut, RodRequest, SeedOut, SolverState, StabilityOut, WaveOut,
-    WorkspaceResponse,
+    WorkspaceResponse, WorkspaceShardResponse,
 };
 use crate::calc::common::ResponseSize;
 use crate::numerics::angles::wrap_pi;
@@ -32,13 +32,13 @@ const NODE_BYTES: u64 = 24 + 8 * 25;
 pub fn response_size(input: &Input) -> ResponseSize {
     let rods = input.model.design.rods.len() as u64;
     let mut size = ResponseSize::fixed(16 * 1024 + rods * 1024);
-    if input.mode == Mode::Fk && input.shape_points > 0 {
+    if input.mode == domain::Mode::Fk && input.shape_points > 0 {
         size = size.numbers(
             "/outputs/rod_shape_points",
             rods * 4 * input.shape_points as u64,
         );
     }
-    if let (Mode::Workspace, Some(sw)) = (input.mode, &input.sweep) {
+    if let (domain::Mode::Workspace, Some(sw)) = (input.mode, &input.sweep) {
         let [n1, n2] = sw.settings.grid.map(|n| n as u64);
         size = size.numbers("/workspace/grid", n1 + n2);
         if sw.return_nodes {
@@ -124,9 +124,7 @@ fn wrap_deg(t: f64) -> f64 {
 pub fn respond(input: &Input, out: Output, budget: &Budget) -> ContinuumWorkspaceResponse {
     match out {
         Output::Fk(f) => ContinuumWorkspaceResponse::Fk(Box::new(fk_response(input, *f, budget))),
-        Output::Workspace(w) => {
-            ContinuumWorkspaceResponse::Workspace(Box::new(workspace_response(input, *w, budget)))
-        }
+        Output::Workspace(w) => workspace_response(input, *w, budget),
         Output::Modes(m) => {
             ContinuumWorkspaceResponse::AssemblyModes(Box::new(modes_response(input, *m, budget)))
         }
@@ -195,6 +193,16 @@ fn fk_status(s: compute::FkStatus) -> wire::FkStatus {
         compute::FkStatus::Ok => wire::FkStatus::Ok,
         compute::FkStatus::NoConvergence => wire::FkStatus::NoConvergence,
         compute::FkStatus::Singular => wire::FkStatus::Singular,
+    }
+}
+
+/// The echoed seed kind of a wave.
+fn wire_seed_kind(k: domain::SeedKind) -> wire::SeedKind {
+    match k {
+        domain::SeedKind::Home => wire::SeedKind::Home,
+        domain::SeedKind::Guess => wire::SeedKind::Guess,
+        domain::SeedKind::AssemblyMode => wire::SeedKind::AssemblyMode,
+        domain::SeedKind::AllStableModes => wire::SeedKind::AllStableModes,
     }
 }
 
@@ -279,7 +287,14 @@ fn wave_out(
     }
 }
 
-fn workspace_response(input: &Input, w: WorkspaceOutput, budget: &Budget) -> WorkspaceResponse {
+/// The answer of a sweep: unsharded, the first wave flattened at the top level and the others
+/// in `other_waves`; with `shard`, the shard's waves as a list with the shard statement (the
+/// merge rule is documented on `WorkspaceShardResponse::shard`).
+fn workspace_response(
+    input: &Input,
+    w: WorkspaceOutput,
+    budget: &Budget,
+) -> ContinuumWorkspaceResponse {
     let (grid, return_nodes, seed_kind) = match &input.sweep {
         Some(sw) => {
             let s = &sw.settings;
@@ -293,7 +308,7 @@ fn workspace_response(input: &Input, w: WorkspaceOutput, budget: &Budget) -> Wor
                         .collect(),
                 },
                 sw.return_nodes,
-                sw.seed.kind,
+                wire_seed_kind(sw.seed.kind),
             )
         }
         // No sweep settings: the computation returns no wave.
@@ -311,34 +326,24 @@ fn workspace_response(input: &Input, w: WorkspaceOutput, budget: &Budget) -> Wor
         .iter()
         .map(|x| wave_out(input, x, return_nodes, seed_kind))
         .collect();
+    if let Some(shard) = input.shard {
+        return ContinuumWorkspaceResponse::WorkspaceShard(Box::new(WorkspaceShardResponse {
+            mode: Mode::Workspace,
+            grid,
+            waves,
+            shard: shard.out(w.n_waves),
+            timing_ms: budget.elapsed_ms(),
+            warnings: w.warnings,
+            preset: preset_out(input),
+            report: report(w.stop, w.attempts, w.evaluations, budget),
+        }));
+    }
     let first = if waves.is_empty() {
-        WaveOut {
-            seed: SeedOut {
-                kind: wire::SeedKind::Home,
-                node: [0, 0],
-                inputs_m: [0.0, 0.0],
-                status: NodeStatus::Unvisited.code(),
-                assembly_mode_index: None,
-                platform: None,
-            },
-            nodes: None,
-            metrics: MetricsOut {
-                n_accepted: 0,
-                n_cells: 0,
-                area_union_m2: None,
-                area_sum_m2: 0.0,
-                folded_cells: 0,
-                quasi_translational_area_m2: 0.0,
-                max_abs_parasitic_deg: 0.0,
-                mean_abs_parasitic_deg: 0.0,
-                max_bending_stress_pa: None,
-            },
-            failures: BTreeMap::new(),
-        }
+        no_wave()
     } else {
         waves.remove(0)
     };
-    WorkspaceResponse {
+    ContinuumWorkspaceResponse::Workspace(Box::new(WorkspaceResponse {
         mode: Mode::Workspace,
         grid,
         wave: first,
@@ -347,6 +352,33 @@ fn workspace_response(input: &Input, w: WorkspaceOutput, budget: &Budget) -> Wor
         warnings: w.warnings,
         preset: preset_out(input),
         report: report(w.stop, w.attempts, w.evaluations, budget),
+    }))
+}
+
+/// The top-level wave of an answer without waves (no sweep settings).
+fn no_wave() -> WaveOut {
+    WaveOut {
+        seed: SeedOut {
+            kind: wire::SeedKind::Home,
+            node: [0, 0],
+            inputs_m: [0.0, 0.0],
+            status: NodeStatus::Unvisited.code(),
+            assembly_mode_index: None,
+            platform: None,
+        },
+        nodes: None,
+        metrics: MetricsOut {
+            n_accepted: 0,
+            n_cells: 0,
+            area_union_m2: None,
+            area_sum_m2: 0.0,
+            folded_cells: 0,
+            quasi_translational_area_m2: 0.0,
+            max_abs_parasitic_deg: 0.0,
+            mean_abs_parasitic_deg: 0.0,
+            max_bending_stress_pa: None,
+        },
+        failures: BTreeMap::new(),
     }
 }
 

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::calc::Range;
+use crate::calc::common::{Shard, ShardOut};
 use crate::numerics::SolverReport;
 
 /// What to compute.
@@ -88,6 +89,19 @@ pub struct ContinuumWorkspaceRequest {
     #[serde(default)]
     #[schema(example = 10_000)]
     pub time_limit_ms: Option<u64>,
+    /// Run only block `index` of `count` near-equal contiguous blocks of the sweep's WAVES
+    /// (extension; mode `workspace` only, a 422 at `/shard` on the other modes). The waves are
+    /// the items, in their order: one per seed (seed kind `all_stable_modes`: one per stable
+    /// assembly mode found at the seed node; every other kind: exactly one). A wave cannot be
+    /// split into blocks of nodes, because it spreads breadth-first and every node is solved
+    /// from an accepted neighbour, so a single-seed sweep is one item: its shard 0 holds the
+    /// wave and shards 1.. are empty. Every shard runs the seed search (the same in each: it
+    /// gives the number of waves and their seeds), then only its waves, each exactly as in the
+    /// unsharded sweep. The answer then has the shape `WorkspaceShardResponse`; merging the
+    /// answers of shards 0..count as its `shard` says gives the unsharded answer.
+    #[serde(default)]
+    #[schema(nullable = false)]
+    pub shard: Option<Shard>,
 }
 
 /// Mechanism design (spec 3.1): either `preset` alone (optionally with `sigma_allow_pa`) or
@@ -528,6 +542,8 @@ pub enum ContinuumWorkspaceResponse {
     Fk(Box<FkResponse>),
     /// mode = workspace.
     Workspace(Box<WorkspaceResponse>),
+    /// mode = workspace with `shard` in the request.
+    WorkspaceShard(Box<WorkspaceShardResponse>),
     /// mode = assembly_modes.
     AssemblyModes(Box<AssemblyModesResponse>),
 }
@@ -790,6 +806,42 @@ pub struct WorkspaceResponse {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub preset: Option<PresetOut>,
     /// Cost and stop reason (deadline: partial sweep).
+    pub report: SolverReport,
+}
+
+/// mode = workspace with `shard` in the request: the shard's block of the sweep's waves, each
+/// wave whole (seed, nodes, metrics, failures) as in the unsharded answer.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = continuum_workspace::WorkspaceShardResponse)]
+pub struct WorkspaceShardResponse {
+    /// Always `workspace`.
+    pub mode: Mode,
+    /// Grid (the whole grid: the same in every shard).
+    pub grid: GridOut,
+    /// The waves `shard.start..shard.end` of the whole sweep, in order (empty when the sweep
+    /// has fewer waves than shards).
+    pub waves: Vec<WaveOut>,
+    /// Which waves this answer holds (`total`: the waves of the whole sweep).
+    /// Merge rule: request shards 0..count with the same body and concatenate their `waves`
+    /// in shard order (wave `start + i` of the sweep is `waves[i]` of the shard holding it).
+    /// The unsharded answer is then: `mode`, `grid` and `preset` of any shard (the same in
+    /// every shard); the first merged wave's `seed`, `nodes`, `metrics` and `failures` at the
+    /// top level and the other merged waves, in order, as `other_waves` (omitted when the
+    /// sweep has one wave); `warnings` the union of the shards' warnings in order of first
+    /// appearance (every shard repeats those of validation and of the seed search; a shard
+    /// whose budget ran out adds `budget_exhausted`). There is nothing to add up or
+    /// recompute: every metric belongs to one wave. `timing_ms` and `report` are per shard
+    /// (every shard's report counts its seed search too).
+    pub shard: ShardOut,
+    /// Wall-clock time of this shard \[ms\].
+    pub timing_ms: f64,
+    /// Warnings.
+    pub warnings: Vec<String>,
+    /// Preset statement when a preset was used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub preset: Option<PresetOut>,
+    /// Cost and stop reason of this shard (the seed search and its waves; deadline: partial).
     pub report: SolverReport,
 }
 
