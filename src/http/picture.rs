@@ -12,7 +12,7 @@ use axum::response::{IntoResponse, Response};
 use serde_json::Value;
 
 use super::problem::ApiError;
-use crate::plot;
+use crate::plot::{self, PlotError};
 
 /// Whether the client prefers SVG (it names `image/svg+xml` and not JSON first).
 fn wants_svg(req: &Request) -> bool {
@@ -75,7 +75,10 @@ pub async fn picture(req: Request, next: Next) -> Response {
     let Ok(answer) = serde_json::from_slice::<Value>(&answer_bytes) else {
         return ApiError::internal().into_response();
     };
-    let drawn = tokio::task::spawn_blocking(move || plot::render(&route, &request, &answer)).await;
+    let drawn = {
+        let route = route.clone();
+        tokio::task::spawn_blocking(move || plot::render(&route, &request, &answer)).await
+    };
     match drawn {
         Ok(Some(Ok(svg))) => {
             let mut r = svg.into_response();
@@ -87,6 +90,10 @@ pub async fn picture(req: Request, next: Next) -> Response {
                 r.headers_mut().insert("server-timing", t.clone());
             }
             r
+        }
+        Ok(Some(Err(PlotError::Missing(what)))) => {
+            ApiError::nothing_to_draw(&route, &format!("the answer has no `{what}` to draw"))
+                .into_response()
         }
         Ok(Some(Err(e))) => {
             tracing::error!(error = %e, "picture could not be drawn");

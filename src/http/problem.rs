@@ -200,6 +200,19 @@ impl ApiError {
         )
     }
 
+    /// 406: the answer was computed but holds nothing the endpoint's picture can draw (for
+    /// example a workspace sweep that accepted no node, or an empty shard); the JSON answer is
+    /// still available with `Accept: application/json`.
+    pub fn nothing_to_draw(route: &str, why: &str) -> Self {
+        Self::new(
+            StatusCode::NOT_ACCEPTABLE,
+            "not-acceptable",
+            "Not acceptable",
+            "NOTHING_TO_DRAW",
+            format!("{route}: no picture of this answer ({why}); ask for application/json"),
+        )
+    }
+
     /// 408: the request body did not arrive within the body timeout.
     pub fn request_timeout(timeout_ms: u64) -> Self {
         Self::new(

@@ -135,3 +135,28 @@ async fn json_answers_do_not_change_with_pictures_available() {
         assert_eq!(resp.headers()["content-type"], "application/json");
     }
 }
+
+/// A valid answer with nothing to draw (here an empty shard of a single-wave sweep, and the
+/// first shard that does hold the wave) is a 406 that says so, never a 500.
+#[tokio::test]
+async fn an_answer_with_nothing_to_draw_is_a_406_not_a_500() {
+    let body = |index: u32| {
+        serde_json::json!({"mode": "workspace", "design": {"preset": "keops_d1"},
+            "workspace": {"grid": [3, 3], "stability_check": "none"},
+            "shard": {"index": index, "count": 2}})
+    };
+    let (status, ct, problem) = svg_of("/v1/continuum-workspace", &body(1)).await;
+    assert_eq!(status, 406, "{problem}");
+    assert_eq!(ct, "application/problem+json");
+    let p: serde_json::Value = serde_json::from_str(&problem).expect("problem+json");
+    assert_eq!(p["type"], "/problems/not-acceptable");
+    assert_eq!(p["code"], "NOTHING_TO_DRAW");
+    assert!(
+        p["detail"]
+            .as_str()
+            .is_some_and(|d| d.contains("application/json"))
+    );
+    let (status, ct, svg) = svg_of("/v1/continuum-workspace", &body(0)).await;
+    assert_eq!((status, ct.as_str()), (200, "image/svg+xml"), "{svg}");
+    assert_eq!(svg_problems(&svg), Vec::<String>::new());
+}
