@@ -47,8 +47,9 @@
 //!   (64 ε cond(Kc))²·E_ref, which is below 1e-20·E_ref for cond(Kc) ≲ 1e5 (property tests).
 //! * Outside the range: a typed error ([`BezierMotionError`]), never NaN.
 //! * Cost (`benches/bezier_motion.rs`, `benches/RESULTS.md`): x(T) by the closed form 0.24 µs at
-//!   2.7e-14 (≈ 1/200 of RK45 at rtol 1e-9); the paper-case optimise request 5.5 µs without and
-//!   11.3 µs with the default kinematic peaks (§3.9 sampling at 64(N+1)+1 points per derivative).
+//!   2.7e-14 (≈ 1/200 of RK45 at rtol 1e-9); the paper-case optimise request 5.0 µs without and
+//!   8.1 µs with the default kinematic peaks (§3.9 sampling at 64(N+1)+1 points per derivative;
+//!   `compute` alone 7.5 µs).
 
 pub mod compute;
 pub mod error;
