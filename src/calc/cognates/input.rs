@@ -9,6 +9,7 @@
 //! power of two close to the largest length L (an exact scaling), so every tolerance is absolute and
 //! no square can overflow or underflow whatever the caller's unit.
 
+use crate::calc::common;
 use crate::calc::{CalcFailure, INVALID_INPUT, Range, Validator};
 
 use super::error::{
@@ -18,7 +19,6 @@ use super::geometry::{C64, FourBar, Sign, cis, cross};
 use super::sampling::Spacing;
 use super::wire::{
     self, AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec, VerifyKind,
-    WireSign,
 };
 
 pub use super::wire::MAX_MAGNITUDE;
@@ -178,10 +178,10 @@ fn deg_to_rad(deg: f64) -> f64 {
     super::geometry::wrap_pi(d.to_radians())
 }
 
-fn sign_of(w: WireSign) -> Sign {
+fn sign_of(w: common::Sign) -> Sign {
     match w {
-        WireSign::Plus => Sign::Plus,
-        WireSign::Minus => Sign::Minus,
+        common::Sign::Plus => Sign::Plus,
+        common::Sign::Minus => Sign::Minus,
     }
 }
 
