@@ -13,6 +13,9 @@
 #![allow(missing_docs)] // criterion macros generate undocumented items
 #![allow(clippy::unwrap_used)] // benchmarks: a panic is the failure report
 
+#[path = "../tests/support/component_importance.rs"]
+mod synthetic_request;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -635,11 +638,10 @@ fn sweep_times_and_acceptance() {
     ten.times_h = (1..=10).map(|i| 400.0 * f64::from(i)).collect();
     let (t, _) = timed(|| run(ten.clone(), &Budget::unlimited()).unwrap());
     println!("| paper machining center, 10 times (`run`) | {t} | < 1 ms |");
-    let r50 = mechcalc::calc::component_importance::synthetic::random_request(50, 3.0, true, 5);
+    let r50 = synthetic_request::random_request(50, 3.0, true, 5);
     let (t, _) = timed(|| run(r50.clone(), &Budget::unlimited()).unwrap());
     println!("| random DAG n = 50, d = 3, 2 times (`run`) | {t} | < 1 ms |");
-    let mut r50c =
-        mechcalc::calc::component_importance::synthetic::random_request(50, 3.0, false, 5);
+    let mut r50c = synthetic_request::random_request(50, 3.0, false, 5);
     r50c.options.betweenness = BetweennessMode::ShortestPaths;
     let (t, _) = timed(|| run(r50c.clone(), &Budget::unlimited()).unwrap());
     println!("| random cyclic n = 50, d = 3, shortest paths, 2 times (`run`) | {t} | < 1 ms |");

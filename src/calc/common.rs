@@ -5,6 +5,8 @@
 //! * `report` ([`SolverReport`](crate::numerics::SolverReport), schema `Report`): how the work
 //!   stopped and what it cost, on every endpoint with iterative or swept work;
 //! * `warnings`: a list of [`Warning`] `{code, message, pointer?}`;
+//! * a sign (assembly mode, branch, side) is the integer `1` or `-1`: [`Sign`] (schema `Sign`),
+//!   its meaning given by the field's description;
 //! * optional outputs are omitted when not requested, never sent as `null`;
 //! * `shard` (top level, optional, on the sweeps): [`Shard`] `{index, count}` splits a sweep into
 //!   `count` contiguous blocks of near-equal size, the answer says which block it holds
@@ -18,6 +20,8 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
+use utoipa::openapi::RefOr;
+use utoipa::openapi::schema::{ObjectBuilder, Schema, SchemaType, Type};
 
 use super::bounds::Range;
 use super::problem::{CalcFailure, FieldIssue, ProblemClass, Validator};
@@ -61,6 +65,54 @@ impl Warning {
             message: message.into(),
             pointer: Some(pointer.into()),
         }
+    }
+}
+
+/// A sign on the wire: the integer `1` or `-1` (schema `Sign`). What it selects (an assembly
+/// mode, a branch, a side) is stated by the field that carries it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "i64", into = "i64")]
+pub enum Sign {
+    /// `1`.
+    #[default]
+    Plus,
+    /// `-1`.
+    Minus,
+}
+
+impl TryFrom<i64> for Sign {
+    type Error = String;
+    fn try_from(v: i64) -> Result<Self, Self::Error> {
+        match v {
+            1 => Ok(Self::Plus),
+            -1 => Ok(Self::Minus),
+            _ => Err(format!("must be 1 or -1, got {v}")),
+        }
+    }
+}
+
+impl From<Sign> for i64 {
+    fn from(s: Sign) -> Self {
+        match s {
+            Sign::Plus => 1,
+            Sign::Minus => -1,
+        }
+    }
+}
+
+impl utoipa::PartialSchema for Sign {
+    fn schema() -> RefOr<Schema> {
+        ObjectBuilder::new()
+            .schema_type(SchemaType::new(Type::Integer))
+            .enum_values(Some([1, -1]))
+            .description(Some("A sign: 1 or -1."))
+            .into()
+    }
+}
+
+impl ToSchema for Sign {
+    fn name() -> std::borrow::Cow<'static, str> {
+        std::borrow::Cow::Borrowed("Sign")
     }
 }
 

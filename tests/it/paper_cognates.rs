@@ -13,9 +13,9 @@
 use approx::assert_abs_diff_eq;
 use mechcalc::calc::cognates::geometry::{C64, FourBar, Sign, Solve};
 use mechcalc::calc::cognates::input::CognatesInput;
-use mechcalc::calc::cognates::sampling::chord_error;
+use mechcalc::calc::cognates::sampling::{Spacing, chord_error};
 use mechcalc::calc::cognates::wire::{
-    CognatesResponse, GrashofClassOut, LinkageTypeOut, MechanismOut, SnapshotStatus, Spacing,
+    CognatesResponse, GrashofClassOut, LinkageTypeOut, MechanismOut, SnapshotStatus,
 };
 use mechcalc::calc::cognates::{CognatesRequest, run};
 use mechcalc::numerics::Budget;

@@ -10,7 +10,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use approx::assert_relative_eq;
 use mechcalc::calc::irefc::geometry::{Geometry, Wheel};
 use mechcalc::calc::irefc::stress::compute::{Stresser, element_forces};
-use mechcalc::calc::irefc::stress::wire::LoadSharing;
+use mechcalc::calc::irefc::stress::input::LoadSharing;
 use mechcalc::calc::irefc::{
     IrefcEfficiencyRequest, IrefcEfficiencyResponse, IrefcStressRequest, IrefcStressResponse,
     run_efficiency, run_stress,

@@ -11,8 +11,8 @@ use mechcalc::calc::cognates::geometry::{
     map_pose,
 };
 use mechcalc::calc::cognates::input::CognatesInput;
-use mechcalc::calc::cognates::sampling::{chord_error, circuit_sweeps};
-use mechcalc::calc::cognates::wire::{CognatesResponse, GrashofClassOut, LinkageTypeOut, Spacing};
+use mechcalc::calc::cognates::sampling::{Spacing, chord_error, circuit_sweeps};
+use mechcalc::calc::cognates::wire::{CognatesResponse, GrashofClassOut, LinkageTypeOut};
 use mechcalc::calc::cognates::{CognatesRequest, run};
 use mechcalc::numerics::Budget;
 use proptest::prelude::*;

@@ -9,7 +9,8 @@ use std::f64::consts::{PI, TAU};
 
 use mechcalc::calc::irefc::geometry::{Geometry, Trig, Wheel};
 use mechcalc::calc::irefc::stress::compute::{Stresser, element_forces};
-use mechcalc::calc::irefc::stress::wire::{LoadSharing, StressSingleResponse};
+use mechcalc::calc::irefc::stress::input::LoadSharing;
+use mechcalc::calc::irefc::stress::wire::StressSingleResponse;
 use mechcalc::calc::irefc::{
     IrefcEfficiencyRequest, IrefcEfficiencyResponse, IrefcStressRequest, IrefcStressResponse,
     run_efficiency, run_stress,

@@ -9,7 +9,6 @@
 use std::time::Duration;
 
 use mechcalc::calc::component_importance::run;
-use mechcalc::calc::component_importance::synthetic::random_request;
 use mechcalc::calc::component_importance::wire::{
     BetweennessMode, ComponentImportanceRequest, ComponentImportanceResponse, ComponentSpec,
     ConstantWeights, EntropyWeights, FailureMode, Options, Outputs, PathMethod, TimeOverride,
@@ -17,6 +16,8 @@ use mechcalc::calc::component_importance::wire::{
 };
 use mechcalc::calc::{CalcFailure, ProblemClass};
 use mechcalc::numerics::Budget;
+
+use crate::support::component_importance::random_request;
 
 fn paper() -> ComponentImportanceRequest {
     let path = concat!(

@@ -3,12 +3,11 @@
 
 use super::error::BezierMotionError;
 use super::history::{History, RHO_MAX_HISTORY, history};
-use super::input::BezierInput;
+use super::input::{BezierInput, Mode};
 use super::kinematics::{Kinematics, kinematics, polygon_against_motion, reverses};
 use super::law::BezierLaw;
 use super::optimize::{LawShape, Objective, objective_terms, residual_rows, solve};
 use super::plant::{Plant, RHO_MAX_GL, ResponseMatrix, response_matrix};
-use super::wire::Mode;
 use crate::calc::common::Warning;
 use crate::numerics::Budget;
 

@@ -5,12 +5,30 @@ use super::history::HistorySpec;
 use super::optimize::Objective;
 use super::plant::Plant;
 use super::wire::{
-    BezierMotionRequest, DAMPING, FREE_P, GAMMA, GAMMA_OVER_PHI_MAX, HISTORY_SAMPLES, INERTIA,
-    J_EQ, MAX_ACCEL_DEGREE, MAX_FACTORS, MAX_INERTIAS, MOTION_TIME, Mode, ORDER_M, ObjectiveIn,
+    self, BezierMotionRequest, DAMPING, FREE_P, GAMMA, GAMMA_OVER_PHI_MAX, HISTORY_SAMPLES,
+    INERTIA, J_EQ, MAX_ACCEL_DEGREE, MAX_FACTORS, MAX_INERTIAS, MOTION_TIME, ORDER_M, ObjectiveIn,
     PHI, RATIO, ROBUST_REL, STIFFNESS, STIFFNESS_FACTOR, WINDOW_AFTER,
 };
 use crate::calc::common::{Warning, time_limit};
 use crate::calc::{CalcFailure, Validator};
+
+/// What a request computes (the request's `mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Evaluate the given law.
+    Simulate,
+    /// The zero (or least) residual-vibration law by the closed-form solve.
+    Optimize,
+}
+
+impl From<wire::Mode> for Mode {
+    fn from(m: wire::Mode) -> Self {
+        match m {
+            wire::Mode::Simulate => Self::Simulate,
+            wire::Mode::Optimize => Self::Optimize,
+        }
+    }
+}
 
 /// A validated request in SI units.
 #[derive(Debug, Clone, PartialEq)]
@@ -170,7 +188,7 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
                     ROBUST_REL,
                 ) =>
             {
-                if req.mode == Mode::Simulate {
+                if req.mode == wire::Mode::Simulate {
                     warnings.push(Warning::at(
                         "ROBUST_IGNORED",
                         "/optimize/robust_stiffness_rel",
@@ -237,7 +255,7 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
         match (j_eq, phi, gamma) {
             (Some(j_eq), Some(phi), Some(gamma)) if ok_k && ok_c && ok_z && ok_t && ok_n => {
                 Ok(Self {
-                    mode: req.mode,
+                    mode: req.mode.into(),
                     plant: Plant::new(j_eq, k, c, z),
                     phi,
                     t: mo.t_s,

@@ -4,12 +4,12 @@ use std::f64::consts::TAU;
 
 use super::compute::{BezierOutput, FactorResult, Residual};
 use super::history::History;
-use super::input::BezierInput;
+use super::input::{BezierInput, Mode};
 use super::optimize::Objective;
 use super::plant::{EndStateMethod, Plant};
 use super::wire::{
-    BezierMotionResponse, EndState, HistoryOut, KinematicsOut, LawOut, MethodOut, ObjectiveIn,
-    OptimizerOut, ReferenceOut, ResidualOut, SensitivityRow, SystemOut,
+    self, BezierMotionResponse, EndState, HistoryOut, KinematicsOut, LawOut, MethodOut,
+    ObjectiveIn, OptimizerOut, ReferenceOut, ResidualOut, SensitivityRow, SystemOut,
 };
 use crate::calc::common::ResponseSize;
 use crate::numerics::{Budget, SolverReport, StopReason};
@@ -35,6 +35,15 @@ pub fn response_size(input: &BezierInput) -> ResponseSize {
     size
 }
 
+impl From<Mode> for wire::Mode {
+    fn from(m: Mode) -> Self {
+        match m {
+            Mode::Simulate => Self::Simulate,
+            Mode::Optimize => Self::Optimize,
+        }
+    }
+}
+
 /// Builds the response.
 #[must_use]
 pub fn respond(input: &BezierInput, out: &BezierOutput, budget: &Budget) -> BezierMotionResponse {
@@ -46,7 +55,7 @@ pub fn respond(input: &BezierInput, out: &BezierOutput, budget: &Budget) -> Bezi
         .as_ref()
         .map_or(0, |h| (h.substeps * h.t.len()) as u64);
     BezierMotionResponse {
-        mode: input.mode,
+        mode: input.mode.into(),
         system: system_out(plant, input.t),
         method: method_out(out),
         law: LawOut {

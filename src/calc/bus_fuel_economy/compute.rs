@@ -6,14 +6,12 @@ use std::collections::HashMap;
 use super::compare::{desirability, overall_desirability};
 use super::cycles::{Cycle, discretise};
 use super::error::BusFuelEconomyError;
-use super::input::BusFuelEconomyInput;
+use super::input::{BusFuelEconomyInput, MotorEval};
 use super::ipmsm::{Currents, Ipmsm, LossSplit, rad_s_to_rpm, rpm_to_rad_s};
 use super::motor::{
     IpmsmMap, MotorEvaluator, MotorInput, MotorKind, build_ipmsm_map, grid_axes, grid_size,
 };
 use super::sim::{SimOutcome, SimSettings, simulate};
-// Request options carried by the validated input (read only: no wire type is built here).
-use super::wire::MotorEval;
 use crate::calc::common::Shard;
 use crate::numerics::Budget;
 

@@ -6,12 +6,12 @@ use super::cycles::{self, Cycle};
 use super::ipmsm::{Ipmsm, IpmsmParams, psi_from_back_emf, rpm_to_rad_s};
 use super::maps::{Envelope, Grid2, efficiency_to_loss};
 use super::motor::{MotorInput, MotorKind};
-use super::sim::Vehicle;
+use super::sim::{Mode, PowerConvention, Vehicle};
 use super::wire as w;
 use super::wire::{
     AcFactorSpec, BatteryModel, BatterySpec, BusFuelEconomyRequest, CycleSpec, EfficiencyMapMotor,
-    EnvelopeTable, GridSpec, IpmsmMotor, LossMapMotor, Mode, MotorEval, MotorSpec, OptionsSpec,
-    OutputKind, PowerConvention, VehicleSpec,
+    EnvelopeTable, GridSpec, IpmsmMotor, LossMapMotor, MotorSpec, OptionsSpec, OutputKind,
+    VehicleSpec,
 };
 use crate::calc::{CalcFailure, ProblemClass, Range, Validator};
 
@@ -48,6 +48,43 @@ const MAX_NAME_LEN: usize = 64;
 const DEFAULT_T_PEAK: f64 = 800.0;
 const DEFAULT_P_PEAK: f64 = 130_000.0;
 const DEFAULT_N_MAX: f64 = 5200.0;
+
+/// How an `ipmsm` motor's loss is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotorEval {
+    /// Solve the dq operating point at every interval.
+    Direct,
+    /// Interpolate a loss map precomputed on the options' grid.
+    LossMap,
+}
+
+impl From<w::Mode> for Mode {
+    fn from(m: w::Mode) -> Self {
+        match m {
+            w::Mode::Backward => Self::Backward,
+            w::Mode::Clip => Self::Clip,
+            w::Mode::Forward => Self::Forward,
+        }
+    }
+}
+
+impl From<w::PowerConvention> for PowerConvention {
+    fn from(c: w::PowerConvention) -> Self {
+        match c {
+            w::PowerConvention::Paper => Self::Paper,
+            w::PowerConvention::Loss => Self::Loss,
+        }
+    }
+}
+
+impl From<w::MotorEval> for MotorEval {
+    fn from(e: w::MotorEval) -> Self {
+        match e {
+            w::MotorEval::Direct => Self::Direct,
+            w::MotorEval::LossMap => Self::LossMap,
+        }
+    }
+}
 
 /// Validated options.
 #[derive(Debug, Clone)]
@@ -1124,12 +1161,12 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
             cycles: cycles_ok.into_iter().map(|(_, c)| c).collect(),
             motors,
             options: Options {
-                mode: o.mode,
-                convention: o.power_convention,
+                mode: o.mode.into(),
+                convention: o.power_convention.into(),
                 substeps,
                 regen: o.regen,
                 regen_limit: o.regen_limit,
-                motor_eval: o.motor_eval.unwrap_or(MotorEval::LossMap),
+                motor_eval: o.motor_eval.map_or(MotorEval::LossMap, MotorEval::from),
                 grid: gr,
                 breakdown: has(OutputKind::LossBreakdown),
                 histogram: has(OutputKind::OpHistogram),

@@ -9,11 +9,10 @@ use super::geometry::{
     ASSEMBLY_SLACK_REL, C64, Family, FourBar, Grashof, GrashofClass, InputRange, SINGULAR_REL,
     Sign, Solve, Special, TOGGLE_REL, cognate1_branch, cognates, map_pose, wrap_pi,
 };
-use super::input::{CognatesInput, Options, SnapshotSpec};
-use super::sampling::{Sweep, circuit_sweeps, fixed_sweeps};
+use super::input::{CognatesInput, CurveMode, Options, SnapshotSpec};
+use super::sampling::{Spacing, Sweep, circuit_sweeps, fixed_sweeps};
 use super::verify::{ImplicitResult, SyncAcc, hausdorff, implicit_check, segments};
 // Request options carried by the validated input (read only: no wire type is built here).
-use super::wire::{CurveMode, Spacing};
 
 /// Server cap on sampled points per request (spec §3 suggests 1e6): bounds memory (~50 MB of
 /// curves) and time (~0.1 s) of one request.

@@ -9,15 +9,16 @@
 //! power of two close to the largest length L (an exact scaling), so every tolerance is absolute and
 //! no square can overflow or underflow whatever the caller's unit.
 
+use crate::calc::common;
 use crate::calc::{CalcFailure, INVALID_INPUT, Range, Validator};
 
 use super::error::{
     COINCIDENT_PIVOTS, COUPLER_POINT_AT_JOINT, COUPLER_TRIANGLE_INVALID, NON_POSITIVE_LENGTH,
 };
 use super::geometry::{C64, FourBar, Sign, cis, cross};
+use super::sampling::Spacing;
 use super::wire::{
-    AngleReference, CognatesRequest, CouplerPoint, CurveMode, GroundSpec, JointsSpec, Spacing,
-    VerifyKind, WireSign,
+    self, AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec, VerifyKind,
 };
 
 pub use super::wire::MAX_MAGNITUDE;
@@ -41,6 +42,33 @@ pub struct SnapshotSpec {
     pub theta: f64,
     /// Assembly branch t1.
     pub branch: Sign,
+}
+
+/// How coupler curves are traced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CurveMode {
+    /// Closed circuits, switching branch at toggles (the whole curve).
+    Circuits,
+    /// Paper style: each mechanism's own input over its range on the branch of the snapshot.
+    FixedBranch,
+}
+
+impl From<wire::CurveMode> for CurveMode {
+    fn from(m: wire::CurveMode) -> Self {
+        match m {
+            wire::CurveMode::Circuits => Self::Circuits,
+            wire::CurveMode::FixedBranch => Self::FixedBranch,
+        }
+    }
+}
+
+impl From<wire::Spacing> for Spacing {
+    fn from(s: wire::Spacing) -> Self {
+        match s {
+            wire::Spacing::Auto => Self::Auto,
+            wire::Spacing::Uniform => Self::Uniform,
+        }
+    }
 }
 
 /// Validated options.
@@ -150,10 +178,10 @@ fn deg_to_rad(deg: f64) -> f64 {
     super::geometry::wrap_pi(d.to_radians())
 }
 
-fn sign_of(w: WireSign) -> Sign {
+fn sign_of(w: common::Sign) -> Sign {
     match w {
-        WireSign::Plus => Sign::Plus,
-        WireSign::Minus => Sign::Minus,
+        common::Sign::Plus => Sign::Plus,
+        common::Sign::Minus => Sign::Minus,
     }
 }
 
@@ -192,8 +220,8 @@ fn validate_options(req: &CognatesRequest, v: &mut Validator) -> Options {
     Options {
         curves: o.curves,
         points_per_circuit: usize::try_from(o.points_per_circuit.clamp(lo, hi)).unwrap_or(360),
-        spacing: o.spacing,
-        curve_mode: o.curve_mode,
+        spacing: o.spacing.into(),
+        curve_mode: o.curve_mode.into(),
         verify_sync: o.verify.contains(&VerifyKind::Sync),
         verify_implicit: o.verify.contains(&VerifyKind::Implicit),
         verify_hausdorff: o.verify.contains(&VerifyKind::Hausdorff),

@@ -11,7 +11,16 @@
 use std::f64::consts::PI;
 
 use super::geometry::{C64, Circuit, FourBar, Sign, Solve};
-use super::wire::Spacing;
+
+/// Spacing of the samples on a limited-range circuit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spacing {
+    /// Cosine spacing on limited-range circuits, uniform on full-rotation ones (O(N⁻²) chord
+    /// error).
+    Auto,
+    /// Uniform in the input angle (O(N⁻¹) near toggles).
+    Uniform,
+}
 
 /// Input angle relative to the ground line \[rad\] and branch at circuit parameter `u ∈ [0, 2π]`.
 #[must_use]

@@ -3,60 +3,12 @@
 //! returned in the same unit; angles are in degrees.
 
 use crate::calc::Range;
+use crate::calc::common::Sign;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
-use utoipa::openapi::RefOr;
-use utoipa::openapi::schema::{ObjectBuilder, Schema, SchemaType, Type};
 
 /// A point `[x, y]` in the caller's length unit.
 pub type Point = [f64; 2];
-
-/// A sign on the wire: the integer `1` or `-1` (assembly branch `t1`, coupler side `t2`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(try_from = "i64", into = "i64")]
-pub enum WireSign {
-    /// `1`.
-    #[default]
-    Plus,
-    /// `-1`.
-    Minus,
-}
-
-impl TryFrom<i64> for WireSign {
-    type Error = String;
-    fn try_from(v: i64) -> Result<Self, Self::Error> {
-        match v {
-            1 => Ok(Self::Plus),
-            -1 => Ok(Self::Minus),
-            _ => Err(format!("must be 1 or -1, got {v}")),
-        }
-    }
-}
-
-impl From<WireSign> for i64 {
-    fn from(s: WireSign) -> Self {
-        match s {
-            WireSign::Plus => 1,
-            WireSign::Minus => -1,
-        }
-    }
-}
-
-impl utoipa::PartialSchema for WireSign {
-    fn schema() -> RefOr<Schema> {
-        ObjectBuilder::new()
-            .schema_type(SchemaType::new(Type::Integer))
-            .enum_values(Some([1, -1]))
-            .description(Some("A sign: 1 or -1."))
-            .into()
-    }
-}
-
-impl ToSchema for WireSign {
-    fn name() -> std::borrow::Cow<'static, str> {
-        std::borrow::Cow::Borrowed("cognates.WireSign")
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Request
@@ -108,7 +60,7 @@ pub struct CognatesRequest {
     /// Assembly branch `t1` of the snapshot (1: E left of the directed line D→B). Default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
-    pub branch: Option<WireSign>,
+    pub branch: Option<Sign>,
     /// Optional outputs and knobs.
     #[serde(default)]
     pub options: CognatesOptions,
@@ -162,7 +114,7 @@ pub enum CouplerPoint {
         e: f64,
         /// Coupler side `t2`: 1 when P is left of the directed line D→E. Default 1.
         #[serde(default)]
-        side: WireSign,
+        side: Sign,
     },
     /// Coupler frame: origin D, x along D→E, y to the left; `k = (u + i·v)/b`.
     Frame {
@@ -186,7 +138,7 @@ pub enum CouplerPoint {
 struct CouplerPointRaw {
     d: Option<f64>,
     e: Option<f64>,
-    side: Option<WireSign>,
+    side: Option<Sign>,
     u: Option<f64>,
     v: Option<f64>,
     p: Option<f64>,
@@ -212,7 +164,7 @@ impl TryFrom<CouplerPointRaw> for CouplerPoint {
             Ok(Self::Triangle {
                 d: need(r.d, "d", "{d, e, side}")?,
                 e: need(r.e, "e", "{d, e, side}")?,
-                side: r.side.unwrap_or(WireSign::Plus),
+                side: r.side.unwrap_or(Sign::Plus),
             })
         } else if frame {
             Ok(Self::Frame {

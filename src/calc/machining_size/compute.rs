@@ -9,13 +9,12 @@ use super::boost::{Boosted, ExactIndex, HistIndex, Method, SplitIndex, TrainData
 use super::data::{self, Matrix, Metrics};
 use super::error::MachiningSizeError;
 use super::gra;
-use super::input::{AnalyzeInput, PredictInput, TrainInput};
+use super::input::{AnalyzeInput, PredictInput, ShapKind, TrainInput};
 use super::model::{Model, ModelSource, Routing, Tree};
 use super::pca::{self, Pca};
 use super::rng;
 use super::shap::{InterventionalTables, InterventionalWeights, PathBuffer, ShapForest};
 use super::smogn::{self, Smogn};
-use super::wire::ShapKind;
 
 /// Rows of one parallel work item (SHAP, prediction).
 const ROW_CHUNK: usize = 32;

@@ -15,11 +15,11 @@ use super::gra::Normalise;
 use super::model::Model;
 use super::smogn::SmognParams;
 use super::wire::{
-    AnalyzeRequest, FRACTION, GRA_RHO, GraNormalise, K_FOLD, LEARNING_RATE, MAX_BACKGROUND,
+    self, AnalyzeRequest, FRACTION, GRA_RHO, GraNormalise, K_FOLD, LEARNING_RATE, MAX_BACKGROUND,
     MAX_BIN, MAX_DEPTH, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
     MAX_INTERVENTIONAL_PAIRS, MAX_PREDICT_ROWS, MAX_ROWS, MAX_SCORE_CELLS, MAX_SHAP_CELLS,
     MAX_TREES, MIN_ROWS, N_ESTIMATORS, PCA_COMPONENTS, PredictRequest, REGULARISATION,
-    RELEVANCE_PHI, SMOGN_K, SMOGN_PERTURBATION, SMOGN_THRESHOLD, ShapKind, TARGET, TEST_FRACTION,
+    RELEVANCE_PHI, SMOGN_K, SMOGN_PERTURBATION, SMOGN_THRESHOLD, TARGET, TEST_FRACTION,
     TrainOutputKind, TrainRequest, TreeMethod,
 };
 
@@ -61,6 +61,27 @@ pub struct TrainOutputs {
     pub shap_summary: bool,
     /// Holdout predictions.
     pub test_predictions: bool,
+}
+
+/// Which SHAP values a `/predict` request asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShapKind {
+    /// No SHAP values.
+    None,
+    /// Path-dependent TreeSHAP (cover-weighted conditional expectations).
+    PathDependent,
+    /// Interventional TreeSHAP against the background rows.
+    Interventional,
+}
+
+impl From<wire::ShapKind> for ShapKind {
+    fn from(k: wire::ShapKind) -> Self {
+        match k {
+            wire::ShapKind::None => Self::None,
+            wire::ShapKind::PathDependent => Self::PathDependent,
+            wire::ShapKind::Interventional => Self::Interventional,
+        }
+    }
 }
 
 /// A validated `/predict` request.
@@ -509,7 +530,8 @@ impl TryFrom<PredictRequest> for PredictInput {
             }
         }
         let n = req.rows.len();
-        if req.shap != ShapKind::None && n * d > MAX_SHAP_CELLS {
+        let shap = ShapKind::from(req.shap);
+        if shap != ShapKind::None && n * d > MAX_SHAP_CELLS {
             v.push_code(
                 TOO_LARGE,
                 "/rows",
@@ -519,9 +541,9 @@ impl TryFrom<PredictRequest> for PredictInput {
                 ),
             );
         }
-        let background_ignored = req.background.is_some() && req.shap != ShapKind::Interventional;
+        let background_ignored = req.background.is_some() && shap != ShapKind::Interventional;
         let mut background = Vec::new();
-        if req.shap == ShapKind::Interventional {
+        if shap == ShapKind::Interventional {
             match &req.background {
                 None => v.push(
                     "/background",
@@ -563,7 +585,7 @@ impl TryFrom<PredictRequest> for PredictInput {
         Ok(Self {
             model,
             rows,
-            shap: req.shap,
+            shap,
             background,
             interactions: req.interactions,
             background_ignored,

@@ -113,7 +113,7 @@ pub fn predict_size(input: &PredictInput) -> ResponseSize {
     let rows = input.rows.len() as u64;
     let d = input.model.n_features as u64;
     let mut size = ResponseSize::fixed(8 * 1024).numbers("/rows", rows);
-    if input.shap != wire::ShapKind::None {
+    if input.shap != input::ShapKind::None {
         size = size.numbers("/shap", rows * (d + 1));
     }
     if input.interactions {

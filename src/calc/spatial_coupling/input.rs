@@ -6,12 +6,12 @@
 
 use std::time::Duration;
 
-use crate::calc::common::time_limit;
+use crate::calc::common::{Sign, time_limit};
 use crate::calc::{CalcFailure, Validator};
 use crate::numerics::angles::sin_cos_deg;
 
 use super::wire::{
-    A_M, ALPHA_DEG, BETA_DEG, BODY3_COORD_M, Branch, DECIMATE, MAX_BODY3_POINTS, MAX_THETA1_POINTS,
+    A_M, ALPHA_DEG, BETA_DEG, BODY3_COORD_M, DECIMATE, MAX_BODY3_POINTS, MAX_THETA1_POINTS,
     MIN_ABS_COS_2ALPHA, N_POINTS, OMEGA1, SpatialCouplingRequest, THETA1_DEG, Vec3,
 };
 
@@ -187,8 +187,8 @@ impl TryFrom<SpatialCouplingRequest> for SpatialCouplingInput {
             a,
             omega1,
             sigma: match req.branch.unwrap_or_default() {
-                Branch::Plus => 1.0,
-                Branch::Minus => -1.0,
+                Sign::Plus => 1.0,
+                Sign::Minus => -1.0,
             },
             points,
             sweep,

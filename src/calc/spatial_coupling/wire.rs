@@ -6,66 +6,15 @@
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
-use utoipa::openapi::RefOr;
-use utoipa::openapi::schema::{ObjectBuilder, Schema, SchemaType, Type};
 
 use crate::calc::Range;
-use crate::calc::common::Warning;
+use crate::calc::common::{Sign, Warning};
 use crate::numerics::SolverReport;
 
 /// A vector `[x, y, z]`.
 pub type Vec3 = [f64; 3];
 /// A 4×4 homogeneous transform, row by row.
 pub type Mat4 = [[f64; 4]; 4];
-
-/// Assembly mode σ on the wire: the integer `1` or `-1` (spec §2 `branch`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(try_from = "i64", into = "i64")]
-pub enum Branch {
-    /// σ = +1: θ2(θ1 = 0) = 90°.
-    #[default]
-    Plus,
-    /// σ = −1: θ2(θ1 = 0) = 270° (the other assembly mode).
-    Minus,
-}
-
-impl TryFrom<i64> for Branch {
-    type Error = String;
-    fn try_from(v: i64) -> Result<Self, Self::Error> {
-        match v {
-            1 => Ok(Self::Plus),
-            -1 => Ok(Self::Minus),
-            _ => Err(format!("must be 1 or -1, got {v}")),
-        }
-    }
-}
-
-impl From<Branch> for i64 {
-    fn from(s: Branch) -> Self {
-        match s {
-            Branch::Plus => 1,
-            Branch::Minus => -1,
-        }
-    }
-}
-
-impl utoipa::PartialSchema for Branch {
-    fn schema() -> RefOr<Schema> {
-        ObjectBuilder::new()
-            .schema_type(SchemaType::new(Type::Integer))
-            .enum_values(Some([1, -1]))
-            .description(Some(
-                "Assembly mode σ: 1 (θ2 = 90° at θ1 = 0) or -1 (θ2 = 270° at θ1 = 0).",
-            ))
-            .into()
-    }
-}
-
-impl ToSchema for Branch {
-    fn name() -> std::borrow::Cow<'static, str> {
-        std::borrow::Cow::Borrowed("spatial_coupling.Branch")
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Request
@@ -106,10 +55,10 @@ pub struct SpatialCouplingRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
     pub omega1_rad_s: Option<f64>,
-    /// Assembly mode σ (1 or -1). Default 1.
+    /// Assembly mode σ: 1 (θ2 = 90° at θ1 = 0) or -1 (θ2 = 270° at θ1 = 0). Default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
-    pub branch: Option<Branch>,
+    pub branch: Option<Sign>,
     /// Input angles θ1 \[deg\] evaluated one by one (any finite value; reduced modulo 360°).
     /// At most 100 000.
     #[serde(default, skip_serializing_if = "Option::is_none")]

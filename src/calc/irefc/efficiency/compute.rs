@@ -1,9 +1,7 @@
 //! Slip speeds, friction power and mesh efficiency per rolling element (spec `irefc_efficiency.md`,
 //! "Algorithm"; efficiency paper eqs 7–23).
 
-use super::input::EfficiencyInput;
-// Request options carried by the validated input (read only: no wire type is built here).
-use super::wire::EfficiencyModel;
+use super::input::{EfficiencyInput, EfficiencyModel};
 use crate::calc::irefc::error::IrefcError;
 use crate::calc::irefc::geometry::Geometry;
 use crate::calc::irefc::stress::compute::element_forces;

@@ -3,8 +3,8 @@
 use std::f64::consts::PI;
 
 use super::wire::{
-    EfficiencyModel, INPUT_TORQUE_NM, IrefcEfficiencyRequest, N_PHASE, POWER_W,
-    ROLLING_FRICTION_MM, SLIDING_FRICTION, SPEED_RPM, phase_deg_range,
+    self, INPUT_TORQUE_NM, IrefcEfficiencyRequest, N_PHASE, POWER_W, ROLLING_FRICTION_MM,
+    SLIDING_FRICTION, SPEED_RPM, phase_deg_range,
 };
 use crate::calc::irefc::error::{AMBIGUOUS_LOAD, BAD_RANGE, IrefcError};
 use crate::calc::irefc::geometry::Geometry;
@@ -18,6 +18,28 @@ pub const ROLLING_FRICTION_PAPER_MM: f64 = 1.0;
 pub const ROLLING_FRICTION_HIGH_MM: f64 = 0.5;
 /// The paper's sliding friction coefficient.
 pub const SLIDING_FRICTION_PAPER: f64 = 0.1;
+
+/// Loss model of the element slip speeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EfficiencyModel {
+    /// The paper's equations exactly as printed (signed slip speed); reproduces its Table 1.
+    PaperTable,
+    /// The paper's equations with |Vs| in the sliding loss (what the paper's text says).
+    PaperAbs,
+    /// Not in the paper: rigid-body relative speeds in the carrier frame (pure rolling at the
+    /// crown, slip at the cam).
+    RigidBody,
+}
+
+impl From<wire::EfficiencyModel> for EfficiencyModel {
+    fn from(m: wire::EfficiencyModel) -> Self {
+        match m {
+            wire::EfficiencyModel::PaperTable => Self::PaperTable,
+            wire::EfficiencyModel::PaperAbs => Self::PaperAbs,
+            wire::EfficiencyModel::RigidBody => Self::RigidBody,
+        }
+    }
+}
 
 /// Validated efficiency input \[SI\].
 #[derive(Debug, Clone, PartialEq)]
@@ -135,7 +157,7 @@ impl EfficiencyInput {
             p_in,
             mu: mu_mm / MM,
             fs,
-            model: req.model.unwrap_or_default(),
+            model: req.model.unwrap_or_default().into(),
             phase_fraction,
             n_phase,
             elements: req.include.and_then(|i| i.elements).unwrap_or(true),

@@ -5,9 +5,7 @@ use std::f64::consts::{PI, TAU};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::input::{Design, StressParams, SweepInput};
-// Request options carried by the validated input (read only: no wire type is built here).
-use super::wire::{LoadSharing, OutputLink};
+use super::input::{Design, LoadSharing, OutputLink, StressParams, SweepInput};
 use crate::calc::irefc::error::IrefcError;
 use crate::calc::irefc::geometry::{AnglePoint, Geometry, Trig, Wheel};
 use crate::numerics::roots;

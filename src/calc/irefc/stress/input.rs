@@ -1,9 +1,9 @@
 //! Validation of an [`IrefcStressRequest`] into SI domain input, collecting every issue.
 
 use super::wire::{
-    CHI_STEP, CURVES_STRIDE, GRID_INTERVALS_MAX, IntRange, IrefcStressRequest, LB_MAX_OVER_R2,
-    LB_MM, LoadSharing, OutputLink, PROFILE_POINTS, STEP_DEG, STEP_DEG_BUILDABLE, StepRange,
-    StressInclude, StressMode, TORQUE_NM,
+    self, CHI_STEP, CURVES_STRIDE, GRID_INTERVALS_MAX, IntRange, IrefcStressRequest,
+    LB_MAX_OVER_R2, LB_MM, PROFILE_POINTS, STEP_DEG, STEP_DEG_BUILDABLE, StepRange, StressInclude,
+    StressMode, TORQUE_NM,
 };
 use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, SWEEP_TOO_LARGE};
 use crate::calc::irefc::input as design;
@@ -21,6 +21,42 @@ pub const SWEEP_COMBINATIONS_MAX: u64 = 100_000;
 pub const SWEEP_WORK_MAX: f64 = 5e8;
 /// Tolerance on the last χ of a sweep range: χ_i = from + i·step is kept while ≤ to + this (spec).
 pub const CHI_RANGE_TOL: f64 = 1e-12;
+
+/// Which link carries the output torque.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputLink {
+    /// Cam output, crown fixed (T_cam = T_out).
+    Cam,
+    /// Crown output, cam rotation locked (T_cam = T_out·(Z2−1)/(Z2+1)).
+    Crown,
+}
+
+/// How the torque is shared over the elements when an element sits at φ2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadSharing {
+    /// The paper: F(φ2) = Fmax·sin α with Fmax from the phase-0 element set (eqs 16–17).
+    PaperPhase0,
+    /// F(φ2) = T_cam·sin α/(r1·Σsin²α) with Σ over the cage phase that puts an element at φ2.
+    PhaseExact,
+}
+
+impl From<wire::OutputLink> for OutputLink {
+    fn from(l: wire::OutputLink) -> Self {
+        match l {
+            wire::OutputLink::Cam => Self::Cam,
+            wire::OutputLink::Crown => Self::Crown,
+        }
+    }
+}
+
+impl From<wire::LoadSharing> for LoadSharing {
+    fn from(l: wire::LoadSharing) -> Self {
+        match l {
+            wire::LoadSharing::PaperPhase0 => Self::PaperPhase0,
+            wire::LoadSharing::PhaseExact => Self::PhaseExact,
+        }
+    }
+}
 
 /// Scalar settings shared by every combination \[SI\].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -237,13 +273,13 @@ fn check_params(
     }
     StressParams {
         torque: req.torque_nm,
-        output_link: req.output_link.unwrap_or_default(),
+        output_link: req.output_link.unwrap_or_default().into(),
         lb: None,
         e_star: 1.0 / (wm.compliance() + rm.compliance()),
         step_deg,
         n_intervals,
         refine: req.refine.unwrap_or(true),
-        load_sharing: req.load_sharing.unwrap_or_default(),
+        load_sharing: req.load_sharing.unwrap_or_default().into(),
         subsurface: include.subsurface.unwrap_or(false),
     }
 }
