@@ -262,7 +262,11 @@ fn print_request_table() {
     // ratios above are asserted within one run).
     println!(
         "\nTarget (issue): paper-case optimise ≤ 10 µs of compute: {} ({:.2} µs median).",
-        if t.median_us() <= 10.0 { "met" } else { "MISSED" },
+        if t.median_us() <= 10.0 {
+            "met"
+        } else {
+            "MISSED"
+        },
         t.median_us()
     );
     println!();
