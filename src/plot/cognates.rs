@@ -4,7 +4,7 @@
 use plotters::prelude::*;
 use serde_json::{Value, json};
 
-use super::style::{SIZE, colour, range};
+use super::style::{SIZE, colour, legend_box, range};
 use super::{PlotError, points};
 
 /// Curves on (the picture's subject), at the requested density or 360 points per circuit.
@@ -115,11 +115,7 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
                 .iter()
                 .map(|&p| TriangleMarker::new(p, 8, colour(6).filled())),
         )?;
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(200, 200, 200))
-            .draw()?;
+        legend_box(&mut chart, 0.85)?;
         root.present()?;
     }
     Ok(svg)
