@@ -7,7 +7,7 @@ use serde_json::{Value, json};
 use std::ops::Range;
 
 use super::style::{
-    Area, Chart, SIZE, colour, legend_box, picture, ramp_legend, range, sequential,
+    Area, Chart, SIZE, colour, framed_chart, legend_box, picture, ramp_legend, range, sequential,
 };
 use super::{PlotError, numbers};
 
@@ -105,22 +105,10 @@ fn fk(answer: &Value) -> Result<String, PlotError> {
 fn framed<'a, 'b>(
     area: &'a Area<'b>,
     caption: &str,
-    (xr, yr): (Range<f64>, Range<f64>),
-    (x_desc, y_desc): (&str, &str),
+    ranges: (Range<f64>, Range<f64>),
+    descs: (&str, &str),
 ) -> Result<Chart<'a, 'b>, PlotError> {
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, ("sans-serif", 15))
-        .margin(8)
-        .x_label_area_size(34)
-        .y_label_area_size(60)
-        .build_cartesian_2d(xr, yr)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()?;
-    Ok(chart)
+    framed_chart(area, (caption, 15), (8, 60), ranges, descs)
 }
 
 /// The nodes of the answer's first wave: at the top level, or the first of `waves` in a

@@ -151,6 +151,34 @@ pub fn ramp_legend(
     Ok(())
 }
 
+/// An f64 × f64 chart in `area` in the house frame: the caption `(text, font size)`, the
+/// `(margin, y label area)` in pixels (the x label area is 34 px), the axes' ranges and
+/// descriptions (quantity [unit]), a light grid.
+///
+/// # Errors
+/// What the backend returns.
+pub fn framed_chart<'a, 'b>(
+    area: &'a Area<'b>,
+    (caption, caption_px): (&str, u32),
+    (margin, y_label_px): (u32, u32),
+    (xr, yr): (std::ops::Range<f64>, std::ops::Range<f64>),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<Chart<'a, 'b>, PlotError> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", caption_px))
+        .margin(margin)
+        .x_label_area_size(34)
+        .y_label_area_size(y_label_px)
+        .build_cartesian_2d(xr, yr)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    Ok(chart)
+}
+
 /// A line chart in `area` with axis descriptions (quantity [unit]), series in palette order and
 /// optional marker points (drawn as circles, e.g. knots).
 pub fn line_chart(
@@ -168,18 +196,7 @@ pub fn line_chart(
             .flat_map(|s| s.points.iter().map(|p| p.1))
             .chain(markers.iter().map(|m| m.1)),
     );
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 15))
-        .margin(6)
-        .x_label_area_size(34)
-        .y_label_area_size(64)
-        .build_cartesian_2d(xs, ys)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()?;
+    let mut chart = framed_chart(area, (title, 15), (6, 64), (xs, ys), (x_desc, y_desc))?;
     for (i, s) in series.iter().enumerate() {
         let c = colour(i);
         chart
