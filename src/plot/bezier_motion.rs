@@ -1,10 +1,9 @@
 //! `POST /v1/bezier-motion-law`: the motion law over the move and the residual vibration of the
 //! compliant drive after it.
 
-use plotters::prelude::*;
 use serde_json::{Value, json};
 
-use super::style::{SIZE, Series, line_chart};
+use super::style::{Series, line_chart, top_and_bottom};
 use super::{PlotError, numbers};
 
 /// A time history over the move and half the move's duration after it, unless the request asks
@@ -37,13 +36,9 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
     }
     let pair =
         |key: &str| -> Vec<(f64, f64)> { t.iter().copied().zip(numbers(&th[key])).collect() };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE)?;
-        let (top, bottom) = root.split_vertically(SIZE.1 / 2);
+    top_and_bottom(|top, bottom| {
         line_chart(
-            &top,
+            top,
             "Bezier motion law: motor angle",
             "time t [s]",
             "angle φ [rad]",
@@ -54,7 +49,7 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
             &[],
         )?;
         line_chart(
-            &bottom,
+            bottom,
             "residual vibration: platform lag behind the rigid law",
             "time t [s]",
             "lag ψ = β − zφ [rad]",
@@ -63,8 +58,6 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
                 points: pair("psi_rad"),
             }],
             &[],
-        )?;
-        root.present()?;
-    }
-    Ok(svg)
+        )
+    })
 }

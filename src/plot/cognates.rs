@@ -4,7 +4,7 @@
 use plotters::prelude::*;
 use serde_json::{Value, json};
 
-use super::style::{SIZE, colour, range};
+use super::style::{SIZE, colour, framed_chart, legend_box, range};
 use super::{PlotError, points};
 
 /// Curves on (the picture's subject), at the requested density or 360 points per circuit.
@@ -72,24 +72,22 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
     {
         let root = SVGBackend::with_string(&mut svg, (side + 60, side)).into_drawing_area();
         root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
+        let mut chart = framed_chart(
+            &root,
+            (
                 "Roberts–Chebyshev cognates: one coupler curve, three four-bars",
-                ("sans-serif", 16),
-            )
-            .margin(8)
-            .x_label_area_size(34)
-            .y_label_area_size(56)
-            .build_cartesian_2d(
+                16,
+            ),
+            (8, 56),
+            (
                 (cx - 0.5 * span)..(cx + 0.5 * span),
                 (cy - 0.5 * span)..(cy + 0.5 * span),
-            )?;
-        chart
-            .configure_mesh()
-            .x_desc("x [length unit of the request]")
-            .y_desc("y [length unit of the request]")
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+            ),
+            (
+                "x [length unit of the request]",
+                "y [length unit of the request]",
+            ),
+        )?;
         for c in &curves {
             chart
                 .draw_series(LineSeries::new(
@@ -115,11 +113,7 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
                 .iter()
                 .map(|&p| TriangleMarker::new(p, 8, colour(6).filled())),
         )?;
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(200, 200, 200))
-            .draw()?;
+        legend_box(&mut chart, 0.85)?;
         root.present()?;
     }
     Ok(svg)

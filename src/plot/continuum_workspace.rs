@@ -4,7 +4,11 @@
 use plotters::prelude::*;
 use serde_json::{Value, json};
 
-use super::style::{SIZE, colour, range, sequential};
+use std::ops::Range;
+
+use super::style::{
+    Area, Chart, SIZE, colour, framed_chart, legend_box, picture, ramp_legend, range, sequential,
+};
 use super::{PlotError, numbers};
 
 /// Rod shapes for FK, nodes for a workspace sweep.
@@ -72,30 +76,14 @@ fn fk(answer: &Value) -> Result<String, PlotError> {
     let platform = numbers(&answer["platform"]["position_m"]);
     let all: Vec<(f64, f64)> = shapes.iter().flatten().copied().collect();
     let (xr, yr) = equal_axes(&all);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (SIZE.1 + 60, SIZE.1)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!(
-                    "rod shapes; platform parasitic angle {:.3} deg",
-                    answer["platform"]["parasitic_angle_deg"]
-                        .as_f64()
-                        .unwrap_or(f64::NAN)
-                ),
-                ("sans-serif", 15),
-            )
-            .margin(8)
-            .x_label_area_size(34)
-            .y_label_area_size(60)
-            .build_cartesian_2d(xr, yr)?;
-        chart
-            .configure_mesh()
-            .x_desc("x [m]")
-            .y_desc("y [m]")
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+    picture((SIZE.1 + 60, SIZE.1), |root| {
+        let caption = format!(
+            "rod shapes; platform parasitic angle {:.3} deg",
+            answer["platform"]["parasitic_angle_deg"]
+                .as_f64()
+                .unwrap_or(f64::NAN)
+        );
+        let mut chart = framed(root, &caption, (xr, yr), ("x [m]", "y [m]"))?;
         for (i, s) in shapes.iter().enumerate() {
             let c = colour(i);
             chart
@@ -108,14 +96,19 @@ fn fk(answer: &Value) -> Result<String, PlotError> {
         if let [px, py] = platform[..] {
             chart.draw_series([TriangleMarker::new((px, py), 8, colour(6).filled())])?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(200, 200, 200))
-            .draw()?;
-        root.present()?;
-    }
-    Ok(svg)
+        legend_box(&mut chart, 0.85)
+    })
+}
+
+/// A chart in `area` with the frame of the workspace pictures: `caption`, the axes' ranges and
+/// descriptions, a light grid.
+fn framed<'a, 'b>(
+    area: &'a Area<'b>,
+    caption: &str,
+    ranges: (Range<f64>, Range<f64>),
+    descs: (&str, &str),
+) -> Result<Chart<'a, 'b>, PlotError> {
+    framed_chart(area, (caption, 15), (8, 60), ranges, descs)
 }
 
 /// The nodes of the answer's first wave: at the top level, or the first of `waves` in a
@@ -152,26 +145,14 @@ fn workspace(answer: &Value) -> Result<String, PlotError> {
     }
     let (xr, yr) = equal_axes(&pts);
     let amax = ok.iter().map(|p| p.2.abs()).fold(0.0, f64::max).max(1e-12);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (SIZE.1 + 200, SIZE.1)).into_drawing_area();
-        root.fill(&WHITE)?;
+    picture((SIZE.1 + 200, SIZE.1), |root| {
         let (plot, legend) = root.split_horizontally(SIZE.1 + 60);
-        let mut chart = ChartBuilder::on(&plot)
-            .caption(
-                "workspace: platform positions coloured by |parasitic angle|",
-                ("sans-serif", 15),
-            )
-            .margin(8)
-            .x_label_area_size(34)
-            .y_label_area_size(60)
-            .build_cartesian_2d(xr, yr)?;
-        chart
-            .configure_mesh()
-            .x_desc("platform x [m]")
-            .y_desc("platform y [m]")
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        let mut chart = framed(
+            &plot,
+            "workspace: platform positions coloured by |parasitic angle|",
+            (xr, yr),
+            ("platform x [m]", "platform y [m]"),
+        )?;
         chart.draw_series(
             ok.iter()
                 .map(|&(x, y, a)| Circle::new((x, y), 3, sequential(a.abs() / amax).filled())),
@@ -184,33 +165,11 @@ fn workspace(answer: &Value) -> Result<String, PlotError> {
             )?
             .label("unstable (beyond the stability boundary)")
             .legend(|(x, y)| Cross::new((x + 6, y), 4, colour(1).stroke_width(2)));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(200, 200, 200))
-            .draw()?;
-        let legend = legend.margin(40, 40, 10, 10);
-        legend.draw(&Text::new(
-            "|parasitic angle| [deg]",
-            (0, 0),
-            ("sans-serif", 12).into_font(),
-        ))?;
-        for k in 0..5 {
-            let t = f64::from(k) / 4.0;
-            let y = 24 + (4 - k) * 28;
-            legend.draw(&Rectangle::new(
-                [(0, y), (20, y + 20)],
-                sequential(t).filled(),
-            ))?;
-            legend.draw(&Text::new(
-                format!("{:.3}", t * amax),
-                (26, y + 4),
-                ("sans-serif", 11).into_font(),
-            ))?;
-        }
-        root.present()?;
-    }
-    Ok(svg)
+        legend_box(&mut chart, 0.85)?;
+        ramp_legend(&legend, "|parasitic angle| [deg]", |t| {
+            format!("{:.3}", t * amax)
+        })
+    })
 }
 
 /// Assembly modes: each solution's parasitic angle against its stability margin, stable ones

@@ -4,7 +4,7 @@
 use plotters::prelude::*;
 use serde_json::{Value, json};
 
-use super::style::{HeatMap, SIZE, Series, heat_map, line_chart};
+use super::style::{HeatMap, SIZE, Series, heat_map, line_chart, top_and_bottom};
 use super::{PlotError, numbers};
 
 /// Curves on for a single design.
@@ -29,13 +29,9 @@ pub fn render_stress(_req: &Value, answer: &Value) -> Result<String, PlotError> 
     let phi = numbers(&c["phi2_deg"]);
     let zip =
         |key: &str| -> Vec<(f64, f64)> { phi.iter().copied().zip(numbers(&c[key])).collect() };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE)?;
-        let (top, bottom) = root.split_vertically(SIZE.1 / 2);
+    top_and_bottom(|top, bottom| {
         line_chart(
-            &top,
+            top,
             "rolling-element force over the mesh cycle",
             "φ2 [deg]",
             "F [N]",
@@ -46,7 +42,7 @@ pub fn render_stress(_req: &Value, answer: &Value) -> Result<String, PlotError> 
             &[],
         )?;
         line_chart(
-            &bottom,
+            bottom,
             "Hertz contact stress",
             "φ2 [deg]",
             "σ [MPa]",
@@ -61,10 +57,8 @@ pub fn render_stress(_req: &Value, answer: &Value) -> Result<String, PlotError> 
                 },
             ],
             &[],
-        )?;
-        root.present()?;
-    }
-    Ok(svg)
+        )
+    })
 }
 
 /// The lowest maximum stress over the other swept parameters, per (Z2, χ).
@@ -129,13 +123,9 @@ pub fn render_efficiency(_req: &Value, answer: &Value) -> Result<String, PlotErr
             .filter_map(|e| Some((e["phi2_deg"].as_f64()?, e[key].as_f64()?)))
             .collect()
     };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE)?;
-        let (top, bottom) = root.split_vertically(SIZE.1 / 2);
+    top_and_bottom(|top, bottom| {
         line_chart(
-            &top,
+            top,
             "per-element efficiency over the mesh cycle",
             "φ2 [deg]",
             "η_k [-]",
@@ -146,7 +136,7 @@ pub fn render_efficiency(_req: &Value, answer: &Value) -> Result<String, PlotErr
             &[],
         )?;
         line_chart(
-            &bottom,
+            bottom,
             "per-element sliding loss",
             "φ2 [deg]",
             "N_S [W]",
@@ -155,8 +145,6 @@ pub fn render_efficiency(_req: &Value, answer: &Value) -> Result<String, PlotErr
                 points: pts("NS_W"),
             }],
             &[],
-        )?;
-        root.present()?;
-    }
-    Ok(svg)
+        )
+    })
 }

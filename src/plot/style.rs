@@ -54,6 +54,131 @@ pub struct Series<'a> {
     pub points: Vec<(f64, f64)>,
 }
 
+impl<'a> Series<'a> {
+    /// Series of labelled point lists (each list cloned).
+    #[must_use]
+    pub fn labelled(owned: &'a [(String, Vec<(f64, f64)>)]) -> Vec<Self> {
+        owned
+            .iter()
+            .map(|(l, p)| Series {
+                label: l,
+                points: p.clone(),
+            })
+            .collect()
+    }
+}
+
+/// A drawing area of an SVG picture.
+pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+/// A chart on f64 × f64 axes in an SVG picture.
+pub type Chart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A picture of `size` pixels on white, drawn by `draw` on its whole area.
+///
+/// # Errors
+/// What `draw` or the backend returns.
+pub fn picture(
+    size: (u32, u32),
+    draw: impl FnOnce(&Area<'_>) -> Result<(), PlotError>,
+) -> Result<String, PlotError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE)?;
+        draw(&root)?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+/// A picture of [`SIZE`] in two equal panels, drawn by `draw(top, bottom)`.
+///
+/// # Errors
+/// What `draw` or the backend returns.
+pub fn top_and_bottom(
+    draw: impl FnOnce(&Area<'_>, &Area<'_>) -> Result<(), PlotError>,
+) -> Result<String, PlotError> {
+    picture(SIZE, |root| {
+        let (top, bottom) = root.split_vertically(SIZE.1 / 2);
+        draw(&top, &bottom)
+    })
+}
+
+/// Draws the series legend of `chart` in a grey-bordered white box, `opacity` of it opaque.
+///
+/// # Errors
+/// What the backend returns.
+pub fn legend_box<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, opacity: f64) -> Result<(), PlotError> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(opacity))
+        .border_style(RGBColor(200, 200, 200))
+        .draw()?;
+    Ok(())
+}
+
+/// A colour-ramp legend in `area`: `title` above five steps of [`sequential`] from t = 0 to 1,
+/// each labelled `label(t)`.
+///
+/// # Errors
+/// What the backend returns.
+pub fn ramp_legend(
+    area: &Area<'_>,
+    title: &str,
+    label: impl Fn(f64) -> String,
+) -> Result<(), PlotError> {
+    let legend = area.margin(40, 40, 10, 10);
+    legend.draw(&Text::new(
+        title.to_owned(),
+        (0, 0),
+        ("sans-serif", 12).into_font(),
+    ))?;
+    for k in 0..5 {
+        let t = f64::from(k) / 4.0;
+        let y = 24 + (4 - k) * 28;
+        legend.draw(&Rectangle::new(
+            [(0, y), (20, y + 20)],
+            sequential(t).filled(),
+        ))?;
+        legend.draw(&Text::new(
+            label(t),
+            (26, y + 4),
+            ("sans-serif", 11).into_font(),
+        ))?;
+    }
+    Ok(())
+}
+
+/// An f64 × f64 chart in `area` in the house frame: the caption `(text, font size)`, the
+/// `(margin, y label area)` in pixels (the x label area is 34 px), the axes' ranges and
+/// descriptions (quantity [unit]), a light grid.
+///
+/// # Errors
+/// What the backend returns.
+pub fn framed_chart<'a, 'b>(
+    area: &'a Area<'b>,
+    (caption, caption_px): (&str, u32),
+    (margin, y_label_px): (u32, u32),
+    (xr, yr): (std::ops::Range<f64>, std::ops::Range<f64>),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<Chart<'a, 'b>, PlotError> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", caption_px))
+        .margin(margin)
+        .x_label_area_size(34)
+        .y_label_area_size(y_label_px)
+        .build_cartesian_2d(xr, yr)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    Ok(chart)
+}
+
 /// A line chart in `area` with axis descriptions (quantity [unit]), series in palette order and
 /// optional marker points (drawn as circles, e.g. knots).
 pub fn line_chart(
@@ -71,18 +196,7 @@ pub fn line_chart(
             .flat_map(|s| s.points.iter().map(|p| p.1))
             .chain(markers.iter().map(|m| m.1)),
     );
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 15))
-        .margin(6)
-        .x_label_area_size(34)
-        .y_label_area_size(64)
-        .build_cartesian_2d(xs, ys)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()?;
+    let mut chart = framed_chart(area, (title, 15), (6, 64), (xs, ys), (x_desc, y_desc))?;
     for (i, s) in series.iter().enumerate() {
         let c = colour(i);
         chart
@@ -98,11 +212,7 @@ pub fn line_chart(
         )?;
     }
     if series.len() > 1 {
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(RGBColor(200, 200, 200))
-            .draw()?;
+        legend_box(&mut chart, 0.8)?;
     }
     Ok(())
 }
@@ -177,9 +287,7 @@ fn edges(c: &[f64]) -> Vec<f64> {
 pub fn heat_map(
     area: &DrawingArea<SVGBackend<'_>, Shift>,
     map: &HeatMap<'_>,
-    overlay: impl FnOnce(
-        &mut ChartContext<'_, SVGBackend<'_>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
-    ) -> Result<(), PlotError>,
+    overlay: impl FnOnce(&mut Chart<'_, '_>) -> Result<(), PlotError>,
 ) -> Result<(), PlotError> {
     let (plot, legend) = area.split_horizontally(area.dim_in_pixel().0.saturating_sub(150));
     let xe = edges(&map.x);
@@ -238,31 +346,14 @@ pub fn heat_map(
     chart.draw_series(cells)?;
     overlay(&mut chart)?;
     // Legend: five steps from the lowest to the highest value.
-    let legend = legend.margin(40, 40, 10, 10);
-    legend.draw(&Text::new(
-        map.z_desc.to_owned(),
-        (0, 0),
-        ("sans-serif", 12).into_font(),
-    ))?;
-    for k in 0..5 {
-        let t = f64::from(k) / 4.0;
+    ramp_legend(&legend, map.z_desc, |t| {
         let v = untr(tlo + t * (thi - tlo));
-        let y = 24 + (4 - k) * 28;
-        legend.draw(&Rectangle::new(
-            [(0, y), (20, y + 20)],
-            sequential(t).filled(),
-        ))?;
-        legend.draw(&Text::new(
-            if v.is_finite() {
-                format!("{v:.4}")
-            } else {
-                "—".to_owned()
-            },
-            (26, y + 4),
-            ("sans-serif", 11).into_font(),
-        ))?;
-    }
-    Ok(())
+        if v.is_finite() {
+            format!("{v:.4}")
+        } else {
+            "—".to_owned()
+        }
+    })
 }
 
 /// Bars of `values` (one per label) in `area`, labels under the bars.

@@ -99,13 +99,7 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
         let root = SVGBackend::with_string(&mut svg, (SIZE.0, SIZE.1 + 200)).into_drawing_area();
         root.fill(&WHITE)?;
         let areas = root.split_evenly((2, 1));
-        let fs: Vec<Series<'_>> = curves
-            .iter()
-            .map(|(l, p)| Series {
-                label: l,
-                points: p.clone(),
-            })
-            .collect();
+        let fs = Series::labelled(&curves);
         line_chart(
             &areas[0],
             "receptance |H(x, x_p, f)| (null points at undamped resonances omitted)",
@@ -114,13 +108,7 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
             &fs,
             &[],
         )?;
-        let ts: Vec<Series<'_>> = tseries
-            .iter()
-            .map(|(l, p)| Series {
-                label: l,
-                points: p.clone(),
-            })
-            .collect();
+        let ts = Series::labelled(&tseries);
         line_chart(
             &areas[1],
             &format!(

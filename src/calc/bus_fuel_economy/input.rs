@@ -875,6 +875,22 @@ fn n_max_rpm(spec: &MotorSpec) -> f64 {
     }
 }
 
+/// The envelope of a tabulated motor (constant efficiency, efficiency map or loss map: the same
+/// four envelope fields) under the pointer `base`.
+macro_rules! table_envelope {
+    ($v:expr, $base:expr, $m:expr) => {
+        envelope(
+            $v,
+            $base,
+            $m.t_peak_nm,
+            $m.p_peak_w,
+            $m.n_max_rpm,
+            $m.envelope.as_ref(),
+        )
+        .0
+    };
+}
+
 fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     let base = format!("/motors/{i}");
     name_ok(v, &format!("{base}/id"), spec.id(), "motor id");
@@ -887,48 +903,20 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
                 m.efficiency,
                 w::EFFICIENCY,
             );
-            let (env, _) = envelope(
-                v,
-                &base,
-                m.t_peak_nm,
-                m.p_peak_w,
-                m.n_max_rpm,
-                m.envelope.as_ref(),
-            );
             MotorKind::Constant {
                 eta: m.efficiency,
-                envelope: env,
+                envelope: table_envelope!(v, &base, m),
             }
         }
         MotorSpec::EfficiencyMap(m) => {
-            let (env, _) = envelope(
-                v,
-                &base,
-                m.t_peak_nm,
-                m.p_peak_w,
-                m.n_max_rpm,
-                m.envelope.as_ref(),
-            );
-            let loss = efficiency_map(v, &base, m, &env, &mut warnings);
-            MotorKind::Map {
-                loss,
-                envelope: env,
-            }
+            let envelope = table_envelope!(v, &base, m);
+            let loss = efficiency_map(v, &base, m, &envelope, &mut warnings);
+            MotorKind::Map { loss, envelope }
         }
         MotorSpec::LossMap(m) => {
-            let (env, _) = envelope(
-                v,
-                &base,
-                m.t_peak_nm,
-                m.p_peak_w,
-                m.n_max_rpm,
-                m.envelope.as_ref(),
-            );
-            let loss = loss_map(v, &base, m, &env, &mut warnings);
-            MotorKind::Map {
-                loss,
-                envelope: env,
-            }
+            let envelope = table_envelope!(v, &base, m);
+            let loss = loss_map(v, &base, m, &envelope, &mut warnings);
+            MotorKind::Map { loss, envelope }
         }
         MotorSpec::Ipmsm(m) => MotorKind::Ipmsm(Box::new(ipmsm(v, &base, m))),
     };

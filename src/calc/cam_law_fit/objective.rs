@@ -222,16 +222,8 @@ impl<'a, M: CurveModel> Ctx<'a, M> {
     /// # Errors
     /// [`EvalRefused::Budget`] once the budget is spent.
     pub fn value(&mut self, g: &[f64; 7]) -> Result<f64, EvalRefused> {
-        let f = if self.eval_curve(g)? {
-            match self.metric {
-                Metric::Euclidean => euclidean(&self.curve, self.data),
-                Metric::Dtw { window } => self.dtw.distance(&self.curve, self.data, window),
-            }
-        } else {
-            f64::INFINITY
-        };
-        self.offer(f, g);
-        Ok(f)
+        let ok = self.eval_curve(g)?;
+        Ok(self.score(ok, g))
     }
 
     /// The objective at `g` even when the budget is spent (counted; updates best-so-far). Used
@@ -239,6 +231,12 @@ impl<'a, M: CurveModel> Ctx<'a, M> {
     pub fn value_forced(&mut self, g: &[f64; 7]) -> f64 {
         self.evaluations += 1;
         let ok = self.model.curve(g, &mut self.curve) && self.curve.iter().all(|v| v.is_finite());
+        self.score(ok, g)
+    }
+
+    /// The objective of the curve just evaluated at `g` (infinite when `ok` is false: a
+    /// degenerate or non-finite curve); updates best-so-far.
+    fn score(&mut self, ok: bool, g: &[f64; 7]) -> f64 {
         let f = if ok {
             match self.metric {
                 Metric::Euclidean => euclidean(&self.curve, self.data),

@@ -248,6 +248,45 @@ fn dag_source_log_space(g: &Digraph, e: usize, reached: &[usize], mark: &[bool],
     }
 }
 
+/// A DFS frame of [`walk_simple_paths`]: (node, next CSR edge, CSR edge into node, accumulated
+/// child sums).
+type Frame = (usize, usize, usize, f64);
+
+/// Depth-first walk over the simple paths from `e` (every node on the current path marked in
+/// `on_path`): `extend(w)` before each path is extended by node `w` (an error stops the walk),
+/// `leave(stack, frame)` after `frame`'s node is taken off the path (`stack` holds its parents).
+fn walk_simple_paths<E>(
+    g: &Digraph,
+    e: usize,
+    stack: &mut Vec<Frame>,
+    on_path: &mut [bool],
+    mut extend: impl FnMut(usize) -> Result<(), E>,
+    mut leave: impl FnMut(&mut Vec<Frame>, Frame),
+) -> Result<(), E> {
+    stack.push((e, g.out_edges(e).start, usize::MAX, 0.0));
+    on_path[e] = true;
+    while let Some(top) = stack.last_mut() {
+        let v = top.0;
+        if top.1 < g.out_edges(v).end {
+            let ed = top.1;
+            top.1 += 1;
+            let w = g.head(ed);
+            if on_path[w] {
+                continue;
+            }
+            extend(w)?;
+            on_path[w] = true;
+            stack.push((w, g.out_edges(w).start, ed, 0.0));
+        } else {
+            let frame = *top;
+            on_path[v] = false;
+            stack.pop();
+            leave(stack, frame);
+        }
+    }
+    Ok(())
+}
+
 /// Edge betweenness over all simple paths by depth-first enumeration (any digraph, spec §3.3).
 ///
 /// Per source e, a first DFS counts π(e,f) for every f; a second DFS accumulates, for each path p
@@ -270,25 +309,19 @@ pub fn simple_path_betweenness_enumerated(
     let mut cnt = vec![0.0f64; n];
     let mut on_path = vec![false; n];
     let mut enumerated = 0u64;
-    // DFS frames: (node, next CSR edge, CSR edge into node, accumulated child sums).
-    let mut stack: Vec<(usize, usize, usize, f64)> = Vec::new();
+    let mut stack: Vec<Frame> = Vec::new();
     for e in 0..n {
         work.passes += 1;
         work.check(budget, STAGE)?;
         // Pass 1: count simple paths from e to every f.
         let mut touched: Vec<usize> = Vec::new();
         stack.clear();
-        stack.push((e, g.out_edges(e).start, usize::MAX, 0.0));
-        on_path[e] = true;
-        while let Some(top) = stack.last_mut() {
-            let v = top.0;
-            if top.1 < g.out_edges(v).end {
-                let ed = top.1;
-                top.1 += 1;
-                let w = g.head(ed);
-                if on_path[w] {
-                    continue;
-                }
+        walk_simple_paths(
+            g,
+            e,
+            &mut stack,
+            &mut on_path,
+            |w| {
                 if cnt[w] == 0.0 {
                     touched.push(w);
                 }
@@ -304,35 +337,24 @@ pub fn simple_path_betweenness_enumerated(
                 if work.paths.is_multiple_of(PATHS_PER_BUDGET_CHECK) {
                     work.check(budget, STAGE)?;
                 }
-                on_path[w] = true;
-                stack.push((w, g.out_edges(w).start, ed, 0.0));
-            } else {
-                on_path[v] = false;
-                stack.pop();
-            }
-        }
+                Ok(())
+            },
+            |_, _| {},
+        )?;
         // Pass 2: accumulate s(p) along the DFS tree.
-        stack.push((e, g.out_edges(e).start, usize::MAX, 0.0));
-        on_path[e] = true;
-        while let Some(top) = stack.last_mut() {
-            let v = top.0;
-            if top.1 < g.out_edges(v).end {
-                let ed = top.1;
-                top.1 += 1;
-                let w = g.head(ed);
-                if on_path[w] {
-                    continue;
-                }
+        walk_simple_paths(
+            g,
+            e,
+            &mut stack,
+            &mut on_path,
+            |_| {
                 work.paths += 1;
                 if work.paths.is_multiple_of(PATHS_PER_BUDGET_CHECK) {
                     work.check(budget, STAGE)?;
                 }
-                on_path[w] = true;
-                stack.push((w, g.out_edges(w).start, ed, 0.0));
-            } else {
-                let (_, _, e_in, acc) = *top;
-                on_path[v] = false;
-                stack.pop();
+                Ok(())
+            },
+            |stack, (v, _, e_in, acc)| {
                 let depth_one = stack.len() == 1;
                 if let Some(parent) = stack.last_mut() {
                     let full = 1.0 / cnt[v] + acc;
@@ -340,8 +362,8 @@ pub fn simple_path_betweenness_enumerated(
                     b[e_in] += if depth_one { acc } else { full };
                     parent.3 += full;
                 }
-            }
-        }
+            },
+        )?;
         for &w in &touched {
             cnt[w] = 0.0;
         }

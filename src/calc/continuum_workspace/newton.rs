@@ -335,15 +335,16 @@ pub fn continue_path(
     budget: &Budget,
     counter: &mut Counter,
 ) -> Result<ContinuationResult, Failed> {
+    let leg = Leg::new(model, from, to, k, opts, budget);
     match stepping {
-        Stepping::Fixed => continuation(model, start, from, to, k, opts, budget, counter),
+        Stepping::Fixed => continuation(&leg, start, counter),
         Stepping::Adaptive => {
             // The adaptive path is the fast one; where it stalls (a singular Jacobian at home, a
             // near-fold far out) the spec's equal steps are walked from the same start, so an
             // answer never depends on which stepping was asked for when both can arrive.
-            match adaptive(model, start.clone(), from, to, k, opts, budget, counter) {
+            match adaptive(&leg, start.clone(), counter) {
                 Err(f) if !matches!(f.reason, NewtonFailure::Budget(_)) => {
-                    let mut r = continuation(model, start, from, to, k, opts, budget, counter)?;
+                    let mut r = continuation(&leg, start, counter)?;
                     r.newton_iterations += f.iterations;
                     r.fell_back_at = Some(f.progress);
                     Ok(r)
@@ -354,29 +355,57 @@ pub fn continue_path(
     }
 }
 
-#[expect(
-    clippy::too_many_arguments,
-    reason = "the continuation's full context; grouping it would only rename it"
-)]
-/// Continue a solution `start` at `from` along the straight parameter path to `to` in `k` equal
-/// steps with tangent predictor; halve a failing step up to 8 times.
-pub fn continuation(
-    model: &Model,
-    start: Solution,
-    from: &Params,
-    to: &Params,
-    k: usize,
+/// One continuation's context: the model, the straight parameter path, its nominal step `1/k`,
+/// the request's Newton options, those of the predicted steps, and the budget.
+struct Leg<'a> {
+    model: &'a Model,
+    path: Path<'a>,
+    nominal: f64,
     opts: NewtonOptions,
-    budget: &Budget,
+    step_opts: NewtonOptions,
+    budget: &'a Budget,
+}
+
+impl<'a> Leg<'a> {
+    /// The leg from `from` to `to` in `k` nominal steps.
+    fn new(
+        model: &'a Model,
+        from: &'a Params,
+        to: &Params,
+        k: usize,
+        opts: NewtonOptions,
+        budget: &'a Budget,
+    ) -> Self {
+        Self {
+            model,
+            path: Path::new(from, to),
+            nominal: 1.0 / k.max(1) as f64,
+            opts,
+            // Predicted steps either converge fast or are halved: give up on creeping solves early.
+            step_opts: NewtonOptions {
+                stall_window: opts.stall_window.or(Some(CONTINUATION_STALL_WINDOW)),
+                ..opts
+            },
+            budget,
+        }
+    }
+}
+
+/// Continue a solution `start` at the leg's start along its straight parameter path to its end
+/// in `k` equal steps with tangent predictor; halve a failing step up to 8 times.
+fn continuation(
+    leg: &Leg<'_>,
+    start: Solution,
     counter: &mut Counter,
 ) -> Result<ContinuationResult, Failed> {
-    let path = Path::new(from, to);
-    let nominal = 1.0 / k.max(1) as f64;
-    // Predicted steps either converge fast or are halved: give up on creeping solves early.
-    let step_opts = NewtonOptions {
-        stall_window: opts.stall_window.or(Some(CONTINUATION_STALL_WINDOW)),
-        ..opts
-    };
+    let &Leg {
+        model,
+        ref path,
+        nominal,
+        step_opts,
+        budget,
+        ..
+    } = leg;
     let mut t = 0.0;
     let mut sol = start;
     let mut accepted = 0usize;
@@ -553,7 +582,7 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
-/// Adaptive continuation of `start` at `from` to `to`: tangent predictor, first step `1/k`,
+/// Adaptive continuation of `start` at the leg's start to its end: tangent predictor, first step `1/k`,
 /// doubled after easy steps (corrector converged in at most [`EASY_ITER`] chord iterations) up
 /// to [`MAX_STEP`], halved on a failed corrector or when the corrector moves more than [`TRUST`]
 /// of the predictor step; chord Newton with the last evaluated Jacobian's LU (kept across steps
@@ -561,27 +590,20 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
 /// with fresh Jacobians; the end point is solved by full Newton to `opts.tol`. Fails when the
 /// step falls below `1/(k 2^8)` (the fixed path's smallest step). Chord iterations count as
 /// Newton iterations in the result.
-#[expect(
-    clippy::too_many_arguments,
-    reason = "the continuation's full context; grouping it would only rename it"
-)]
-pub fn adaptive(
-    model: &Model,
+fn adaptive(
+    leg: &Leg<'_>,
     start: Solution,
-    from: &Params,
-    to: &Params,
-    k: usize,
-    opts: NewtonOptions,
-    budget: &Budget,
     counter: &mut Counter,
 ) -> Result<ContinuationResult, Failed> {
-    let path = Path::new(from, to);
-    let nominal = 1.0 / k.max(1) as f64;
+    let &Leg {
+        model,
+        ref path,
+        nominal,
+        opts,
+        step_opts,
+        budget,
+    } = leg;
     let h_min = nominal / f64::from(1u32 << MAX_HALVINGS);
-    let step_opts = NewtonOptions {
-        stall_window: opts.stall_window.or(Some(CONTINUATION_STALL_WINDOW)),
-        ..opts
-    };
     let mid_tol = opts.tol.max(CORRECTOR_TOL);
     let mut t = 0.0;
     let mut sol = start;

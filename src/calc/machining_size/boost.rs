@@ -805,16 +805,7 @@ fn finish_tree(
                     cover: f64::from(b.n),
                     loss_change: s.gain,
                 },
-                None => Node {
-                    left: LEAF,
-                    right: LEAF,
-                    feature: 0,
-                    threshold: 0.0,
-                    default_left: false,
-                    value,
-                    cover: f64::from(b.n),
-                    loss_change: 0.0,
-                },
+                None => Node::leaf(value, f64::from(b.n)),
             }
         })
         .collect();

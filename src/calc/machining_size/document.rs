@@ -266,15 +266,7 @@ pub fn read_native(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
                 format!("must have magnitude ≤ 1e100, got {}", raw.value[i]),
             ));
         }
-        let names = RawNames {
-            left: "left",
-            right: "right",
-            feature: "feature",
-            threshold: "threshold",
-            value: "value",
-            cover: "cover",
-        };
-        trees.push(build_tree(&raw, names, &at_t, n_features)?);
+        trees.push(build_tree(&raw, RawNames::PLAIN, &at_t, n_features)?);
     }
     Ok(Model {
         base_score,

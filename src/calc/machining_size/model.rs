@@ -41,6 +41,21 @@ pub struct Node {
 }
 
 impl Node {
+    /// A leaf with value `value` and cover `cover`.
+    #[must_use]
+    pub fn leaf(value: f64, cover: f64) -> Self {
+        Self {
+            left: LEAF,
+            right: LEAF,
+            feature: 0,
+            threshold: 0.0,
+            default_left: false,
+            value,
+            cover,
+            loss_change: 0.0,
+        }
+    }
+
     /// Whether the node is a leaf.
     #[must_use]
     pub fn is_leaf(&self) -> bool {
@@ -71,16 +86,7 @@ impl Tree {
     #[must_use]
     pub fn stump(value: f64, cover: f64) -> Self {
         Self {
-            nodes: vec![Node {
-                left: LEAF,
-                right: LEAF,
-                feature: 0,
-                threshold: 0.0,
-                default_left: false,
-                value,
-                cover,
-                loss_change: 0.0,
-            }],
+            nodes: vec![Node::leaf(value, cover)],
         }
     }
 
@@ -304,6 +310,19 @@ pub struct RawNames {
     pub cover: &'static str,
 }
 
+impl RawNames {
+    /// The arrays named by their own roles (`left`, `right`, `feature`, …): the native model
+    /// document.
+    pub const PLAIN: Self = Self {
+        left: "left",
+        right: "right",
+        feature: "feature",
+        threshold: "threshold",
+        value: "value",
+        cover: "cover",
+    };
+}
+
 /// A structural defect of a tree document, with the JSON pointer of the offending entry.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct StructureIssue {
@@ -481,14 +500,7 @@ pub fn build_tree(
 mod tests {
     use super::*;
 
-    const NAMES: RawNames = RawNames {
-        left: "left",
-        right: "right",
-        feature: "feature",
-        threshold: "threshold",
-        value: "value",
-        cover: "cover",
-    };
+    const NAMES: RawNames = RawNames::PLAIN;
 
     fn raw(left: Vec<i64>, right: Vec<i64>) -> RawTree {
         let n = left.len();

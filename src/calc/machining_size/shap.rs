@@ -984,19 +984,6 @@ mod tests {
     use super::super::model::{ModelSource, Node, Routing};
     use super::*;
 
-    fn leaf(value: f64, cover: f64) -> Node {
-        Node {
-            left: super::super::model::LEAF,
-            right: super::super::model::LEAF,
-            feature: 0,
-            threshold: 0.0,
-            default_left: false,
-            value,
-            cover,
-            loss_change: 0.0,
-        }
-    }
-
     fn split(feature: u32, threshold: f64, left: u32, cover: f64) -> Node {
         Node {
             left,
@@ -1019,7 +1006,11 @@ mod tests {
             routing: Routing::F64,
             source: ModelSource::Native,
             trees: vec![Tree {
-                nodes: vec![split(0, 3.5, 1, 4.0), leaf(-1.5, 3.0), leaf(3.0, 1.0)],
+                nodes: vec![
+                    split(0, 3.5, 1, 4.0),
+                    Node::leaf(-1.5, 3.0),
+                    Node::leaf(3.0, 1.0),
+                ],
             }],
         }
     }
@@ -1043,12 +1034,12 @@ mod tests {
             split(0, 0.0, 1, 10.0),
             split(1, 0.0, 3, 4.0),
             split(1, 1.0, 5, 6.0),
-            leaf(1.0, 1.0),
-            leaf(2.0, 3.0),
-            leaf(3.0, 2.0),
+            Node::leaf(1.0, 1.0),
+            Node::leaf(2.0, 3.0),
+            Node::leaf(3.0, 2.0),
             split(0, 5.0, 7, 4.0),
-            leaf(4.0, 3.0),
-            leaf(5.0, 1.0),
+            Node::leaf(4.0, 3.0),
+            Node::leaf(5.0, 1.0),
         ];
         let m = Model {
             base_score: 0.5,
@@ -1091,7 +1082,7 @@ mod tests {
             };
             let k = nodes.len() as u32;
             if depth == 0 || next() < 0.15 {
-                nodes.push(leaf(next() * 4.0 - 2.0, cover));
+                nodes.push(Node::leaf(next() * 4.0 - 2.0, cover));
                 return k;
             }
             let feature = (next() * f64::from(d)) as u32 % d;

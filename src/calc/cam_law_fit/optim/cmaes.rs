@@ -223,7 +223,7 @@ mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
-    use super::super::testmodel::setup;
+    use super::super::testmodel::{coefficient_error, setup};
     use super::*;
     use crate::calc::cam_law_fit::objective::Metric;
     use crate::numerics::Budget;
@@ -254,12 +254,7 @@ mod tests {
             max_evaluations: 20_000,
         };
         let end = run(&mut ctx, &free, &[1.0 / 7.0; 7], &p, &mut rng);
-        let c = super::super::normalized(&end.g);
-        let err = c
-            .iter()
-            .zip(&truth)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let err = coefficient_error(&end.g, &truth);
         assert!(err < 1e-6, "err {err} {end:?}");
     }
 }

@@ -281,7 +281,7 @@ pub fn run_with<M: CurveModel>(
 
 #[cfg(test)]
 mod tests {
-    use super::super::testmodel::setup;
+    use super::super::testmodel::{coefficient_error, setup};
     use super::*;
     use crate::calc::cam_law_fit::objective::Metric;
     use crate::numerics::Budget;
@@ -293,12 +293,7 @@ mod tests {
         let mut ctx = Ctx::new(&m, &y, Metric::Euclidean, Budget::unlimited(), false);
         let free = FreeGenes((0..7).collect());
         let end = run(&mut ctx, &[1.0; 7], &free, 2000);
-        let c = super::super::normalized(&end.g);
-        let err = c
-            .iter()
-            .zip(&truth)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let err = coefficient_error(&end.g, &truth);
         assert!(err < 1e-9, "err {err}, {end:?}");
         assert!(ctx.evaluations() <= 2000);
 

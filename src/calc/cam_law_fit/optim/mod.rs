@@ -119,4 +119,13 @@ pub(crate) mod testmodel {
         assert!(m.curve(truth, &mut y));
         (m, y)
     }
+
+    /// Largest absolute difference between the normalized coefficients of `g` and `truth`.
+    pub fn coefficient_error(g: &[f64; 7], truth: &[f64; 7]) -> f64 {
+        super::normalized(g)
+            .iter()
+            .zip(truth)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
 }
