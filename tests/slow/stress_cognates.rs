@@ -91,12 +91,27 @@ fn fail(v: Value) -> CalcFailure {
     }
 }
 
-fn lk(l: f64, a: f64, b: f64, c: f64, cp: Value, extra: Value) -> Value {
+/// A linkage request: ground `l`, crank `a`, coupler `b`, rocker `c`, plus the `extra` fields.
+fn lk([l, a, b, c]: [f64; 4], cp: Value, extra: Value) -> Value {
     let mut v = json!({"ground": {"A": [0, 0], "B": [l, 0]}, "crank": a, "coupler": b, "rocker": c, "coupler_point": cp});
     if let (Some(o), Some(x)) = (v.as_object_mut(), extra.as_object()) {
         o.extend(x.clone());
     }
     v
+}
+
+/// A linkage request at one input angle with every option on.
+fn lk_at(bars: [f64; 4], cp: Value, input_angle_deg: f64) -> Value {
+    lk(
+        bars,
+        cp,
+        json!({"input_angle_deg": input_angle_deg, "options": all_options()}),
+    )
+}
+
+/// The special-linkage class of the original and both cognates.
+fn specials(r: &CognatesResponse) -> Vec<Option<SpecialOut>> {
+    r.mechanisms.iter().map(|m| m.grashof.special).collect()
 }
 
 fn has_warning(r: &CognatesResponse, code: WarningCode) -> bool {
@@ -159,13 +174,10 @@ fn extreme_aspect_ratio_warns_and_stays_finite() {
         (1.0, 1.0, 1.0, 1e-7),
         (3e5, 2e5, 1e-2, 1e5 + 1.0),
     ] {
-        match attempt(lk(
-            l,
-            a,
-            b,
-            c,
+        match attempt(lk_at(
+            [l, a, b, c],
             json!({"u": b * 0.3, "v": b * 0.4}),
-            json!({"input_angle_deg": 10.0, "options": all_options()}),
+            10.0,
         )) {
             Ok(r) => assert!(
                 has_warning(&r, WarningCode::ExtremeAspectRatio),
@@ -203,26 +215,17 @@ fn absolute_scale_extremes() {
 fn near_toggle_snapshots() {
     let cases = [
         lk(
-            3.1,
-            1.13,
-            1.23,
-            1.04,
+            [3.1, 1.13, 1.23, 1.04],
             json!({"d": 0.92, "e": 1.56, "side": 1}),
             json!({}),
         ),
         lk(
-            4.0,
-            3.5,
-            3.0,
-            1.0,
+            [4.0, 3.5, 3.0, 1.0],
             json!({"d": 2.0, "e": 2.5, "side": 1}),
             json!({}),
         ),
         lk(
-            4.0,
-            3.0,
-            1.0,
-            3.5,
+            [4.0, 3.0, 1.0, 3.5],
             json!({"d": 0.8, "e": 0.6, "side": -1}),
             json!({}),
         ),
@@ -306,13 +309,10 @@ fn change_point_warns_with_folded_angles() {
         (2.0, 1.0, 4.0, 3.0),
     ] {
         for eps in [0.0, 1e-15, -1e-15, 1e-11, -1e-11] {
-            let r = ok(lk(
-                l,
-                a + eps,
-                b,
-                c,
+            let r = ok(lk_at(
+                [l, a + eps, b, c],
                 json!({"u": 0.3 * b, "v": 0.5 * b}),
-                json!({"input_angle_deg": 179.0, "options": all_options()}),
+                179.0,
             ));
             for m in &r.mechanisms {
                 assert_eq!(
@@ -338,10 +338,7 @@ fn change_point_warns_with_folded_angles() {
 fn grashof_rtol_zero_and_max() {
     for rtol in [0.0, 1e-3] {
         let r = ok(lk(
-            4.0,
-            1.0 + 1e-5,
-            2.0,
-            3.0,
+            [4.0, 1.0 + 1e-5, 2.0, 3.0],
             json!({"u": 0.6, "v": 1.0}),
             json!({"options": {"grashof_rtol": rtol}}),
         ));
@@ -358,15 +355,12 @@ fn grashof_rtol_zero_and_max() {
 fn parallelogram_original_locks_cognate_one() {
     // a = c, b = l: cognate 1 is a deltoid with crank = ground (spec §7).
     for side in [1.0, -1.0] {
-        let r = ok(lk(
-            3.0,
-            1.0,
-            3.0,
-            1.0,
+        let r = ok(lk_at(
+            [3.0, 1.0, 3.0, 1.0],
             json!({"u": 1.2, "v": side * 0.8}),
-            json!({"input_angle_deg": 40.0, "options": all_options()}),
+            40.0,
         ));
-        let sp: Vec<_> = r.mechanisms.iter().map(|m| m.grashof.special).collect();
+        let sp: Vec<_> = specials(&r);
         assert_eq!(
             sp,
             [
@@ -403,10 +397,7 @@ fn parallelogram_original_locks_cognate_one() {
 fn deltoid_original_singular_at_zero() {
     // a = l, b = c: D reaches B at φ = 0.
     let base = lk(
-        2.0,
-        2.0,
-        1.5,
-        1.5,
+        [2.0, 2.0, 1.5, 1.5],
         json!({"u": 0.5, "v": 0.7}),
         json!({"options": all_options()}),
     );
@@ -441,15 +432,12 @@ fn deltoid_original_singular_at_zero() {
     );
     assert_eq!(r.mechanisms[2].grashof.special, Some(SpecialOut::Deltoid));
     // Deltoid crank = coupler (a = b, c = l) → (deltoid, parallelogram).
-    let r2 = ok(lk(
-        2.0,
-        1.5,
-        1.5,
-        2.0,
+    let r2 = ok(lk_at(
+        [2.0, 1.5, 1.5, 2.0],
         json!({"u": 0.5, "v": 0.7}),
-        json!({"input_angle_deg": 30.0, "options": all_options()}),
+        30.0,
     ));
-    let sp: Vec<_> = r2.mechanisms.iter().map(|m| m.grashof.special).collect();
+    let sp: Vec<_> = specials(&r2);
     assert_eq!(
         sp,
         [
@@ -459,13 +447,10 @@ fn deltoid_original_singular_at_zero() {
         ]
     );
     // Rhombus.
-    let r3 = ok(lk(
-        1.0,
-        1.0,
-        1.0,
-        1.0,
+    let r3 = ok(lk_at(
+        [1.0, 1.0, 1.0, 1.0],
         json!({"u": 0.5, "v": 0.7}),
-        json!({"input_angle_deg": 0.0, "options": all_options()}),
+        0.0,
     ));
     assert_eq!(r3.mechanisms[0].grashof.special, Some(SpecialOut::Rhombus));
 }
@@ -473,13 +458,10 @@ fn deltoid_original_singular_at_zero() {
 #[test]
 fn crank_tip_near_output_pivot() {
     // a = l with b ≠ c: s → 0 is never assemblable; the snapshot at φ = 0 must say so cleanly.
-    let r = ok(lk(
-        2.0,
-        2.0,
-        1.0,
-        1.5,
+    let r = ok(lk_at(
+        [2.0, 2.0, 1.0, 1.5],
         json!({"u": 0.5, "v": 0.7}),
-        json!({"input_angle_deg": 0.0, "options": all_options()}),
+        0.0,
     ));
     let s = r.mechanisms[0].snapshot.as_ref().expect("snapshot");
     assert!(matches!(
@@ -487,13 +469,10 @@ fn crank_tip_near_output_pivot() {
         SnapshotStatus::NotAssemblable | SnapshotStatus::Singular
     ));
     for eps in [1e-15, 1e-12, 1e-9] {
-        let _ = ok(lk(
-            2.0,
-            2.0 - eps,
-            1.5,
-            1.5,
+        let _ = ok(lk_at(
+            [2.0, 2.0 - eps, 1.5, 1.5],
             json!({"u": 0.5, "v": 0.7}),
-            json!({"input_angle_deg": 0.0, "options": all_options()}),
+            0.0,
         ));
     }
 }
@@ -505,7 +484,7 @@ fn crank_tip_near_output_pivot() {
 #[test]
 fn coupler_point_on_or_near_a_joint() {
     for (u, v) in [(0.0, 0.0), (3.5, 0.0), (1e-10, 0.0), (3.5 - 1e-10, 1e-10)] {
-        let e = fail(lk(4.0, 1.0, 3.5, 3.0, json!({"u": u, "v": v}), json!({})));
+        let e = fail(lk([4.0, 1.0, 3.5, 3.0], json!({"u": u, "v": v}), json!({})));
         assert_eq!(e.code, "COUPLER_POINT_AT_JOINT", "{e}");
         assert_eq!(e.errors[0].pointer, "/coupler_point");
     }
@@ -513,14 +492,7 @@ fn coupler_point_on_or_near_a_joint() {
         (1e-4, 1e-4, MechanismId::Cognate1),
         (3.5 - 1e-4, 1e-4, MechanismId::Cognate2),
     ] {
-        let r = ok(lk(
-            4.0,
-            1.0,
-            3.5,
-            3.0,
-            json!({"u": u, "v": v}),
-            json!({"input_angle_deg": 20.0, "options": all_options()}),
-        ));
+        let r = ok(lk_at([4.0, 1.0, 3.5, 3.0], json!({"u": u, "v": v}), 20.0));
         let w = r
             .warnings
             .iter()
@@ -529,14 +501,7 @@ fn coupler_point_on_or_near_a_joint() {
         assert_eq!(w.mechanism, Some(who));
     }
     for (u, v) in [(1e-8, 0.0), (3.5 * (1.0 - 1e-8), 1e-9), (1e-6, -1e-6)] {
-        let _ = ok(lk(
-            4.0,
-            1.0,
-            3.5,
-            3.0,
-            json!({"u": u, "v": v}),
-            json!({"input_angle_deg": 20.0, "options": all_options()}),
-        ));
+        let _ = ok(lk_at([4.0, 1.0, 3.5, 3.0], json!({"u": u, "v": v}), 20.0));
     }
 }
 
@@ -552,13 +517,10 @@ fn collinear_and_near_degenerate_coupler_triangles() {
                 // Largest excess of one side over the sum of the other two, as the server sees it.
                 let excess = (d2 - (b + e)).max(e - (b + d2)).max(b - (d2 + e));
                 let slack = 1e-12 * b.max(d2).max(e);
-                match attempt(lk(
-                    4.0,
-                    1.0,
-                    b,
-                    3.0,
+                match attempt(lk_at(
+                    [4.0, 1.0, b, 3.0],
                     json!({"d": d2, "e": e, "side": side}),
-                    json!({"input_angle_deg": 33.0, "options": all_options()}),
+                    33.0,
                 )) {
                     Ok(r) => {
                         assert!(excess <= slack, "accepted beyond the slack: {d2} {e}");
@@ -583,13 +545,10 @@ fn collinear_and_near_degenerate_coupler_triangles() {
     }
     // θ3 = 90° ± tiny: C_x ill-conditioned but finite.
     for dv in [0.0, 1e-15, 1e-9] {
-        let _ = ok(lk(
-            3.1,
-            1.13,
-            1.23,
-            1.04,
+        let _ = ok(lk_at(
+            [3.1, 1.13, 1.23, 1.04],
             json!({"u": dv, "v": 0.92}),
-            json!({"input_angle_deg": 30.0, "options": all_options()}),
+            30.0,
         ));
     }
 }
@@ -607,13 +566,10 @@ fn random_near_degenerate_triangles() {
             b * rng.random_range(0.1..1.0),
             b * rng.random_range(0.5..2.0),
         );
-        let req = lk(
-            l,
-            a,
-            b,
-            c,
+        let req = lk_at(
+            [l, a, b, c],
             json!({"d": d, "e": e, "side": 1}),
-            json!({"input_angle_deg": rng.random_range(-180.0..180.0), "options": all_options()}),
+            rng.random_range(-180.0..180.0),
         );
         if let Err(err) = attempt(req) {
             assert!(
@@ -631,16 +587,13 @@ fn random_near_degenerate_triangles() {
 #[test]
 fn rejections_carry_codes_and_pointers() {
     let cp = json!({"d": 0.92, "e": 1.56, "side": 1});
-    let e = fail(lk(3.1, -1.0, 1.23, 0.0, cp.clone(), json!({})));
+    let e = fail(lk([3.1, -1.0, 1.23, 0.0], cp.clone(), json!({})));
     assert_eq!(e.code, "NON_POSITIVE_LENGTH");
     assert_eq!(e.class, ProblemClass::InvalidInput);
     let ptrs: Vec<_> = e.errors.iter().map(|i| i.pointer.as_str()).collect();
     assert_eq!(ptrs, ["/crank", "/rocker"]);
     let e = fail(lk(
-        3.1,
-        1.13,
-        1.23,
-        1.04,
+        [3.1, 1.13, 1.23, 1.04],
         json!({"d": -0.1, "e": 1.56}),
         json!({}),
     ));
@@ -648,18 +601,15 @@ fn rejections_carry_codes_and_pointers() {
         (e.code, e.errors[0].pointer.as_str()),
         ("NON_POSITIVE_LENGTH", "/coupler_point/d")
     );
-    let e = fail(lk(0.0, 1.13, 1.23, 1.04, cp.clone(), json!({})));
+    let e = fail(lk([0.0, 1.13, 1.23, 1.04], cp.clone(), json!({})));
     assert_eq!(
         (e.code, e.errors[0].pointer.as_str()),
         ("COINCIDENT_PIVOTS", "/ground/B")
     );
-    let e = fail(lk(1e-13, 1.13, 1.23, 1.04, cp.clone(), json!({})));
+    let e = fail(lk([1e-13, 1.13, 1.23, 1.04], cp.clone(), json!({})));
     assert_eq!(e.code, "COINCIDENT_PIVOTS");
     let e = fail(lk(
-        3.1,
-        1.13,
-        1.23,
-        1.04,
+        [3.1, 1.13, 1.23, 1.04],
         json!({"d": 0.2, "e": 1.56}),
         json!({}),
     ));
@@ -667,26 +617,20 @@ fn rejections_carry_codes_and_pointers() {
         (e.code, e.errors[0].pointer.as_str()),
         ("COUPLER_TRIANGLE_INVALID", "/coupler_point")
     );
-    let e = fail(lk(10.0, 1.0, 2.0, 3.0, cp.clone(), json!({})));
+    let e = fail(lk([10.0, 1.0, 2.0, 3.0], cp.clone(), json!({})));
     assert_eq!(
         (e.code, e.class),
         ("NOT_ASSEMBLABLE", ProblemClass::Infeasible)
     );
     // Longest = sum of the others: a rigid, single configuration.
     let e = fail(lk(
-        6.0,
-        1.0,
-        2.0,
-        3.0,
+        [6.0, 1.0, 2.0, 3.0],
         json!({"u": 0.5, "v": 0.5}),
         json!({}),
     ));
     assert_eq!(e.code, "NOT_ASSEMBLABLE");
     let e = fail(lk(
-        3.1,
-        1.13,
-        1.23,
-        1.04,
+        [3.1, 1.13, 1.23, 1.04],
         cp.clone(),
         json!({"options": {"points_per_circuit": 8, "grashof_rtol": 0.1}}),
     ));
@@ -746,10 +690,7 @@ fn too_many_points_and_deadline() {
     // Grashof double rocker: verification samples 3 × 2 circuits × 1e5 = 6e5 points, fixed-branch
     // curves another (2 + 1 + 2) intervals × 1e5 = 5e5: above the 1e6 cap.
     let base = lk(
-        4.0,
-        3.0,
-        1.0,
-        3.5,
+        [4.0, 3.0, 1.0, 3.5],
         json!({"d": 0.8, "e": 0.6, "side": 1}),
         json!({}),
     );
@@ -771,31 +712,22 @@ fn too_many_points_and_deadline() {
 
 #[test]
 fn huge_angles_and_fixed_branch_without_snapshot() {
-    let r = ok(lk(
-        3.1,
-        1.13,
-        1.23,
-        1.04,
+    let r = ok(lk_at(
+        [3.1, 1.13, 1.23, 1.04],
         json!({"d": 0.92, "e": 1.56}),
-        json!({"input_angle_deg": 1e15, "options": all_options()}),
+        1e15,
     ));
     assert!(r.mechanisms[0].snapshot.is_some());
     let mut opts = all_options();
     opts["curve_mode"] = json!("fixed_branch");
     let r = ok(lk(
-        3.1,
-        1.13,
-        1.23,
-        1.04,
+        [3.1, 1.13, 1.23, 1.04],
         json!({"d": 0.92, "e": 1.56}),
         json!({"options": opts.clone()}),
     ));
     assert!(has_warning(&r, WarningCode::FixedBranchDefaultBranches));
     let r = ok(lk(
-        3.1,
-        1.13,
-        1.23,
-        1.04,
+        [3.1, 1.13, 1.23, 1.04],
         json!({"d": 0.92, "e": 1.56}),
         json!({"input_angle_deg": 100.0, "options": opts}),
     ));
