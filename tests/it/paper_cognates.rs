@@ -15,7 +15,7 @@ use mechcalc::calc::cognates::geometry::{C64, FourBar, Sign, Solve};
 use mechcalc::calc::cognates::input::CognatesInput;
 use mechcalc::calc::cognates::sampling::{Spacing, chord_error};
 use mechcalc::calc::cognates::wire::{
-    CognatesResponse, GrashofClassOut, LinkageTypeOut, MechanismOut, SnapshotStatus,
+    CognatesResponse, GrashofClassOut, LinkageTypeOut, MechanismOut, SnapshotOut, SnapshotStatus,
 };
 use mechcalc::calc::cognates::{CognatesRequest, run};
 use mechcalc::numerics::Budget;
@@ -76,6 +76,24 @@ fn fourbar(m: &MechanismOut) -> FourBar {
 
 fn sign(b: i8) -> Sign {
     if b > 0 { Sign::Plus } else { Sign::Minus }
+}
+
+/// "P1 = P2 = P": an independent re-solve of each cognate at its own snapshot input angle and
+/// branch puts its coupler point on `p` within `tol`.
+fn assert_cognates_trace_p(
+    r: &CognatesResponse,
+    [s1, s2]: [&SnapshotOut; 2],
+    p: [f64; 2],
+    tol: f64,
+) {
+    for (m, s) in [(&r.mechanisms[1], s1), (&r.mechanisms[2], s2)] {
+        let fb = fourbar(m);
+        let theta = s.input_angle_deg.unwrap_or(f64::NAN).to_radians();
+        let Solve::Pose(q) = fb.solve(theta, sign(s.branch.unwrap_or(1)), false) else {
+            panic!("re-solve assembles")
+        };
+        assert_pt([q.p.re, q.p.im], p, tol, "re-solved P_i vs P");
+    }
 }
 
 /// Independent closed form of spec §2/§4.5 for A = (0, 0), B = (l, 0): θ3, k and C.
@@ -368,14 +386,7 @@ fn table1_snapshot_branch_plus_spec_6_1() {
     assert_pt(j2.crank_joint, [1.348891, 2.16475], PRINTED_6, "D2");
     assert_pt(j2.rocker_joint, [1.86249, 0.949826], PRINTED_6, "E2");
     // "P1 = P2 = P": independent re-solve of each cognate at its own input angle and branch.
-    for (m, s) in [(&r.mechanisms[1], s1), (&r.mechanisms[2], s2)] {
-        let fb = fourbar(m);
-        let theta = s.input_angle_deg.unwrap_or(f64::NAN).to_radians();
-        let Solve::Pose(q) = fb.solve(theta, sign(s.branch.unwrap_or(1)), false) else {
-            panic!("re-solve assembles")
-        };
-        assert_pt([q.p.re, q.p.im], j0.p, 1e-14, "re-solved P_i vs P");
-    }
+    assert_cognates_trace_p(&r, [s1, s2], j0.p, 1e-14);
 }
 
 #[test]
@@ -391,14 +402,7 @@ fn table1_snapshot_branch_minus_spec_6_1() {
     assert_eq!(s1.branch, Some(1));
     assert!((s2.input_angle_deg.unwrap_or(f64::NAN) - -6.1163).abs() <= 5e-5);
     assert_eq!(s2.branch, Some(1));
-    for (m, s) in [(&r.mechanisms[1], s1), (&r.mechanisms[2], s2)] {
-        let fb = fourbar(m);
-        let theta = s.input_angle_deg.unwrap_or(f64::NAN).to_radians();
-        let Solve::Pose(q) = fb.solve(theta, sign(s.branch.unwrap_or(1)), false) else {
-            panic!("re-solve assembles")
-        };
-        assert_pt([q.p.re, q.p.im], j0.p, 1e-15 * 4.0, "re-solved P_i vs P");
-    }
+    assert_cognates_trace_p(&r, [s1, s2], j0.p, 1e-15 * 4.0);
 }
 
 #[test]
