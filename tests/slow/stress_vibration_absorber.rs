@@ -84,6 +84,20 @@ fn direct_tip(v: &Value, t: f64) -> f64 {
     c.dot(&s.rows(0, n).into_owned())
 }
 
+/// The last tip sample of `a` (the answer to `v`) agrees to 1e-9 of the tip's peak with a direct
+/// exponential at `t_end`.
+fn assert_last_tip_matches_direct(v: &Value, a: &Value, t_end: f64) {
+    let want = direct_tip(v, t_end);
+    let scale = a["time_response"]["points"][0]["max_abs_m"]
+        .as_f64()
+        .expect("max");
+    assert!(
+        (last_tip(a) - want).abs() <= 1e-9 * scale,
+        "{} vs {want}",
+        last_tip(a)
+    );
+}
+
 fn last_tip(a: &Value) -> f64 {
     let w = a["time_response"]["points"][0]["w_m"]
         .as_array()
@@ -143,15 +157,7 @@ fn stiff_systems_step_exactly_at_large_steps() {
     let a = finite_answer(&v);
     // 1e-9: the benchmark measures 1.4e-10 stepping drift at n = 30 over 10 s (spec §8 expects
     // ≤ 1e-10; not met at n = 30, see the module docs), with a margin for machine round-off.
-    let want = direct_tip(&v, 2.0);
-    let scale = a["time_response"]["points"][0]["max_abs_m"]
-        .as_f64()
-        .expect("max");
-    assert!(
-        (last_tip(&a) - want).abs() <= 1e-9 * scale,
-        "{} vs {want}",
-        last_tip(&a)
-    );
+    assert_last_tip_matches_direct(&v, &a, 2.0);
 }
 
 #[test]
@@ -189,15 +195,7 @@ fn long_horizons_are_re_anchored() {
         "outputs": {"time_response": {"t_end_s": 500.0, "dt_s": 0.001, "return_series": true, "decimate": 1000}}});
     let a = finite_answer(&v);
     assert_eq!(a["time_response"]["n_samples"], 500_001);
-    let want = direct_tip(&v, 500.0);
-    let scale = a["time_response"]["points"][0]["max_abs_m"]
-        .as_f64()
-        .expect("max");
-    assert!(
-        (last_tip(&a) - want).abs() <= 1e-9 * scale,
-        "{} vs {want}",
-        last_tip(&a)
-    );
+    assert_last_tip_matches_direct(&v, &a, 500.0);
 }
 
 #[test]
@@ -218,15 +216,7 @@ fn sixteen_harmonics_on_fifty_undamped_modes_stay_exact() {
             .map(Vec::len),
         Some(16)
     );
-    let want = direct_tip(&v, 1.0);
-    let scale = a["time_response"]["points"][0]["max_abs_m"]
-        .as_f64()
-        .expect("max");
-    assert!(
-        (last_tip(&a) - want).abs() <= 1e-9 * scale,
-        "{} vs {want}",
-        last_tip(&a)
-    );
+    assert_last_tip_matches_direct(&v, &a, 1.0);
 }
 
 #[test]
