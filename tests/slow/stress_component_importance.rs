@@ -139,6 +139,19 @@ fn rejects_at(r: ComponentImportanceRequest, pointer: &str) -> CalcFailure {
     e
 }
 
+/// The failure names every one of `pointers` among its field issues.
+#[track_caller]
+fn rejects_at_all(r: ComponentImportanceRequest, pointers: &[&str]) -> CalcFailure {
+    let e = err(r);
+    for p in pointers {
+        assert!(
+            e.errors.iter().any(|i| i.pointer == *p),
+            "{p} missing in {e}"
+        );
+    }
+    e
+}
+
 fn has_warning(resp: &ComponentImportanceResponse, code: &str) -> bool {
     resp.warnings.iter().any(|w| w.code == code)
 }
@@ -251,19 +264,16 @@ fn rejects_reliability_and_time_errors() {
         eta_h: 1000.0,
         beta: f64::NAN,
     });
-    let e = err(r);
-    for p in [
-        "/components/0/weibull/eta_h",
-        "/components/1/weibull/beta",
-        "/components/2/weibull/beta",
-        "/components/3/weibull/eta_h",
-        "/components/4/weibull/beta",
-    ] {
-        assert!(
-            e.errors.iter().any(|i| i.pointer == p),
-            "{p} missing in {e}"
-        );
-    }
+    let e = rejects_at_all(
+        r,
+        &[
+            "/components/0/weibull/eta_h",
+            "/components/1/weibull/beta",
+            "/components/2/weibull/beta",
+            "/components/3/weibull/eta_h",
+            "/components/4/weibull/beta",
+        ],
+    );
     // Every issue is collected at once.
     assert_eq!(e.errors.len(), 5, "{e}");
 
@@ -287,16 +297,12 @@ fn rejects_reliability_and_time_errors() {
         alpha: 1.5,
         impact: -1.0,
     }]);
-    let e = err(r);
-    assert!(
-        e.errors
-            .iter()
-            .any(|i| i.pointer == "/components/0/failure_modes/0/alpha")
-    );
-    assert!(
-        e.errors
-            .iter()
-            .any(|i| i.pointer == "/components/0/failure_modes/0/impact")
+    rejects_at_all(
+        r,
+        &[
+            "/components/0/failure_modes/0/alpha",
+            "/components/0/failure_modes/0/impact",
+        ],
     );
     let mut r = paper();
     r.components[0].failure_modes = Some(Vec::new());
@@ -318,16 +324,12 @@ fn rejects_reliability_and_time_errors() {
     let mut r = paper();
     r.components[0].efficiency_override = Some(-1.0);
     r.components[1].level_override = Some(0);
-    let e = err(r);
-    assert!(
-        e.errors
-            .iter()
-            .any(|i| i.pointer == "/components/0/efficiency_override")
-    );
-    assert!(
-        e.errors
-            .iter()
-            .any(|i| i.pointer == "/components/1/level_override")
+    rejects_at_all(
+        r,
+        &[
+            "/components/0/efficiency_override",
+            "/components/1/level_override",
+        ],
     );
 }
 
@@ -337,17 +339,14 @@ fn rejects_override_errors() {
     r.overrides[0].f.insert("S".into(), 1.2);
     r.overrides[0].f.insert("a/b".into(), 0.1);
     r.overrides[1].ri.insert("NC".into(), -1e-6);
-    let e = err(r);
-    for p in [
-        "/overrides/0/F/S",
-        "/overrides/0/F/a~1b",
-        "/overrides/1/RI/NC",
-    ] {
-        assert!(
-            e.errors.iter().any(|i| i.pointer == p),
-            "{p} missing in {e}"
-        );
-    }
+    rejects_at_all(
+        r,
+        &[
+            "/overrides/0/F/S",
+            "/overrides/0/F/a~1b",
+            "/overrides/1/RI/NC",
+        ],
+    );
     let mut r = paper();
     r.overrides[1].time_h = 1999.0;
     rejects_at(r, "/overrides/1/time_h");
@@ -373,9 +372,7 @@ fn rejects_option_errors() {
     let mut r = paper();
     r.options.q_in = 1.2;
     r.options.o_out = -0.2;
-    let e = err(r);
-    assert!(e.errors.iter().any(|i| i.pointer == "/options/q_in"));
-    assert!(e.errors.iter().any(|i| i.pointer == "/options/o_out"));
+    rejects_at_all(r, &["/options/q_in", "/options/o_out"]);
     let mut r = paper();
     r.options.constant_weights = ConstantWeights::Fixed(vec![0.6, 0.5]);
     rejects_at(r, "/options/constant_weights");
