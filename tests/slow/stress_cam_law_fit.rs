@@ -66,6 +66,14 @@ fn run(v: &Value, budget: &Budget) -> Result<FitCamLawResponse, CalcFailure> {
     out
 }
 
+/// Largest absolute difference between fitted and true coefficients (pairwise).
+fn coefficient_error(got: &[f64], want: &[f64]) -> f64 {
+    got.iter()
+        .zip(want)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+}
+
 fn law_data(c: &[f64; 7], bc: &BoundaryConditions, q: Quantity, xs: &[f64]) -> Option<Vec<f64>> {
     let law = SevenSegmentLaw::try_new(c, bc).ok()?;
     let mut y = vec![0.0; xs.len()];
@@ -181,12 +189,7 @@ fn sample_counts_from_8_to_200000() {
         }
         let r = run(&v, &Budget::unlimited()).expect("valid request");
         if n >= 50 && (n < 200_000 || heavy()) {
-            let err = r
-                .coefficients
-                .iter()
-                .zip(&c)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
+            let err = coefficient_error(&r.coefficients, &c);
             assert!(err < 1e-8, "N = {n}: {err}");
         }
         if n == 200_000 && !heavy() {
@@ -233,12 +236,7 @@ fn non_uniform_abscissae() {
         xs.dedup();
         let y = law_data(&c, &bc, Quantity::V, &xs).expect("law");
         let r = run(&request(&xs, "velocity", &y, &bc), &Budget::unlimited()).expect("fit");
-        let err = r
-            .coefficients
-            .iter()
-            .zip(&c)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let err = coefficient_error(&r.coefficients, &c);
         let y_norm = y.iter().map(|v| v * v).sum::<f64>().sqrt();
         println!("n = {n}: err {err:.2e}, EN {:.2e}", r.objective.final_value);
         // Every case matches its samples; with 12 clustered samples several laws do (the
@@ -434,11 +432,6 @@ fn early_snap_trap_regression_random_law_with_end_rates() {
     let mut v = request(&xs, "velocity", &y, &bc);
     v["optimizer"] = json!({});
     let r = run(&v, &Budget::unlimited()).expect("fit");
-    let err = r
-        .coefficients
-        .iter()
-        .zip(&truth)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
+    let err = coefficient_error(&r.coefficients, &truth);
     assert!(err < 1e-7, "{err:.3e}");
 }
