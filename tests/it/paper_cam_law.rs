@@ -59,26 +59,8 @@ fn table1_peaks_and_knots() {
     let knot_t = [
         0.0, 0.064516, 0.193548, 0.387097, 0.483871, 0.741935, 0.967742, 1.0,
     ];
-    let knot_s = [
-        0.0,
-        0.0183293714,
-        0.1029953061,
-        0.3409300267,
-        0.4772699257,
-        0.8062166995,
-        0.9836654137,
-        1.0,
-    ];
-    let knot_v = [
-        0.2,
-        0.3974939772,
-        0.9148280105,
-        1.4088456222,
-        1.4088456222,
-        1.0395991318,
-        0.5320894799,
-        0.5,
-    ];
+    let knot_s = cam_table1::TABLE1_KNOT_S;
+    let knot_v = cam_table1::TABLE1_KNOT_V;
     for (k, knot) in law.knots().iter().enumerate() {
         close(
             &format!("knot t_{k} (printed to 6 digits)"),

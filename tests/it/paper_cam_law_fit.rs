@@ -204,26 +204,8 @@ fn golden_values_table1_law() {
     let law = SevenSegmentLaw::try_new(&TABLE1_C, &TABLE1_BC).expect("law");
     assert!((law.a1() - 4.0093387580).abs() < 1e-9);
     assert!((law.a2() + 2.2475427443).abs() < 1e-9);
-    let ks = [
-        0.0,
-        0.0183293714,
-        0.1029953061,
-        0.3409300267,
-        0.4772699257,
-        0.8062166995,
-        0.9836654137,
-        1.0,
-    ];
-    let kv = [
-        0.2,
-        0.3974939772,
-        0.9148280105,
-        1.4088456222,
-        1.4088456222,
-        1.0395991318,
-        0.5320894799,
-        0.5,
-    ];
+    let ks = cam_table1::TABLE1_KNOT_S;
+    let kv = cam_table1::TABLE1_KNOT_V;
     for (k, knot) in law.knots().iter().enumerate() {
         assert!((knot.s - ks[k]).abs() < 1e-9, "s knot {k}");
         assert!((knot.v - kv[k]).abs() < 1e-9, "v knot {k}");

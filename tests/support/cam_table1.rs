@@ -18,3 +18,35 @@ pub const TABLE1_BC: BoundaryConditions = BoundaryConditions {
 
 /// Table-1 coefficient vector before normalisation (ĉ = c / 31).
 pub const TABLE1_C: [f64; 7] = [2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0];
+
+/// Table-1 knot displacements s(t_k), k = 0..7 (§5.2, 10 decimals).
+#[allow(
+    dead_code,
+    reason = "the paper tests check the knots; the benches do not"
+)]
+pub const TABLE1_KNOT_S: [f64; 8] = [
+    0.0,
+    0.0183293714,
+    0.1029953061,
+    0.3409300267,
+    0.4772699257,
+    0.8062166995,
+    0.9836654137,
+    1.0,
+];
+
+/// Table-1 knot velocities v(t_k), k = 0..7 (§5.2, 10 decimals).
+#[allow(
+    dead_code,
+    reason = "the paper tests check the knots; the benches do not"
+)]
+pub const TABLE1_KNOT_V: [f64; 8] = [
+    0.2,
+    0.3974939772,
+    0.9148280105,
+    1.4088456222,
+    1.4088456222,
+    1.0395991318,
+    0.5320894799,
+    0.5,
+];
