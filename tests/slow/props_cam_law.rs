@@ -5,25 +5,12 @@
 // Reference expressions are written as in the spec.
 #![allow(clippy::suboptimal_flops)]
 
+use crate::support::cam_law_strategies::coefficients;
 use mechcalc::calc::cam_law::catalogue::{NamedLaw, TABLE3};
 use mechcalc::calc::cam_law::law::{
     BoundaryConditions, Quantity, SevenSegmentLaw, accelerations_centroid, accelerations_cramer,
 };
 use proptest::prelude::*;
-
-/// Seven coefficients, each exactly 0 with probability ~1/3, else in [0.02, 1]; both pulses
-/// non-empty (an empty pulse is repaired by giving its middle segment a length).
-fn coefficients() -> impl Strategy<Value = [f64; 7]> {
-    proptest::array::uniform7(prop_oneof![1 => Just(0.0), 2 => 0.02f64..1.0]).prop_map(|mut c| {
-        if c[0] + c[1] + c[2] <= 0.0 {
-            c[1] = 0.3;
-        }
-        if c[4] + c[5] + c[6] <= 0.0 {
-            c[5] = 0.3;
-        }
-        c
-    })
-}
 
 /// Boundary conditions with log-uniform Δt in [1e-2, 1e2], Δs of either sign (or 0) up to 1e2,
 /// end rates up to a few times the natural scales Δs/Δt, Δs/Δt².

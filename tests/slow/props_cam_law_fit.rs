@@ -6,6 +6,7 @@
 // Reference expressions are written as in the spec.
 #![allow(clippy::suboptimal_flops)]
 
+use crate::support::cam_law_strategies::coefficients;
 use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
 use mechcalc::calc::cam_law_fit::compute::LawModel;
 use mechcalc::calc::cam_law_fit::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
@@ -14,20 +15,6 @@ use mechcalc::numerics::Budget;
 use mechcalc::numerics::grid;
 use proptest::prelude::*;
 use serde_json::json;
-
-/// Seven coefficients, each exactly 0 with probability ~1/3, else in [0.02, 1]; both pulses
-/// non-empty.
-fn coefficients() -> impl Strategy<Value = [f64; 7]> {
-    proptest::array::uniform7(prop_oneof![1 => Just(0.0), 2 => 0.02f64..1.0]).prop_map(|mut c| {
-        if c[0] + c[1] + c[2] <= 0.0 {
-            c[1] = 0.3;
-        }
-        if c[4] + c[5] + c[6] <= 0.0 {
-            c[5] = 0.3;
-        }
-        c
-    })
-}
 
 /// Boundary conditions: log-uniform Δt in [1e-2, 1e2], Δs of either sign up to 1e2, end rates up
 /// to a few times the natural scales.

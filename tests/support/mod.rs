@@ -8,6 +8,7 @@
 
 pub mod bezier_ode;
 pub mod bus_demo_motor;
+pub mod cam_law_strategies;
 pub mod cam_table1;
 pub mod component_importance;
 pub mod finite;
