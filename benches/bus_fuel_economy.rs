@@ -22,20 +22,11 @@ use serde_json::{Value, json};
 
 #[path = "../tests/support/bus_demo_motor.rs"]
 mod bus_demo_motor;
-use bus_demo_motor::demo_efficiency_map;
+use bus_demo_motor::{demo_efficiency_map, demo_ipmsm_json as demo};
 
 const CYCLES: [&str; 3] = ["manhattan", "hwfet", "hdudds"];
 /// Repetitions per accuracy-table cell (median and worst are reported).
 const REPS: usize = 5;
-
-fn demo(id: &str, h: f64) -> Value {
-    json!({"id": id, "model": "ipmsm", "pole_pairs": 4, "back_emf": {"v_peak_phase": 83.3, "at_rpm": 1000},
-           "ld_h": 0.00035, "lq_h": 0.00055, "r_phase_20c_ohm": 0.006, "winding_temp_c": 100, "i_max_arms": 500,
-           "v_dc": 360, "n_max_rpm": 5200, "t_cap_nm": 800, "p_cap_w": 130000,
-           "ac_factor": {"model": "dowell", "conductor_height_m": h, "layers": 6, "porosity": 0.9,
-                         "stack_length_m": 0.083, "end_length_m": 0.05},
-           "iron": {"k_h": 3.0, "k_e": 0.03}})
-}
 
 fn request(v: Value) -> BusFuelEconomyRequest {
     serde_json::from_value(v).expect("bench request decodes")

@@ -9,17 +9,10 @@ use mechcalc::AppState;
 use mechcalc::config::ServiceConfig;
 use serde_json::{Value, json};
 
+use crate::support::bus_demo_motor::demo_ipmsm_json as demo;
+
 const PATH: &str = "/v1/bus-fuel-economy";
 const MAP_PATH: &str = "/v1/bus-fuel-economy/motor-map";
-
-fn demo(id: &str, h: f64) -> Value {
-    json!({"id": id, "model": "ipmsm", "pole_pairs": 4, "back_emf": {"v_peak_phase": 83.3, "at_rpm": 1000},
-           "ld_h": 0.00035, "lq_h": 0.00055, "r_phase_20c_ohm": 0.006, "winding_temp_c": 100, "i_max_arms": 500,
-           "v_dc": 360, "n_max_rpm": 5200, "t_cap_nm": 800, "p_cap_w": 130000,
-           "ac_factor": {"model": "dowell", "conductor_height_m": h, "layers": 6, "porosity": 0.9,
-                         "stack_length_m": 0.083, "end_length_m": 0.05},
-           "iron": {"k_h": 3.0, "k_e": 0.03}})
-}
 
 fn example() -> Value {
     json!({"cycles": ["manhattan", "hwfet", "hdudds"], "motors": [demo("initial", 0.0035), demo("low_kac", 0.0032)]})

@@ -11,7 +11,7 @@ use mechcalc::numerics::Budget;
 use serde_json::{Value, json};
 
 use crate::support::bus_demo_motor;
-use bus_demo_motor::{demo_efficiency_map, demo_ipmsm};
+use bus_demo_motor::{demo_efficiency_map, demo_ipmsm, demo_ipmsm_json};
 
 const CYCLES: [&str; 3] = ["manhattan", "hwfet", "hdudds"];
 
@@ -23,16 +23,6 @@ fn run_json(v: Value) -> BusFuelEconomyResponse {
 /// Constant motor η_M = 0.93 with the 800 N·m / 130 kW / 5200 rpm envelope (V3, V4, V9).
 fn constant_motor() -> Value {
     json!({"id": "c93", "model": "constant", "efficiency": 0.93, "t_peak_nm": 800, "p_peak_w": 130000, "n_max_rpm": 5200})
-}
-
-/// The spec's demo IPMSM (V5).
-fn demo_ipmsm_json(id: &str, h: f64) -> Value {
-    json!({"id": id, "model": "ipmsm", "pole_pairs": 4, "back_emf": {"v_peak_phase": 83.3, "at_rpm": 1000},
-           "ld_h": 0.00035, "lq_h": 0.00055, "r_phase_20c_ohm": 0.006, "winding_temp_c": 100, "i_max_arms": 500,
-           "v_dc": 360, "n_max_rpm": 5200, "t_cap_nm": 800, "p_cap_w": 130000,
-           "ac_factor": {"model": "dowell", "conductor_height_m": h, "layers": 6, "porosity": 0.9,
-                         "stack_length_m": 0.083, "end_length_m": 0.05},
-           "iron": {"k_h": 3.0, "k_e": 0.03}})
 }
 
 /// V1 (§4 table): cycle facts, exact to 1e-9.

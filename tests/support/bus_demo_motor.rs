@@ -1,5 +1,5 @@
 //! The spec's demo IPMSM (bus_fuel_economy.md V5) as a model object, and an efficiency map
-//! tabulated from it. Shared by tests/it/paper_bus_fuel_economy.rs and benches/bus_fuel_economy.rs
+//! tabulated from it. Shared by tests/it/{paper,http}_bus_fuel_economy.rs, benches/bus_fuel_economy.rs
 //! and tests/slow/props_bus_fuel_economy.rs (each includes this file with `#[path]`), so they check and
 //! time the same motor.
 
@@ -8,6 +8,17 @@ use mechcalc::calc::bus_fuel_economy::ipmsm::{
     Ipmsm, IpmsmParams, psi_from_back_emf, rpm_to_rad_s,
 };
 use serde_json::{Value, json};
+
+/// The demo IPMSM (V5) as a request's motor object: `id`, and the Dowell AC factor's conductor
+/// height `h` (m).
+pub fn demo_ipmsm_json(id: &str, h: f64) -> Value {
+    json!({"id": id, "model": "ipmsm", "pole_pairs": 4, "back_emf": {"v_peak_phase": 83.3, "at_rpm": 1000},
+           "ld_h": 0.00035, "lq_h": 0.00055, "r_phase_20c_ohm": 0.006, "winding_temp_c": 100, "i_max_arms": 500,
+           "v_dc": 360, "n_max_rpm": 5200, "t_cap_nm": 800, "p_cap_w": 130000,
+           "ac_factor": {"model": "dowell", "conductor_height_m": h, "layers": 6, "porosity": 0.9,
+                         "stack_length_m": 0.083, "end_length_m": 0.05},
+           "iron": {"k_h": 3.0, "k_e": 0.03}})
+}
 
 /// The demo IPMSM (V5); `caps = false` drops the 800 N·m / 130 kW caps (raw electrical envelope).
 pub fn demo_ipmsm(caps: bool) -> Ipmsm {
