@@ -11,12 +11,12 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 
-fn api_dir() -> PathBuf {
+pub fn api_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("api")
 }
 
-/// The `api/` examples as (file, endpoint, request body).
-pub fn examples() -> Vec<(String, String, Value)> {
+/// The `api/` examples listed in `api/examples.json` as (file, endpoint).
+pub fn example_files() -> Vec<(String, String)> {
     let index: Value = serde_json::from_str(
         &std::fs::read_to_string(api_dir().join("examples.json")).expect("api/examples.json"),
     )
@@ -28,6 +28,16 @@ pub fn examples() -> Vec<(String, String, Value)> {
         .map(|e| {
             let file = e["file"].as_str().expect("file").to_owned();
             let endpoint = e["endpoint"].as_str().expect("endpoint").to_owned();
+            (file, endpoint)
+        })
+        .collect()
+}
+
+/// The `api/` examples as (file, endpoint, request body).
+pub fn examples() -> Vec<(String, String, Value)> {
+    example_files()
+        .into_iter()
+        .map(|(file, endpoint)| {
             let body: Value = serde_json::from_str(
                 &std::fs::read_to_string(api_dir().join(&file)).expect("example readable"),
             )

@@ -6,28 +6,15 @@
 
 use crate::common;
 
-use std::path::PathBuf;
-
+use crate::contract::{api_dir, example_files};
 use common::{post_json, send};
 use serde_json::Value;
 
-fn api_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("api")
-}
-
 /// `(endpoint, example body)` for every example in `api/examples.json`.
 fn examples() -> Vec<(String, String)> {
-    let index: Value = serde_json::from_str(
-        &std::fs::read_to_string(api_dir().join("examples.json")).expect("api/examples.json"),
-    )
-    .expect("api/examples.json is JSON");
-    index["examples"]
-        .as_array()
-        .expect("examples array")
-        .iter()
-        .map(|e| {
-            let file = e["file"].as_str().expect("file");
-            let endpoint = e["endpoint"].as_str().expect("endpoint").to_owned();
+    example_files()
+        .into_iter()
+        .map(|(file, endpoint)| {
             let body = std::fs::read_to_string(api_dir().join(file)).expect("example file");
             (endpoint, body)
         })
