@@ -59,6 +59,23 @@ impl Reply {
         p
     }
 
+    /// A 422 invalid-input problem whose `errors[]` name (at least) every one of `want`; the
+    /// problem body.
+    #[track_caller]
+    pub fn invalid_input_at(&self, want: &[&str]) -> Value {
+        let p = self.problem(422);
+        assert_eq!(p["type"], "/problems/invalid-input");
+        assert_eq!(p["code"], "INVALID_INPUT");
+        let ptrs = self.pointers();
+        for w in want {
+            assert!(
+                ptrs.iter().any(|q| q == w),
+                "{w} missing from {ptrs:?}: {p}"
+            );
+        }
+        p
+    }
+
     /// The JSON pointers of a problem's `errors[]`.
     pub fn pointers(&self) -> Vec<String> {
         self.json()["errors"]
