@@ -59,6 +59,13 @@ impl Reply {
         p
     }
 
+    /// A 422 problem whose `errors[]` name exactly `want`, in order.
+    #[track_caller]
+    pub fn assert_422_at(&self, want: &[&str]) {
+        self.problem(422);
+        assert_eq!(self.pointers(), want);
+    }
+
     /// A 422 invalid-input problem whose `errors[]` name (at least) every one of `want`; the
     /// problem body.
     #[track_caller]
