@@ -263,12 +263,7 @@ async fn non_oscillating_joint_omits_amplitudes_and_warns() {
             "{block}.{key} present at ξ = 1.5"
         );
     }
-    let codes: Vec<&str> = b["warnings"]
-        .as_array()
-        .expect("warnings")
-        .iter()
-        .filter_map(|w| w["code"].as_str())
-        .collect();
+    let codes = common::warning_codes(&b);
     assert!(codes.contains(&"NOT_OSCILLATORY"), "{codes:?}");
 }
 

@@ -247,12 +247,7 @@ async fn warnings_name_the_hazard() {
     )
     .await
     .json();
-    let codes: Vec<&str> = b["warnings"]
-        .as_array()
-        .expect("warnings")
-        .iter()
-        .filter_map(|w| w["code"].as_str())
-        .collect();
+    let codes = common::warning_codes(&b);
     assert!(codes.contains(&"NEAR_PERPENDICULAR_SHAFTS"), "{codes:?}");
     // β close to α − 90°: D(0) = cos(α−β)·cos 2α nearly 0, valid but ill-conditioned.
     let b = post_json(

@@ -96,6 +96,16 @@ impl Reply {
     }
 }
 
+/// The `code`s of an answer's `warnings[]`, in order.
+pub fn warning_codes(answer: &Value) -> Vec<&str> {
+    answer["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(|w| w["code"].as_str())
+        .collect()
+}
+
 /// The default configuration used by tests.
 pub fn config() -> ServiceConfig {
     ServiceConfig {
