@@ -6,12 +6,30 @@ use crate::common;
 use crate::contract::examples;
 
 use std::io::Write;
-use std::process::{Command, Stdio};
+use std::process::{Command, Output, Stdio};
 
 use serde_json::Value;
 
 fn mechcalc() -> Command {
     Command::new(env!("CARGO_BIN_EXE_mechcalc"))
+}
+
+/// Runs the CLI with `args`, writes `input` to its stdin and waits for it to exit.
+fn run_with_stdin(args: &[&str], input: &[u8]) -> Output {
+    let mut child = mechcalc()
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(input)
+        .expect("write");
+    child.wait_with_output().expect("exits")
 }
 
 /// Wall-clock measurements differ between two runs of the same request.
@@ -80,20 +98,10 @@ async fn run_gives_the_http_answer_for_every_example() {
 
 #[test]
 fn a_refused_request_is_problem_details_on_stderr_and_exit_2() {
-    let mut child = mechcalc()
-        .args(["run", "cam-law/evaluate", "-"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("runs");
-    child
-        .stdin
-        .take()
-        .expect("stdin")
-        .write_all(br#"{"coefficients": [1, 2]}"#)
-        .expect("write");
-    let out = child.wait_with_output().expect("exits");
+    let out = run_with_stdin(
+        &["run", "cam-law/evaluate", "-"],
+        br#"{"coefficients": [1, 2]}"#,
+    );
     assert_eq!(out.status.code(), Some(2));
     assert!(out.stdout.is_empty());
     let p: Value = serde_json::from_slice(&out.stderr).expect("problem JSON on stderr");
@@ -133,20 +141,10 @@ fn batch_is_ndjson_in_input_order() {
         input.push_str(&line);
         input.push('\n');
     }
-    let mut child = mechcalc()
-        .args(["run", "/v1/cam-law/evaluate", "--batch"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("runs");
-    child
-        .stdin
-        .take()
-        .expect("stdin")
-        .write_all(input.as_bytes())
-        .expect("write");
-    let out = child.wait_with_output().expect("exits");
+    let out = run_with_stdin(
+        &["run", "/v1/cam-law/evaluate", "--batch"],
+        input.as_bytes(),
+    );
     assert_eq!(out.status.code(), Some(2), "one line is refused");
     let lines: Vec<Value> = String::from_utf8_lossy(&out.stdout)
         .lines()
