@@ -49,6 +49,19 @@ const EVALS: [(&str, &str, (f64, f64)); 5] = [
     ("loss map 50×10", "loss_map", (50.0, 10.0)),
 ];
 
+/// `REPS` timed runs of `req`: the sorted wall times (ms) and the fuel economy.
+fn timed_fe(req: &BusFuelEconomyRequest) -> (Vec<f64>, f64) {
+    let mut times = Vec::with_capacity(REPS);
+    let mut value = 0.0;
+    for _ in 0..REPS {
+        let t0 = Instant::now();
+        value = fe(black_box(req));
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    (times, value)
+}
+
 fn knob_request(cycle: &str, eval: &str, grid: (f64, f64), k: u32) -> BusFuelEconomyRequest {
     request(json!({
         "cycles": [cycle], "motors": [demo("demo", 0.0035)],
@@ -71,14 +84,7 @@ fn accuracy_table() {
         for (label, eval, grid) in EVALS {
             for k in [1u32, 2, 4, 8, 16] {
                 let req = knob_request(cycle, eval, grid, k);
-                let mut times = Vec::with_capacity(REPS);
-                let mut value = 0.0;
-                for _ in 0..REPS {
-                    let t0 = Instant::now();
-                    value = fe(black_box(&req));
-                    times.push(t0.elapsed().as_secs_f64() * 1e3);
-                }
-                times.sort_by(f64::total_cmp);
+                let (times, value) = timed_fe(&req);
                 let default = if eval == "loss_map" && grid == (250.0, 50.0) && k == 1 {
                     " **(default)**"
                 } else {
@@ -111,14 +117,7 @@ fn efficiency_map_table() {
             let direct = fe(&request(
                 json!({"cycles": [cycle], "motors": [demo("d", 0.0035)], "options": {"motor_eval": "direct"}}),
             ));
-            let mut times = Vec::with_capacity(REPS);
-            let mut value = 0.0;
-            for _ in 0..REPS {
-                let t0 = Instant::now();
-                value = fe(black_box(&req));
-                times.push(t0.elapsed().as_secs_f64() * 1e3);
-            }
-            times.sort_by(f64::total_cmp);
+            let (times, value) = timed_fe(&req);
             println!(
                 "| {} × {} | {cycle} | {:.2} | {value:.6} | {:+.1e} |",
                 grid.0,
