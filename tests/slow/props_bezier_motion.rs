@@ -3,6 +3,7 @@
 //! regime (ξ across 1 included), and the optimum's residual energy never above the reference
 //! law's. Case counts honour PROPTEST_CASES.
 
+use mechcalc::calc::bezier_motion::wire::{DAMPING, MOTION_TIME, STIFFNESS};
 use mechcalc::calc::bezier_motion::{BezierMotionRequest, run};
 use mechcalc::numerics::Budget;
 use proptest::prelude::*;
@@ -277,6 +278,11 @@ proptest! {
         let back = [x2[0], x2[1] / s];
         let d = root_energy(&c.plant, [back[0] - x[0], back[1] - x[1]]);
         prop_assert!(d <= 1e-12 * c.scale(&law.a), "x {x:?} vs scaled {back:?}");
+        // The requests below need the scaled drive inside the service's ranges (s² k can pass
+        // the stiffness bound); outside them only the identity above is checked.
+        if !(STIFFNESS.contains(p2.k) && DAMPING.contains(p2.c) && MOTION_TIME.contains(t2)) {
+            return Ok(());
+        }
         let mut a = c.json("optimize");
         let mut b = a.clone();
         b["system"]["k_Nm_per_rad"] = json!(p2.k);
@@ -385,13 +391,14 @@ proptest! {
         let sc = hq.norm() * gs.norm() + f.norm() + rows.r.norm() * mu.norm();
         prop_assert!(kkt <= 1e-9 * sc, "KKT residual {kkt:e} on scale {sc:e}");
         if obj == Objective::MinDeviation {
-            // Component of γ* − γ_ref in the null space of R: (I − R⁺R) d.
+            // Component of γ* − γ_ref in the null space of R: (I − Q Qᵀ) d.
+            // The projector onto rowspace(R) is Q Qᵀ with Q from a Householder QR of Rᵀ: Q is
+            // orthogonal to round-off, so the projector carries only the ε·cond(R) of the
+            // subspace itself. (I − R⁺R through nalgebra's SVD is not: for a full-rank 2×2 R of
+            // cond 1.8e6 it is 2.4e-6 from zero, ≈ 6000·ε·cond(R).)
             let d = &gs - nalgebra::DVector::from_column_slice(&c.gamma);
-            let svd = rows.r.clone().svd(true, true);
-            let eps = 1e-10 * svd.singular_values.max();
-            let pinv = svd.pseudo_inverse(eps).expect("pinv");
-            let null_part = &d - &pinv * (&rows.r * &d);
-            // The projector I − R⁺R itself carries ε·cond(R) of round-off.
+            let q = rows.r.transpose().qr().q();
+            let null_part = &d - &q * (q.transpose() * &d);
             let sv = rows.r.singular_values();
             let cond_r = if sv.len() > 1 && sv[1] > 0.0 { sv[0] / sv[1] } else { 1.0 };
             let size = d.norm() + c.phi.abs() + c.gamma.iter().map(|g| g * g).sum::<f64>().sqrt();
