@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use common::{post_json, send_to};
+use common::{post_json, post_json_to};
 use mechcalc::AppState;
 use mechcalc::config::ServiceConfig;
 use serde_json::{Value, json};
@@ -193,14 +193,7 @@ async fn exhausted_time_budget_is_422() {
     };
     let body = json!({"cycles": ["manhattan", "hwfet", "hdudds"], "motors": [demo("a", 0.0035), demo("b", 0.003)],
                       "options": {"motor_eval": "direct", "substeps": 32}});
-    let r = send_to(
-        AppState::new(config),
-        "POST",
-        PATH,
-        Some("application/json"),
-        serde_json::to_vec(&body).expect("json"),
-    )
-    .await;
+    let r = post_json_to(AppState::new(config), PATH, &body).await;
     let p = r.problem(422);
     assert_eq!(p["code"], "DEADLINE_EXCEEDED");
 }

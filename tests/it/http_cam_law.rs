@@ -5,7 +5,7 @@ use crate::common;
 
 use std::time::Duration;
 
-use common::{post_json, send_to};
+use common::{post_json, post_json_to};
 use mechcalc::AppState;
 use mechcalc::config::ServiceConfig;
 use serde_json::{Value, json};
@@ -151,14 +151,7 @@ async fn oversized_body_is_413() {
     };
     let mut b = table1();
     b["abscissa"] = json!({"values": (0..2000).map(|i| f64::from(i) / 1999.0).collect::<Vec<_>>()});
-    let r = send_to(
-        AppState::new(config),
-        "POST",
-        PATH,
-        Some("application/json"),
-        serde_json::to_vec(&b).expect("json"),
-    )
-    .await;
+    let r = post_json_to(AppState::new(config), PATH, &b).await;
     assert_eq!(r.problem(413)["type"], "/problems/body-too-large");
 }
 
@@ -175,14 +168,7 @@ async fn saturated_pool_is_503_with_retry_after() {
         .acquire(Duration::from_millis(10))
         .await
         .expect("the only slot is free");
-    let r = send_to(
-        state,
-        "POST",
-        PATH,
-        Some("application/json"),
-        serde_json::to_vec(&table1()).expect("json"),
-    )
-    .await;
+    let r = post_json_to(state, PATH, &table1()).await;
     let p = r.problem(503);
     assert_eq!(p["type"], "/problems/overloaded");
     assert!(r.headers.get("retry-after").is_some());

@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use common::{post_json, send_to};
+use common::{post_json, post_json_to};
 use mechcalc::AppState;
 use mechcalc::config::ServiceConfig;
 use serde_json::{Value, json};
@@ -216,14 +216,7 @@ async fn exhausted_server_budget_is_too_large() {
     };
     let mut b = complete_digraph(9);
     b["options"] = json!({"max_simple_paths": 1e8});
-    let r = send_to(
-        AppState::new(config),
-        "POST",
-        PATH,
-        Some("application/json"),
-        serde_json::to_vec(&b).expect("json"),
-    )
-    .await;
+    let r = post_json_to(AppState::new(config), PATH, &b).await;
     let p = r.problem(422);
     assert_eq!(p["type"], "/problems/too-large");
     assert_eq!(p["code"], "BUDGET_EXHAUSTED");

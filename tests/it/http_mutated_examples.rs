@@ -103,14 +103,7 @@ async fn mutated_examples_never_give_500() {
         for pointer in leaves.iter().step_by(stride) {
             for body in mutations(&original, pointer) {
                 sent += 1;
-                let r = common::send_to(
-                    AppState::new(config.clone()),
-                    "POST",
-                    endpoint,
-                    Some("application/json"),
-                    serde_json::to_vec(&body).expect("json"),
-                )
-                .await;
+                let r = common::post_json_to(AppState::new(config.clone()), endpoint, &body).await;
                 let status = r.status.as_u16();
                 let ok = match status {
                     200 => r.content_type() == "application/json" && all_numbers_finite(&r.json()),

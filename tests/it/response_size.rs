@@ -92,21 +92,10 @@ fn limited(max_response_bytes: usize) -> AppState {
     })
 }
 
-async fn post_to(state: AppState, path: &str, body: &Value) -> common::Reply {
-    common::send_to(
-        state,
-        "POST",
-        path,
-        Some("application/json"),
-        serde_json::to_vec(body).expect("json"),
-    )
-    .await
-}
-
 #[tokio::test]
 async fn the_service_limit_reaches_the_modules_and_names_the_option() {
     let started = std::time::Instant::now();
-    let r = post_to(limited(50_000), "/v1/irefc-stress", &big_sweep()).await;
+    let r = common::post_json_to(limited(50_000), "/v1/irefc-stress", &big_sweep()).await;
     let p = r.problem(422);
     assert_eq!(p["type"], "/problems/too-large");
     assert_eq!(p["code"], "RESPONSE_TOO_LARGE");
@@ -125,7 +114,7 @@ async fn the_service_limit_reaches_the_modules_and_names_the_option() {
                      "constraints": {"t_a": 0.0, "t_b": 1.0, "s_a": 0.0, "s_b": 1.0},
                      "abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": 200000}},
                      "quantities": ["s", "v", "a", "j"]});
-    let r = post_to(limited(1_000_000), "/v1/cam-law/evaluate", &cam).await;
+    let r = common::post_json_to(limited(1_000_000), "/v1/cam-law/evaluate", &cam).await;
     r.problem(422);
     assert_eq!(r.pointers(), vec!["/abscissa"]);
 }
@@ -137,7 +126,7 @@ async fn the_estimate_bounds_every_example_answer() {
         if !ESTIMATED.contains(&endpoint.as_str()) {
             continue;
         }
-        let r = post_to(AppState::new(common::config()), &endpoint, &body).await;
+        let r = common::post_json_to(AppState::new(common::config()), &endpoint, &body).await;
         if r.status != 200 {
             continue;
         }
@@ -145,7 +134,7 @@ async fn the_estimate_bounds_every_example_answer() {
         // One byte below the real size: an estimate ≥ the real size refuses before computing
         // (its message says so); an estimate below it would let the calculation run into the
         // service's check of the encoded answer ("the answer is N bytes").
-        let r = post_to(limited(actual - 1), &endpoint, &body).await;
+        let r = common::post_json_to(limited(actual - 1), &endpoint, &body).await;
         let p = r.problem(422);
         let detail = p["detail"].as_str().unwrap_or_default();
         assert!(

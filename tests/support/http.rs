@@ -150,15 +150,21 @@ pub async fn send(method: &str, path: &str, content_type: Option<&str>, body: Ve
     send_to(AppState::new(config()), method, path, content_type, body).await
 }
 
-/// POST a JSON value.
-pub async fn post_json(path: &str, body: &Value) -> Reply {
-    send(
+/// POST a JSON value to a fresh app built from `state`.
+pub async fn post_json_to(state: AppState, path: &str, body: &Value) -> Reply {
+    send_to(
+        state,
         "POST",
         path,
         Some("application/json"),
         serde_json::to_vec(body).expect("serializable"),
     )
     .await
+}
+
+/// POST a JSON value to a fresh app with the test configuration.
+pub async fn post_json(path: &str, body: &Value) -> Reply {
+    post_json_to(AppState::new(config()), path, body).await
 }
 
 /// GET a path.
