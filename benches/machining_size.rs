@@ -27,11 +27,11 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mechcalc::calc::machining_size::boost::{
-    BoostParams, Boosted, ExactIndex, HistIndex, Method, SplitIndex, TrainData, boost,
+    BoostParams, Boosted, Method, SplitIndex, TrainData, boost,
 };
 use mechcalc::calc::machining_size::data::{Matrix, all_rows, complement, metrics};
 use mechcalc::calc::machining_size::document::{DocLimits, read_xgboost};
-use mechcalc::calc::machining_size::model::{Model, ModelSource, Routing};
+use mechcalc::calc::machining_size::model::Model;
 use mechcalc::calc::machining_size::rng;
 use mechcalc::calc::machining_size::shap::{
     InterventionalTables, InterventionalWeights, PathBuffer, ShapForest,
@@ -164,18 +164,11 @@ fn big_set() -> Set {
 
 fn table2(n_estimators: usize, colsample: f64) -> BoostParams {
     BoostParams {
-        n_estimators,
-        max_depth: 6,
         learning_rate: 0.05,
         reg_lambda: 0.1,
         reg_alpha: 0.05,
-        gamma: 0.0,
-        min_child_weight: 1.0,
         colsample_bytree: colsample,
-        subsample: 1.0,
-        seed: 0,
-        base_score: None,
-        method: Method::Exact,
+        ..BoostParams::xgboost(n_estimators, 6)
     }
 }
 
@@ -183,12 +176,7 @@ fn table2(n_estimators: usize, colsample: f64) -> BoostParams {
 /// after its DMatrix exists.
 fn fit(x: &Matrix, y: &[f64], rows: &[u32], p: &BoostParams, threads: usize) -> Boosted {
     let features: Vec<usize> = (0..x.n_cols()).filter(|&f| !x.is_constant(f)).collect();
-    let index = match p.method {
-        Method::Exact => SplitIndex::Exact(ExactIndex::build(x, &features, threads)),
-        Method::Hist { max_bin } => {
-            SplitIndex::Hist(HistIndex::build(x, rows, &features, max_bin, threads))
-        }
-    };
+    let index = SplitIndex::build(p.method, x, rows, &features, threads);
     let data = TrainData {
         x,
         y,
@@ -202,17 +190,6 @@ fn fit(x: &Matrix, y: &[f64], rows: &[u32], p: &BoostParams, threads: usize) -> 
         &Budget::unlimited().with_threads(threads),
         threads,
     )
-}
-
-fn model_of(b: Boosted, d: usize) -> Model {
-    Model {
-        base_score: b.base_score,
-        n_features: d,
-        feature_names: Vec::new(),
-        routing: Routing::F64,
-        source: ModelSource::Native,
-        trees: b.trees,
-    }
 }
 
 fn reference() -> Option<Value> {
@@ -387,7 +364,7 @@ fn sweep_grid(paper: &Set, reference: Option<&Value>) {
                 if k == 0 {
                     effective = b.trees.iter().filter(|t| t.n_splits() > 0).count();
                 }
-                let m = model_of(b, paper.d);
+                let m = b.into_model(paper.d, Vec::new());
                 let pred: Vec<f64> = test
                     .iter()
                     .map(|&r| m.predict_prepared(&x.row(r as usize)))
@@ -446,7 +423,7 @@ fn sweep_shap(paper: &Set, reference: Option<&Value>) {
             reg_alpha: 0.0,
             ..table2(400, 1.0)
         };
-        let m = model_of(fit(&x, &paper.y, &all_rows(paper.n), &p, 2), paper.d);
+        let m = fit(&x, &paper.y, &all_rows(paper.n), &p, 2).into_model(paper.d, Vec::new());
         models.push((format!("ours 400 trees, depth {depth}, α 0"), m, ""));
     }
     for (label, m, key) in &models {
@@ -576,14 +553,9 @@ fn sweep_shap(paper: &Set, reference: Option<&Value>) {
 }
 
 fn sweeps(_: &mut Criterion) {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if !args.iter().any(|a| a == "--bench") {
+    let Some(filters) = support::sweep_filters("sweep") else {
         return;
-    }
-    let filters: Vec<&String> = args.iter().filter(|a| !a.starts_with('-')).collect();
-    if !filters.is_empty() && !filters.iter().any(|f| f.contains("sweep")) {
-        return;
-    }
+    };
     let paper = paper_set();
     paper.dump();
     let big = big_set();
@@ -622,7 +594,7 @@ fn bench_core(c: &mut Criterion) {
             b.iter(|| fit(&x, &paper.y, &rows, &p, 2));
         },
     );
-    let m = model_of(fit(&x, &paper.y, &rows, &table2(400, 1.0), 2), paper.d);
+    let m = fit(&x, &paper.y, &rows, &table2(400, 1.0), 2).into_model(paper.d, Vec::new());
     let row = x.row(3);
     let mut buf = PathBuffer::for_depth(m.max_depth());
     let forest = ShapForest::new(&m);

@@ -105,3 +105,23 @@ pub fn time_for<T>(target: Duration, max_runs: usize, mut f: impl FnMut() -> T) 
     let runs = ((target.as_secs_f64() / first) as usize).clamp(3, max_runs.max(3));
     time_runs(runs, f)
 }
+
+/// Median and worst of `reps` timings of `f` after one warm-up run, in µs.
+pub fn time_us(reps: usize, f: impl FnMut()) -> (f64, f64) {
+    let (t, ()) = time_runs(reps, f);
+    (t.median_us(), t.worst_us())
+}
+
+/// The name filters of a `cargo bench` run (its arguments that do not start with `-`), or `None`
+/// when the minutes-long accuracy-vs-cost sweeps are not to run: when the benches run as tests
+/// (no `--bench`), or when there are filters and none contains `word` (`cargo bench --bench
+/// <name> sweep` runs the sweeps alone).
+#[must_use]
+pub fn sweep_filters(word: &str) -> Option<Vec<String>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if !args.iter().any(|a| a == "--bench") {
+        return None;
+    }
+    let filters: Vec<String> = args.into_iter().filter(|a| !a.starts_with('-')).collect();
+    (filters.is_empty() || filters.iter().any(|f| f.contains(word))).then_some(filters)
+}

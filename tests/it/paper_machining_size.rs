@@ -11,31 +11,21 @@ use mechcalc::calc::machining_size::shap::{
 };
 
 use crate::support::machining_size::{
-    brute_interventional, brute_path_dependent, fixture, max_abs_diff, model_of, nums, paper_data,
-    rows, table2, train_on,
+    brute_interventional, brute_path_dependent, fixture, max_abs_diff, nums, paper_data, rows,
+    table2, train_on,
 };
 
 /// Spec §7.1: x = [1, 2, 3, 4], y = [1, 2, 3, 10], one feature, exact method.
 fn tiny(params: &BoostParams) -> Model {
     let x = Matrix::from_rows(vec![vec![1.0], vec![2.0], vec![3.0], vec![4.0]], 1);
     let y = [1.0, 2.0, 3.0, 10.0];
-    model_of(train_on(&x, &y, &all_rows(4), params, 1), 1)
+    train_on(&x, &y, &all_rows(4), params, 1).into_model(1, Vec::new())
 }
 
 fn t1() -> BoostParams {
     BoostParams {
-        n_estimators: 1,
-        max_depth: 1,
         learning_rate: 1.0,
-        reg_lambda: 1.0,
-        reg_alpha: 0.0,
-        gamma: 0.0,
-        min_child_weight: 1.0,
-        colsample_bytree: 1.0,
-        subsample: 1.0,
-        seed: 0,
-        base_score: None,
-        method: Method::Exact,
+        ..BoostParams::xgboost(1, 1)
     }
 }
 
@@ -141,7 +131,7 @@ fn paper_training(method: Method, n: usize) -> (Model, Matrix, Vec<f64>) {
         ..table2(n)
     };
     let b = train_on(&x, &d.centred, &d.train_rows, &params, 1);
-    (model_of(b, d.names.len()), x, d.centred)
+    (b.into_model(d.names.len(), Vec::new()), x, d.centred)
 }
 
 fn case(name: &str) -> serde_json::Value {
@@ -213,10 +203,8 @@ fn gamma_pruning_matches_xgboost() {
         gamma: 2e-3,
         ..table2(60)
     };
-    let m = model_of(
-        train_on(&x, &d.centred, &d.train_rows, &params, 1),
-        d.names.len(),
-    );
+    let m =
+        train_on(&x, &d.centred, &d.train_rows, &params, 1).into_model(d.names.len(), Vec::new());
     let c = case("exact_depth3_gamma");
     let diff = max_abs_diff(&predictions(&m, &x), &nums(&c["predictions"]));
     eprintln!("gamma case vs xgboost: max |Δprediction| = {diff:e}");

@@ -20,7 +20,7 @@ use proptest::prelude::*;
 use serde_json::json;
 
 use crate::support::machining_size::{
-    brute_interventional, brute_path_dependent, max_abs_diff, model_of, train_on,
+    brute_interventional, brute_path_dependent, max_abs_diff, train_on,
 };
 use crate::support::proptest_cfg::cases;
 
@@ -55,27 +55,14 @@ fn data_set(n: usize, d: usize) -> impl Strategy<Value = DataSet> {
 }
 
 fn params(n_estimators: usize, max_depth: usize) -> BoostParams {
-    BoostParams {
-        n_estimators,
-        max_depth,
-        learning_rate: 0.3,
-        reg_lambda: 1.0,
-        reg_alpha: 0.0,
-        gamma: 0.0,
-        min_child_weight: 1.0,
-        colsample_bytree: 1.0,
-        subsample: 1.0,
-        seed: 0,
-        base_score: None,
-        method: Method::Exact,
-    }
+    BoostParams::xgboost(n_estimators, max_depth)
 }
 
 fn trained(ds: &DataSet, p: &BoostParams) -> (Model, Matrix) {
     let d = ds.rows[0].len();
     let x = Matrix::from_rows(ds.rows.clone(), d);
     let b = train_on(&x, &ds.y, &all_rows(ds.y.len()), p, 1);
-    (model_of(b, d), x)
+    (b.into_model(d, Vec::new()), x)
 }
 
 fn shap(m: &Model, x: &[f64]) -> Vec<f64> {

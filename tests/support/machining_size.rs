@@ -2,11 +2,9 @@
 //! (`tests/fixtures/machining_size/`, made by its `generate.py`), brute-force Shapley values (the
 //! independent check of TreeSHAP: 2^d coalitions, exact game values), and small builders.
 
-use mechcalc::calc::machining_size::boost::{
-    BoostParams, Boosted, ExactIndex, HistIndex, Method, SplitIndex, TrainData, boost,
-};
+use mechcalc::calc::machining_size::boost::{BoostParams, Boosted, SplitIndex, TrainData, boost};
 use mechcalc::calc::machining_size::data::Matrix;
-use mechcalc::calc::machining_size::model::{Model, ModelSource, Routing, Tree, cover_fraction};
+use mechcalc::calc::machining_size::model::{Model, Tree, cover_fraction};
 use mechcalc::numerics::Budget;
 use serde_json::Value;
 
@@ -67,18 +65,11 @@ pub fn paper_data() -> PaperData {
 /// The paper's Table-2 parameters with colsample 1.0 (spec §7.2), base score 0 (centred target).
 pub fn table2(n_estimators: usize) -> BoostParams {
     BoostParams {
-        n_estimators,
-        max_depth: 6,
         learning_rate: 0.05,
         reg_lambda: 0.1,
         reg_alpha: 0.05,
-        gamma: 0.0,
-        min_child_weight: 1.0,
-        colsample_bytree: 1.0,
-        subsample: 1.0,
-        seed: 0,
         base_score: Some(0.0),
-        method: Method::Exact,
+        ..BoostParams::xgboost(n_estimators, 6)
     }
 }
 
@@ -91,12 +82,7 @@ pub fn train_on(
     threads: usize,
 ) -> Boosted {
     let features: Vec<usize> = (0..x.n_cols()).collect();
-    let index = match params.method {
-        Method::Exact => SplitIndex::Exact(ExactIndex::build(x, &features, threads)),
-        Method::Hist { max_bin } => {
-            SplitIndex::Hist(HistIndex::build(x, rows, &features, max_bin, threads))
-        }
-    };
+    let index = SplitIndex::build(params.method, x, rows, &features, threads);
     let data = TrainData {
         x,
         y,
@@ -105,18 +91,6 @@ pub fn train_on(
         index: &index,
     };
     boost(&data, params, &Budget::unlimited(), threads)
-}
-
-/// A native model from trained trees.
-pub fn model_of(b: Boosted, n_features: usize) -> Model {
-    Model {
-        base_score: b.base_score,
-        n_features,
-        feature_names: Vec::new(),
-        routing: Routing::F64,
-        source: ModelSource::Native,
-        trees: b.trees,
-    }
 }
 
 /// E[tree | x_S] with the cover weighting of path-dependent TreeSHAP: follow x on features in S,

@@ -12,7 +12,7 @@
 use crate::numerics::{Budget, StopReason, par_map};
 
 use super::data::Matrix;
-use super::model::{LEAF, Node, Tree};
+use super::model::{LEAF, Model, ModelSource, Node, Routing, Tree};
 use super::rng;
 
 /// XGBoost's minimum loss change of a split (`kRtEps`).
@@ -87,6 +87,28 @@ pub fn soft_threshold(g: f64, alpha: f64) -> f64 {
 }
 
 impl BoostParams {
+    /// XGBoost's own defaults (η 0.3, λ 1, α 0, γ 0, min_child_weight 1, no sampling, seed 0,
+    /// base score the target mean, exact splits) with `n_estimators` rounds of depth
+    /// `max_depth`: the parameters of a comparison with XGBoost run as it comes. The service's
+    /// defaults are the paper's Table 2 (`wire::TrainParams`).
+    #[must_use]
+    pub const fn xgboost(n_estimators: usize, max_depth: usize) -> Self {
+        Self {
+            n_estimators,
+            max_depth,
+            learning_rate: 0.3,
+            reg_lambda: 1.0,
+            reg_alpha: 0.0,
+            gamma: 0.0,
+            min_child_weight: 1.0,
+            colsample_bytree: 1.0,
+            subsample: 1.0,
+            seed: 0,
+            base_score: None,
+            method: Method::Exact,
+        }
+    }
+
     /// score(G, H) = T_α(G)²/(H + λ); 0 when H < min_child_weight or H ≤ 0 (XGBoost's CalcGain).
     #[must_use]
     pub fn score(&self, g: f64, h: f64) -> f64 {
@@ -250,6 +272,25 @@ pub enum SplitIndex {
     Hist(HistIndex),
 }
 
+impl SplitIndex {
+    /// The index `method` searches, over `features` of `x` (the hist cuts from rows `rows`).
+    #[must_use]
+    pub fn build(
+        method: Method,
+        x: &Matrix,
+        rows: &[u32],
+        features: &[usize],
+        threads: usize,
+    ) -> Self {
+        match method {
+            Method::Exact => Self::Exact(ExactIndex::build(x, features, threads)),
+            Method::Hist { max_bin } => {
+                Self::Hist(HistIndex::build(x, rows, features, max_bin, threads))
+            }
+        }
+    }
+}
+
 /// What one model trains on: rows `rows` of `x` with targets `y` (indexed like `x`'s rows),
 /// candidate features `features` (original column indices, ascending), and the index built over
 /// those features.
@@ -276,6 +317,22 @@ pub struct Boosted {
     pub trees: Vec<Tree>,
     /// How training stopped.
     pub stop: StopReason,
+}
+
+impl Boosted {
+    /// The model these trees make, for rows of `n_features` columns named `feature_names`
+    /// (f64 routing: a native model compares thresholds in f64).
+    #[must_use]
+    pub fn into_model(self, n_features: usize, feature_names: Vec<String>) -> Model {
+        Model {
+            base_score: self.base_score,
+            n_features,
+            feature_names,
+            routing: Routing::F64,
+            source: ModelSource::Native,
+            trees: self.trees,
+        }
+    }
 }
 
 /// Trains an ensemble on `data` (spec §3). Checks the budget before every round; returns the
@@ -821,20 +878,11 @@ fn finish_tree(
 mod tests {
     use super::*;
 
+    /// The hand-checkable stump of spec T1: one round, depth 1, η 1.
     fn params() -> BoostParams {
         BoostParams {
-            n_estimators: 1,
-            max_depth: 1,
             learning_rate: 1.0,
-            reg_lambda: 1.0,
-            reg_alpha: 0.0,
-            gamma: 0.0,
-            min_child_weight: 1.0,
-            colsample_bytree: 1.0,
-            subsample: 1.0,
-            seed: 0,
-            base_score: None,
-            method: Method::Exact,
+            ..BoostParams::xgboost(1, 1)
         }
     }
 
@@ -843,12 +891,7 @@ mod tests {
         let y = [1.0, 2.0, 3.0, 10.0];
         let rows = super::super::data::all_rows(4);
         let features = [0usize];
-        let index = match p.method {
-            Method::Exact => SplitIndex::Exact(ExactIndex::build(&x, &features, 1)),
-            Method::Hist { max_bin } => {
-                SplitIndex::Hist(HistIndex::build(&x, &rows, &features, max_bin, 1))
-            }
-        };
+        let index = SplitIndex::build(p.method, &x, &rows, &features, 1);
         let data = TrainData {
             x: &x,
             y: &y,
@@ -939,12 +982,7 @@ mod tests {
         let all = super::super::data::all_rows(n);
         let features: Vec<usize> = (0..6).collect();
         for method in [Method::Exact, Method::Hist { max_bin: 4 }] {
-            let index = match method {
-                Method::Exact => SplitIndex::Exact(ExactIndex::build(&x, &features, 2)),
-                Method::Hist { max_bin } => {
-                    SplitIndex::Hist(HistIndex::build(&x, &all, &features, max_bin, 2))
-                }
-            };
+            let index = SplitIndex::build(method, &x, &all, &features, 2);
             let data = TrainData {
                 x: &x,
                 y: &y,

@@ -5,12 +5,12 @@ use std::borrow::Cow;
 
 use crate::numerics::{Budget, StopReason, par_map, par_map_while};
 
-use super::boost::{Boosted, ExactIndex, HistIndex, Method, SplitIndex, TrainData, boost};
+use super::boost::{Boosted, ExactIndex, Method, SplitIndex, TrainData, boost};
 use super::data::{self, Matrix, Metrics};
 use super::error::MachiningSizeError;
 use super::gra;
 use super::input::{AnalyzeInput, PredictInput, ShapKind, TrainInput};
-use super::model::{Model, ModelSource, Routing, Tree};
+use super::model::{Model, Tree};
 use super::pca::{self, Pca};
 use super::rng;
 use super::shap::{InterventionalTables, InterventionalWeights, PathBuffer, ShapForest};
@@ -101,12 +101,7 @@ struct Fitted {
 
 /// The split index of a model trained on `rows` of `x`.
 fn build_index(x: &Matrix, rows: &[u32], input: &TrainInput, threads: usize) -> SplitIndex {
-    match input.params.method {
-        Method::Exact => SplitIndex::Exact(ExactIndex::build(x, &input.features, threads)),
-        Method::Hist { max_bin } => {
-            SplitIndex::Hist(HistIndex::build(x, rows, &input.features, max_bin, threads))
-        }
-    }
+    SplitIndex::build(input.params.method, x, rows, &input.features, threads)
 }
 
 /// Trains one model on `rows` of the input (SMOGN first, when asked). `shared` is an exact index
@@ -174,14 +169,7 @@ fn smogn_error(e: smogn::SmognError, pointer: &'static str) -> MachiningSizeErro
 }
 
 fn to_model(input: &TrainInput, b: Boosted) -> Model {
-    Model {
-        base_score: b.base_score,
-        n_features: input.x.n_cols(),
-        feature_names: input.names.clone(),
-        routing: Routing::F64,
-        source: ModelSource::Native,
-        trees: b.trees,
-    }
+    b.into_model(input.x.n_cols(), input.names.clone())
 }
 
 /// Predictions of `model` for rows `rows` of `x` (f64 routing).
