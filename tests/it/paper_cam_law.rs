@@ -21,7 +21,7 @@ use mechcalc::numerics::Budget;
 use serde_json::{Value, json};
 
 use crate::support::cam_table1;
-use cam_table1::TABLE1_BC;
+use cam_table1::{PHASE2_BC, PHASE2_C, TABLE1_BC};
 
 /// Spec §5.2: 1e-9 absolute on s, v, a.
 const ABS_SVA: f64 = 1e-9;
@@ -150,27 +150,10 @@ fn l9_golden() {
     close("s(0.5)", law.eval(0.5).s, 0.6499655353, ABS_SVA);
 }
 
-fn phase2_coefficients() -> [f64; 7] {
-    [0.3917, 0.0500, 0.1195, 0.0235, 0.1199, 0.1389, 0.2065]
-}
-
-fn phase2_bc() -> BoundaryConditions {
-    BoundaryConditions {
-        t_a: 210.0,
-        t_b: 300.0,
-        s_a: 20.38,
-        s_b: -4.27,
-        v_a: -0.0028,
-        v_b: 0.0183,
-        a_a: 0.0,
-        a_b: 0.006,
-    }
-}
-
 /// §5.2 Phase II of the real cam (paper Tables 8/10; coefficients sum to 1.05, renormalized).
 #[test]
 fn phase2_real_cam() {
-    let law = SevenSegmentLaw::try_new(&phase2_coefficients(), &phase2_bc()).expect("Phase II");
+    let law = SevenSegmentLaw::try_new(&PHASE2_C, &PHASE2_BC).expect("Phase II");
     close("A1 (fall: negative)", law.a1(), -0.0181122881, 1e-9);
     close("A2", law.a2(), 0.0190255423, 1e-9);
     close("s(240°)", law.eval(240.0).s, 16.8411839026, ABS_SVA);
@@ -181,7 +164,7 @@ fn phase2_real_cam() {
 
     // Through the endpoint: 422 without `normalize`, warning with it.
     let mut req = request(json!({
-        "coefficients": phase2_coefficients(),
+        "coefficients": PHASE2_C,
         "constraints": {"t_a": 210.0, "t_b": 300.0, "s_a": 20.38, "s_b": -4.27, "v_a": -0.0028, "v_b": 0.0183, "a_a": 0.0, "a_b": 0.006},
         "abscissa": {"values": [240.0, 255.0, 270.0]}
     }));
@@ -412,7 +395,7 @@ fn appendix_a1_explicit_pieces_match_general_law() {
 fn cramer_matches_centroid_on_spec_cases() {
     let cases = [
         ([2.0, 4.0, 6.0, 3.0, 8.0, 7.0, 1.0], TABLE1_BC),
-        (phase2_coefficients(), phase2_bc()),
+        (PHASE2_C, PHASE2_BC),
     ];
     for (c, bc) in cases {
         let law = SevenSegmentLaw::try_new(&c, &bc).expect("valid");

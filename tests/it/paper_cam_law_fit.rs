@@ -20,7 +20,7 @@ use mechcalc::numerics::{Budget, StopReason};
 use serde_json::{Value, json};
 
 use crate::support::cam_table1;
-use cam_table1::TABLE1_BC;
+use cam_table1::{PHASE2_BC, PHASE2_C, TABLE1_BC};
 
 fn heavy() -> bool {
     std::env::var_os("CAMFIT_HEAVY").is_some()
@@ -252,18 +252,8 @@ fn golden_values_mt_l9_and_phase_ii() {
     assert!((pk.v_max_abs - 2.0).abs() < 1e-9 && (pk.x_at_v_max - 0.30).abs() < 1e-9);
     assert!((l9.eval(0.5).s - 0.6499655353).abs() < 1e-9);
 
-    let c2: [f64; 7] = [0.3917, 0.0500, 0.1195, 0.0235, 0.1199, 0.1389, 0.2065].map(|c| c / 1.05);
-    let bc = BoundaryConditions {
-        t_a: 210.0,
-        t_b: 300.0,
-        s_a: 20.38,
-        s_b: -4.27,
-        v_a: -0.0028,
-        v_b: 0.0183,
-        a_a: 0.0,
-        a_b: 0.0060,
-    };
-    let ph2 = SevenSegmentLaw::try_new(&c2, &bc).expect("phase II");
+    let c2 = PHASE2_C.map(|c| c / 1.05);
+    let ph2 = SevenSegmentLaw::try_new(&c2, &PHASE2_BC).expect("phase II");
     assert!((ph2.a1() + 0.0181122881).abs() < 1e-9 && (ph2.a2() - 0.0190255423).abs() < 1e-9);
     assert!((ph2.eval(240.0).s - 16.8411839026).abs() < 1e-9);
     assert!((ph2.eval(255.0).v + 0.5725431661).abs() < 1e-9);

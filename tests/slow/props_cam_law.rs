@@ -5,7 +5,7 @@
 // Reference expressions are written as in the spec.
 #![allow(clippy::suboptimal_flops)]
 
-use crate::support::cam_law_strategies::coefficients;
+use crate::support::cam_law_strategies::{coefficients, scaled_conditions};
 use mechcalc::calc::cam_law::catalogue::{NamedLaw, TABLE3};
 use mechcalc::calc::cam_law::law::{
     BoundaryConditions, Quantity, SevenSegmentLaw, accelerations_centroid, accelerations_cramer,
@@ -15,27 +15,7 @@ use proptest::prelude::*;
 /// Boundary conditions with log-uniform Δt in [1e-2, 1e2], Δs of either sign (or 0) up to 1e2,
 /// end rates up to a few times the natural scales Δs/Δt, Δs/Δt².
 fn boundary_conditions() -> impl Strategy<Value = BoundaryConditions> {
-    (
-        -100.0f64..100.0,
-        -2.0f64..2.0,
-        -100.0f64..100.0,
-        prop_oneof![1 => Just(0.0), 6 => -100.0f64..100.0],
-        proptest::array::uniform4(-3.0f64..3.0),
-    )
-        .prop_map(|(t_a, log_dt, s_a, ds, r)| {
-            let dt = 10f64.powf(log_dt);
-            let scale = ds.abs().max(1.0);
-            BoundaryConditions {
-                t_a,
-                t_b: t_a + dt,
-                s_a,
-                s_b: s_a + ds,
-                v_a: r[0] * scale / dt,
-                v_b: r[1] * scale / dt,
-                a_a: r[2] * scale / dt / dt,
-                a_b: r[3] * scale / dt / dt,
-            }
-        })
+    scaled_conditions(prop_oneof![1 => Just(0.0), 6 => -100.0f64..100.0], 3.0, 1.0)
 }
 
 /// Zero end rates (for the scaling property).

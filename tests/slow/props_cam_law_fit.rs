@@ -6,7 +6,7 @@
 // Reference expressions are written as in the spec.
 #![allow(clippy::suboptimal_flops)]
 
-use crate::support::cam_law_strategies::coefficients;
+use crate::support::cam_law_strategies::{coefficients, scaled_conditions};
 use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
 use mechcalc::calc::cam_law_fit::compute::LawModel;
 use mechcalc::calc::cam_law_fit::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
@@ -19,27 +19,7 @@ use serde_json::json;
 /// Boundary conditions: log-uniform Δt in [1e-2, 1e2], Δs of either sign up to 1e2, end rates up
 /// to a few times the natural scales.
 fn boundary_conditions() -> impl Strategy<Value = BoundaryConditions> {
-    (
-        -100.0f64..100.0,
-        -2.0f64..2.0,
-        -100.0f64..100.0,
-        prop_oneof![-100.0f64..-0.01, 0.01f64..100.0],
-        proptest::array::uniform4(-2.0f64..2.0),
-    )
-        .prop_map(|(t_a, log_dt, s_a, ds, r)| {
-            let dt = 10f64.powf(log_dt);
-            let scale = ds.abs();
-            BoundaryConditions {
-                t_a,
-                t_b: t_a + dt,
-                s_a,
-                s_b: s_a + ds,
-                v_a: r[0] * scale / dt,
-                v_b: r[1] * scale / dt,
-                a_a: r[2] * scale / dt / dt,
-                a_b: r[3] * scale / dt / dt,
-            }
-        })
+    scaled_conditions(prop_oneof![-100.0f64..-0.01, 0.01f64..100.0], 2.0, 0.0)
 }
 
 /// `cases` by default; `PROPTEST_CASES` overrides it for bigger runs.

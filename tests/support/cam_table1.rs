@@ -1,6 +1,6 @@
 //! The spec's Table-1 cam-law case (cam_law_fit.md §5.2/§8: non-zero end rates, all seven
-//! segments non-empty), shared by the cam-law tests and benches (each includes this file with
-//! `#[path]`) so they evaluate, fit and time the same law.
+//! segments non-empty) and Phase II of the paper's real cam, shared by the cam-law tests and
+//! benches (each includes this file with `#[path]`) so they evaluate, fit and time the same law.
 
 use mechcalc::calc::cam_law::law::BoundaryConditions;
 
@@ -50,3 +50,21 @@ pub const TABLE1_KNOT_V: [f64; 8] = [
     0.5320894799,
     0.5,
 ];
+
+/// Phase II of the paper's real cam (cam_law.md §5.2, paper Tables 8/10): the coefficients as
+/// printed (they sum to 1.05; the law renormalises them).
+#[allow(dead_code, reason = "the paper tests use Phase II; the benches do not")]
+pub const PHASE2_C: [f64; 7] = [0.3917, 0.0500, 0.1195, 0.0235, 0.1199, 0.1389, 0.2065];
+
+/// Phase II boundary conditions: a fall from 20.38 to −4.27 over 210°–300°.
+#[allow(dead_code, reason = "the paper tests use Phase II; the benches do not")]
+pub const PHASE2_BC: BoundaryConditions = BoundaryConditions {
+    t_a: 210.0,
+    t_b: 300.0,
+    s_a: 20.38,
+    s_b: -4.27,
+    v_a: -0.0028,
+    v_b: 0.0183,
+    a_a: 0.0,
+    a_b: 0.006,
+};
