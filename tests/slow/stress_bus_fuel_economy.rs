@@ -13,6 +13,8 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 use std::time::Duration;
 
+use crate::support::finite::first_null_or_non_finite_where;
+
 /// JSON keys whose value may legitimately be null (undefined FE, map points outside the
 /// envelope, the modal bin of a bus that never moves, ipmsm-only breakdown parts).
 const NULLABLE: [&str; 9] = [
@@ -28,32 +30,17 @@ const NULLABLE: [&str; 9] = [
 ];
 
 /// Every number in the response is finite (serde_json writes NaN/∞ as null, so nulls are only
-/// allowed under the nullable keys).
-fn assert_finite(v: &Value, key: &str, path: &str) {
-    match v {
-        // fe_change_pct is null where either FE is undefined.
-        Value::Null => assert!(
-            NULLABLE.contains(&key) || path.starts_with("/comparison/fe_change_pct/"),
-            "null (NaN?) at {path}"
-        ),
-        Value::Number(n) => assert!(
-            n.as_f64().is_some_and(f64::is_finite),
-            "non-finite at {path}"
-        ),
-        Value::Array(a) => a
-            .iter()
-            .enumerate()
-            .for_each(|(i, x)| assert_finite(x, key, &format!("{path}/{i}"))),
-        Value::Object(o) => o
-            .iter()
-            .for_each(|(k, x)| assert_finite(x, k, &format!("{path}/{k}"))),
-        _ => {}
-    }
+/// allowed under the nullable keys, and in fe_change_pct where either FE is undefined).
+fn assert_finite(v: &Value) {
+    let bad = first_null_or_non_finite_where(v, |key, path| {
+        NULLABLE.contains(&key) || path.starts_with("/comparison/fe_change_pct/")
+    });
+    assert!(bad.is_none(), "null (NaN?) or non-finite at {bad:?}");
 }
 
 fn check_response(r: &BusFuelEconomyResponse) {
     let v = serde_json::to_value(r).expect("response serialises");
-    assert_finite(&v, "", "");
+    assert_finite(&v);
     for x in &r.results {
         assert!(
             x.energy_in_kwh.is_finite() && x.distance_km >= 0.0 && x.friction_brake_kwh >= -1e-12

@@ -21,6 +21,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
+use crate::support::finite::first_null_or_non_finite;
+
 fn stress_cases() -> usize {
     std::env::var("STRESS_CASES")
         .ok()
@@ -37,22 +39,12 @@ fn all_options() -> Value {
 
 /// Every number in the response is finite: serde_json turns NaN/∞ into `null`, and absent optional
 /// outputs are omitted (never `null`), so any `null` is a defect.
-fn assert_all_finite(v: &Value, path: &str) {
-    match v {
-        Value::Null => panic!("null (NaN/∞ or an unset optional) at {path}"),
-        Value::Number(n) => assert!(
-            n.as_f64().is_some_and(f64::is_finite),
-            "non-finite at {path}"
-        ),
-        Value::Array(a) => a
-            .iter()
-            .enumerate()
-            .for_each(|(i, x)| assert_all_finite(x, &format!("{path}/{i}"))),
-        Value::Object(o) => o
-            .iter()
-            .for_each(|(k, x)| assert_all_finite(x, &format!("{path}/{k}"))),
-        Value::Bool(_) | Value::String(_) => {}
-    }
+fn assert_all_finite(v: &Value) {
+    let bad = first_null_or_non_finite(v, &[]);
+    assert!(
+        bad.is_none(),
+        "null (NaN/∞ or an unset optional) or non-finite at {bad:?}"
+    );
 }
 
 /// Runs a request; returns the response after checking finiteness, or the typed failure.
@@ -75,7 +67,7 @@ fn attempt(v: Value) -> Result<CognatesResponse, CalcFailure> {
     let out = out.unwrap_or_else(|_| panic!("panic for {v}"));
     if let Ok(r) = &out {
         let j = serde_json::to_value(r).expect("serialisable");
-        assert_all_finite(&j, "");
+        assert_all_finite(&j);
     }
     out
 }

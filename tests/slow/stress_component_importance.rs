@@ -11,13 +11,12 @@ use std::time::Duration;
 use mechcalc::calc::component_importance::run;
 use mechcalc::calc::component_importance::wire::{
     BetweennessMode, ComponentImportanceRequest, ComponentImportanceResponse, ComponentSpec,
-    ConstantWeights, EntropyWeights, FailureMode, Options, Outputs, PathMethod, TimeOverride,
-    Weibull,
+    ConstantWeights, EntropyWeights, FailureMode, Outputs, PathMethod, TimeOverride, Weibull,
 };
 use mechcalc::calc::{CalcFailure, ProblemClass};
 use mechcalc::numerics::Budget;
 
-use crate::support::component_importance::random_request;
+use crate::support::component_importance::{random_request, request_on};
 
 fn paper() -> ComponentImportanceRequest {
     let path = concat!(
@@ -169,20 +168,10 @@ fn comp(id: &str, eta: f64, beta: f64, s: f64) -> ComponentSpec {
 
 /// A request on ids `n0..` with the given edges.
 fn graph_request(n: usize, edges: &[(usize, usize)]) -> ComponentImportanceRequest {
-    ComponentImportanceRequest {
-        components: (0..n)
-            .map(|i| comp(&format!("n{i}"), 5000.0 + 100.0 * i as f64, 0.8, 0.3))
-            .collect(),
-        edges: edges
-            .iter()
-            .map(|&(a, b)| [format!("n{a}"), format!("n{b}")])
-            .collect(),
-        times_h: vec![500.0, 2000.0],
-        overrides: Vec::new(),
-        options: Options::default(),
-        outputs: Outputs::default(),
-        time_limit_ms: None,
-    }
+    let components = (0..n)
+        .map(|i| comp(&format!("n{i}"), 5000.0 + 100.0 * i as f64, 0.8, 0.3))
+        .collect();
+    request_on(components, edges)
 }
 
 fn complete_edges(n: usize) -> Vec<(usize, usize)> {

@@ -45,12 +45,23 @@ pub fn random_request(
             }
         })
         .collect();
+    request_on(components, &edges)
+}
+
+/// A request on `components` with edges between their indices (`(a, b)`: from
+/// `components[a]` to `components[b]`), times 500 h and 2000 h, default options and outputs.
+#[must_use]
+pub fn request_on(
+    components: Vec<ComponentSpec>,
+    edges: &[(usize, usize)],
+) -> ComponentImportanceRequest {
+    let edges = edges
+        .iter()
+        .map(|&(a, b)| [components[a].id.clone(), components[b].id.clone()])
+        .collect();
     ComponentImportanceRequest {
         components,
-        edges: edges
-            .iter()
-            .map(|&(a, b)| [format!("C{a}"), format!("C{b}")])
-            .collect(),
+        edges,
         times_h: vec![500.0, 2000.0],
         overrides: Vec::new(),
         options: Options::default(),
