@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use mechcalc::calc::cam_law::catalogue::{NamedLaw, TABLE3};
 use mechcalc::calc::cam_law::law::{BoundaryConditions, Quantity, SevenSegmentLaw};
-use mechcalc::calc::cam_law_fit::compute::{Algorithm, LawModel, Settings, fit};
+use mechcalc::calc::cam_law_fit::compute::{Algorithm, FitOutcome, LawModel, Settings, fit};
 use mechcalc::calc::cam_law_fit::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
 use mechcalc::calc::cam_law_fit::optim::ga::GaParams;
 use mechcalc::calc::cam_law_fit::optim::normalized;
@@ -66,11 +66,17 @@ struct Case {
     f_star: f64,
 }
 
-fn law_case(name: &'static str, c: [f64; 7], q: Quantity, metric: Metric) -> Case {
-    let xs = linspace(0.0, 1.0, 300);
-    let law = SevenSegmentLaw::try_new(&c, &BoundaryConditions::UNIT_RISE).expect("law");
-    let mut y = vec![0.0; 300];
+/// `n` equally spaced abscissae over [t_a, t_b] and the quantity `q` of the law (c, bc) there.
+fn sampled(c: &[f64; 7], bc: &BoundaryConditions, q: Quantity, n: usize) -> (Vec<f64>, Vec<f64>) {
+    let xs = linspace(bc.t_a, bc.t_b, n);
+    let law = SevenSegmentLaw::try_new(c, bc).expect("law");
+    let mut y = vec![0.0; n];
     law.eval_quantity_into(&xs, q, &mut y);
+    (xs, y)
+}
+
+fn law_case(name: &'static str, c: [f64; 7], q: Quantity, metric: Metric) -> Case {
+    let (_, y) = sampled(&c, &BoundaryConditions::UNIT_RISE, q, 300);
     Case {
         name,
         bc: BoundaryConditions::UNIT_RISE,
@@ -285,20 +291,35 @@ struct RunStats {
     hit: Option<f64>,
 }
 
-fn run_case(case: &Case, s: &Settings) -> RunStats {
+/// One fit run plain (timed), then again with the tracing model; the trace's times are rescaled
+/// to the plain run (module docs).
+struct TracedFit {
+    secs: f64,
+    evals: u64,
+    out: FitOutcome,
+    /// (rescaled time [s], objective, coefficient error) at every improvement.
+    trace: Vec<(f64, f64, f64)>,
+}
+
+/// One fit of `case` with `s` under `budget`: the outcome, its wall time [s] and the objective
+/// evaluations it made.
+fn plain_fit(case: &Case, s: &Settings, budget: Budget) -> (FitOutcome, f64, u64) {
     let xs = linspace(0.0, 1.0, case.data.len());
-    let budget = || Budget::unlimited().with_max_evaluations(50_000);
     let model = LawModel {
         xs: &xs,
         bc: case.bc,
         quantity: case.quantity,
     };
     let t = Instant::now();
-    let mut ctx = Ctx::new(&model, &case.data, case.metric, budget(), false);
+    let mut ctx = Ctx::new(&model, &case.data, case.metric, budget, false);
     let out = fit(&mut ctx, s);
-    let secs = t.elapsed().as_secs_f64();
-    let evals = ctx.evaluations();
-    // Traced repetition for time to target.
+    (out, t.elapsed().as_secs_f64(), ctx.evaluations())
+}
+
+fn traced_fit(case: &Case, s: &Settings) -> TracedFit {
+    let budget = || Budget::unlimited().with_max_evaluations(50_000);
+    let (out, secs, evals) = plain_fit(case, s, budget());
+    let xs = linspace(0.0, 1.0, case.data.len());
     let traced = Traced {
         inner: LawModel {
             xs: &xs,
@@ -319,21 +340,36 @@ fn run_case(case: &Case, s: &Settings) -> RunStats {
     } else {
         1.0
     };
-    let target = case.f_star.mul_add(1.0 + 1e-4, 1e-8);
-    let hit = traced
+    let trace = traced
         .state
         .borrow()
         .2
         .iter()
-        .find(|(_, f, _)| *f <= target)
-        .map(|(t, _, _)| t * scale);
-    RunStats {
+        .map(|&(t, f, e)| (t * scale, f, e))
+        .collect();
+    TracedFit {
         secs,
-        f: out.best,
+        evals,
+        out,
+        trace,
+    }
+}
+
+fn run_case(case: &Case, s: &Settings) -> RunStats {
+    let run = traced_fit(case, s);
+    let target = case.f_star.mul_add(1.0 + 1e-4, 1e-8);
+    let hit = run
+        .trace
+        .iter()
+        .find(|(_, f, _)| *f <= target)
+        .map(|(t, _, _)| *t);
+    RunStats {
+        secs: run.secs,
+        f: run.out.best,
         err: case
             .truth
-            .map_or(f64::NAN, |t| max_err(&out.coefficients, &t)),
-        evals,
+            .map_or(f64::NAN, |t| max_err(&run.out.coefficients, &t)),
+        evals: run.evals,
         hit,
     }
 }
@@ -422,54 +458,16 @@ fn ga_error_vs_time(seeds: u64) {
         "\n### Paper GA on the Table-1 case: max coefficient error of the best-so-far vs time (median of {seeds} seeds)\n"
     );
     let case = &cases()[0];
-    let xs = linspace(0.0, 1.0, 300);
     let marks = [0.05, 0.1, 0.2, 0.4, 0.8, 1.6];
     let mut per_mark: Vec<Vec<f64>> = vec![Vec::new(); marks.len()];
     for seed in 0..seeds {
-        let s = settings(VARIANTS[0], seed, 0);
-        let t = Instant::now();
-        let model = LawModel {
-            xs: &xs,
-            bc: case.bc,
-            quantity: case.quantity,
-        };
-        let mut ctx = Ctx::new(
-            &model,
-            &case.data,
-            case.metric,
-            Budget::unlimited().with_max_evaluations(50_000),
-            false,
-        );
-        let _ = fit(&mut ctx, &s);
-        let plain = t.elapsed().as_secs_f64();
-        let traced = Traced {
-            inner: LawModel {
-                xs: &xs,
-                bc: case.bc,
-                quantity: case.quantity,
-            },
-            data: &case.data,
-            metric: case.metric,
-            truth: case.truth,
-            start: Instant::now(),
-            state: RefCell::new((f64::INFINITY, Dtw::new(), Vec::new())),
-        };
-        let mut ctx = Ctx::new(
-            &traced,
-            &case.data,
-            case.metric,
-            Budget::unlimited().with_max_evaluations(50_000),
-            false,
-        );
-        let _ = fit(&mut ctx, &s);
-        let scale = plain / traced.start.elapsed().as_secs_f64();
-        let trace = traced.state.borrow();
+        let run = traced_fit(case, &settings(VARIANTS[0], seed, 0));
         for (m, slot) in marks.iter().zip(per_mark.iter_mut()) {
-            let e = trace
-                .2
+            let e = run
+                .trace
                 .iter()
                 .rev()
-                .find(|(t, _, _)| t * scale <= *m)
+                .find(|(t, _, _)| t <= m)
                 .map(|(_, _, e)| *e)
                 .unwrap_or(f64::NAN);
             slot.push(e);
@@ -505,10 +503,7 @@ fn auto_fit(
     snap: f64,
     restarts: u32,
 ) -> (f64, u64) {
-    let xs = linspace(bc.t_a, bc.t_b, n);
-    let law = SevenSegmentLaw::try_new(c, bc).expect("law");
-    let mut y = vec![0.0; n];
-    law.eval_quantity_into(&xs, q, &mut y);
+    let (xs, y) = sampled(c, bc, q, n);
     let model = LawModel {
         xs: &xs,
         bc: *bc,
@@ -623,10 +618,7 @@ fn knob_tables() {
     );
     println!("| objective | median µs/evaluation | worst µs/evaluation |");
     println!("|---|---|---|");
-    let xs = linspace(0.0, 1.0, 300);
-    let law = SevenSegmentLaw::try_new(&TABLE1_C, &TABLE1_BC).expect("law");
-    let mut data = vec![0.0; 300];
-    law.eval_quantity_into(&xs, Quantity::A, &mut data);
+    let (xs, data) = sampled(&TABLE1_C, &TABLE1_BC, Quantity::A, 300);
     let model = LawModel {
         xs: &xs,
         bc: TABLE1_BC,
@@ -675,25 +667,15 @@ fn knob_tables() {
         let mut secs = Vec::new();
         let mut evs = Vec::new();
         for seed in 0..6 {
-            let xs = linspace(0.0, 1.0, 300);
-            let model = LawModel {
-                xs: &xs,
-                bc: case.bc,
-                quantity: case.quantity,
-            };
-            let t = Instant::now();
-            let mut ctx = Ctx::new(
-                &model,
-                &case.data,
-                case.metric,
+            let (out, t, evals) = plain_fit(
+                &case,
+                &settings(VARIANTS[5], seed, restarts),
                 Budget::unlimited().with_max_evaluations(200_000),
-                false,
             );
-            let out = fit(&mut ctx, &settings(VARIANTS[5], seed, restarts));
-            secs.push(t.elapsed().as_secs_f64());
+            secs.push(t);
             fs.push(out.best);
             #[allow(clippy::cast_precision_loss)]
-            evs.push(ctx.evaluations() as f64);
+            evs.push(evals as f64);
         }
         let hits = fs.iter().filter(|f| **f <= 1.02 * case.f_star).count();
         let mark = if restarts == 3 { " (default)" } else { "" };
@@ -718,16 +700,8 @@ fn knob_tables() {
             let mut s = settings(VARIANTS[0], seed, 0);
             s.ga.population = pop;
             s.ga.generations = gens;
-            let xs = linspace(0.0, 1.0, 300);
-            let model = LawModel {
-                xs: &xs,
-                bc: case.bc,
-                quantity: case.quantity,
-            };
-            let t = Instant::now();
-            let mut ctx = Ctx::new(&model, &case.data, case.metric, Budget::unlimited(), false);
-            let out = fit(&mut ctx, &s);
-            secs.push(t.elapsed().as_secs_f64());
+            let (out, t, _) = plain_fit(case, &s, Budget::unlimited());
+            secs.push(t);
             errs.push(max_err(&out.coefficients, &normalized(&TABLE1_C)));
         }
         let worst = errs.iter().copied().fold(0.0, f64::max);
@@ -784,10 +758,7 @@ fn benches(c: &mut Criterion) {
     }
     g.finish();
     let mut g = c.benchmark_group("cam_law_fit/objective_n300");
-    let xs = linspace(0.0, 1.0, 300);
-    let law = SevenSegmentLaw::try_new(&TABLE1_C, &TABLE1_BC).expect("law");
-    let mut data = vec![0.0; 300];
-    law.eval_quantity_into(&xs, Quantity::A, &mut data);
+    let (xs, data) = sampled(&TABLE1_C, &TABLE1_BC, Quantity::A, 300);
     let model = LawModel {
         xs: &xs,
         bc: TABLE1_BC,

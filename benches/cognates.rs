@@ -10,8 +10,11 @@
 // `criterion_group!` generates an undocumented public function.
 #![allow(missing_docs)]
 
+#[path = "support/mod.rs"]
+mod support;
+
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mechcalc::calc::cognates::geometry::{FourBar, cognates};
@@ -22,6 +25,7 @@ use mechcalc::numerics::Budget;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
+use support::time_us;
 
 const NS: [usize; 10] = [32, 64, 128, 256, 360, 512, 1024, 2048, 4096, 8192];
 const DEFAULT_N: usize = 360;
@@ -77,20 +81,6 @@ fn random_linkages() -> Vec<Value> {
 fn mech(v: &Value) -> (FourBar, f64) {
     let input = CognatesInput::try_from(req(v)).expect("valid");
     (input.mech, input.scale)
-}
-
-/// Median and worst of `reps` timings of `f`, in µs.
-fn time_us(reps: usize, mut f: impl FnMut()) -> (f64, f64) {
-    f();
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed().as_secs_f64() * 1e6
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    (t[t.len() / 2], t[t.len() - 1])
 }
 
 fn reps_for(n: usize) -> usize {

@@ -13,6 +13,9 @@
 #![allow(missing_docs)] // criterion macros generate undocumented items
 #![allow(clippy::unwrap_used)] // benchmarks: a panic is the failure report
 
+#[path = "support/mod.rs"]
+mod support;
+
 #[path = "../tests/support/component_importance.rs"]
 mod synthetic_request;
 
@@ -667,15 +670,7 @@ fn sweep_times_and_acceptance() {
 }
 
 fn sweeps(_: &mut Criterion) {
-    // The sweeps take minutes: only under `cargo bench` (not when benches run as tests), and
-    // with a name filter only if it mentions "sweep" (`cargo bench --bench component_importance
-    // sweep` runs the sweeps alone).
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if !args.iter().any(|a| a == "--bench") {
-        return;
-    }
-    let filters: Vec<&String> = args.iter().filter(|a| !a.starts_with('-')).collect();
-    if !filters.is_empty() && !filters.iter().any(|f| f.contains("sweep")) {
+    if support::sweep_filters("sweep").is_none() {
         return;
     }
     println!("\n## component_importance accuracy-vs-cost sweeps (release build)");

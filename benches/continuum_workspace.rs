@@ -33,39 +33,10 @@ use mechcalc::calc::continuum_workspace::{
 };
 use mechcalc::numerics::Budget;
 use serde_json::{Value, json};
+use support::{process_cpu_ms, time_us};
 
 const EI: f64 = 2.638_937_829_015_426;
 const LEN: f64 = 0.5;
-
-/// Median and worst of `reps` timings of `f`, in µs.
-fn time_us(reps: usize, mut f: impl FnMut()) -> (f64, f64) {
-    f();
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed().as_secs_f64() * 1e6
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    (t[t.len() / 2], t[t.len() - 1])
-}
-
-/// Process CPU time (user + system, all threads) in ms, from /proc (10 ms resolution).
-fn cpu_ms() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let after = stat.rsplit(')').next().unwrap_or("");
-    let f: Vec<&str> = after.split_whitespace().collect();
-    let ticks = |i: usize| {
-        f.get(i)
-            .and_then(|x| x.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    // Fields 14 and 15 of the stat line are the 12th and 13th after the command name.
-    (ticks(11) + ticks(12)) * 10.0
-}
 
 struct RodCase {
     name: &'static str,
@@ -157,6 +128,31 @@ fn solve_home(model: &Model, lambda: [f64; 2], tol: f64) -> Solution {
     .solution
 }
 
+/// A warm Newton solve of `p` from `from` with `opts`, and its median and worst time over 2000
+/// repetitions [µs].
+fn timed_warm_solve(
+    model: &Model,
+    p: &Params,
+    from: &[f64],
+    opts: NewtonOptions,
+) -> (Solution, f64, f64) {
+    let solve = || {
+        newton::solve(
+            model,
+            p,
+            black_box(from),
+            opts,
+            &Budget::unlimited(),
+            &mut Counter::default(),
+        )
+    };
+    let sol = solve().expect("a warm start converges");
+    let (tm, tw) = time_us(2000, || {
+        black_box(solve().ok());
+    });
+    (sol, tm, tw)
+}
+
 #[expect(
     clippy::too_many_lines,
     reason = "prints the three FK tables of benches/RESULTS.md (error vs RK4 steps, Newton tolerance, end-to-end requests) from one set of reference solutions"
@@ -189,16 +185,7 @@ fn fk_table() {
             force: [0.0, 0.0],
             moment: 0.0,
         };
-        let opts = NewtonOptions::new(1e-10, 50);
-        let sol = newton::solve(
-            &model,
-            &p,
-            &from.v,
-            opts,
-            &Budget::unlimited(),
-            &mut Counter::default(),
-        )
-        .expect("warm");
+        let (sol, tm, tw) = timed_warm_solve(&model, &p, &from.v, NewtonOptions::new(1e-10, 50));
         let pos = model.position(&sol.v);
         let perr = (pos[0] - rp[0]).hypot(pos[1] - rp[1]);
         let terr = (model.angle(&sol.v) - rt).to_degrees().abs();
@@ -210,19 +197,6 @@ fn fk_table() {
             .fold(0.0f64, |m, (a, b)| {
                 m.max((a[0] - b[0]).abs()).max((a[1] - b[1]).abs())
             });
-        let (tm, tw) = time_us(2000, || {
-            black_box(
-                newton::solve(
-                    &model,
-                    &p,
-                    black_box(&from.v),
-                    opts,
-                    &Budget::unlimited(),
-                    &mut Counter::default(),
-                )
-                .ok(),
-            );
-        });
         let mark = if steps == 32 { " (default)" } else { "" };
         println!(
             "| {steps}{mark} | {perr:.2e} | {terr:.2e} | {ferr:.2e} | {} | {tm:.1} / {tw:.0} |",
@@ -253,30 +227,8 @@ fn fk_table() {
     .expect("tight");
     let tp = model.position(&tight.v);
     for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14] {
-        let opts = NewtonOptions::new(tol, 50);
-        let sol = newton::solve(
-            &model,
-            &p,
-            &from.v,
-            opts,
-            &Budget::unlimited(),
-            &mut Counter::default(),
-        )
-        .expect("solves");
+        let (sol, tm, tw) = timed_warm_solve(&model, &p, &from.v, NewtonOptions::new(tol, 50));
         let pos = model.position(&sol.v);
-        let (tm, tw) = time_us(2000, || {
-            black_box(
-                newton::solve(
-                    &model,
-                    &p,
-                    black_box(&from.v),
-                    opts,
-                    &Budget::unlimited(),
-                    &mut Counter::default(),
-                )
-                .ok(),
-            );
-        });
         let mark = if (tol - 1e-10).abs() < 1e-20 {
             " (default)"
         } else {
@@ -599,18 +551,14 @@ fn sweep_request(n: u32, stability: &str, extra: Value) -> ContinuumWorkspaceReq
 }
 
 fn run_sweep(req: &ContinuumWorkspaceRequest) -> (Value, f64, f64) {
-    let c0 = cpu_ms();
+    let c0 = process_cpu_ms();
     let t0 = Instant::now();
     let r = run(req.clone(), &Budget::unlimited()).expect("sweep");
     let wall = t0.elapsed().as_secs_f64() * 1e3;
-    let cpu = cpu_ms() - c0;
+    let cpu = process_cpu_ms() - c0;
     (serde_json::to_value(r).expect("json"), wall, cpu)
 }
 
-#[expect(
-    clippy::too_many_lines,
-    reason = "prints the three sweep tables of benches/RESULTS.md (design 1 reference, knobs, threads) in the order they appear there"
-)]
 fn sweep_tables() {
     println!(
         "\n### Sweeps: design 1, ranges home +/- 0.45 m, gap limit 0.05 m, F = 0, 8 sub-steps, M = 20 (spec 6.2 reference: ~705 nodes, union 0.2333 m^2, 35 folded, 3.18 deg, QT 0.1252 m^2)\n"
@@ -656,49 +604,32 @@ fn sweep_tables() {
     println!("\n### Sweep knobs (31 x 31, det_sign unless stated; one run each)\n");
     println!("| knob | wall ms | CPU ms | accepted | union m^2 | max angle deg | failures |");
     println!("|---|---|---|---|---|---|---|");
-    let knobs: Vec<(&str, ContinuumWorkspaceRequest)> = vec![
-        (
-            "max_substeps 1",
-            sweep_request(31, "det_sign", json!({"max_substeps": 1})),
-        ),
-        (
-            "max_substeps 2",
-            sweep_request(31, "det_sign", json!({"max_substeps": 2})),
-        ),
-        (
-            "max_substeps 4",
-            sweep_request(31, "det_sign", json!({"max_substeps": 4})),
-        ),
+    let knobs: [(&str, &str, Value); 10] = [
+        ("max_substeps 1", "det_sign", json!({"max_substeps": 1})),
+        ("max_substeps 2", "det_sign", json!({"max_substeps": 2})),
+        ("max_substeps 4", "det_sign", json!({"max_substeps": 4})),
         (
             "max_substeps 8 (default)",
-            sweep_request(31, "det_sign", json!({"max_substeps": 8})),
+            "det_sign",
+            json!({"max_substeps": 8}),
         ),
-        (
-            "max_substeps 16",
-            sweep_request(31, "det_sign", json!({"max_substeps": 16})),
-        ),
-        (
-            "predictor off",
-            sweep_request(31, "det_sign", json!({"predictor": false})),
-        ),
+        ("max_substeps 16", "det_sign", json!({"max_substeps": 16})),
+        ("predictor off", "det_sign", json!({"predictor": false})),
         (
             "substep_max_iter 50 (no sweep cap)",
-            sweep_request(31, "det_sign", json!({"substep_max_iter": 50})),
+            "det_sign",
+            json!({"substep_max_iter": 50}),
         ),
         (
             "full stability, M = 40",
-            sweep_request(31, "full", json!({"stability_segments": 40})),
+            "full",
+            json!({"stability_segments": 40}),
         ),
-        (
-            "8 neighbours",
-            sweep_request(31, "det_sign", json!({"neighbours": 8})),
-        ),
-        (
-            "area_method sum",
-            sweep_request(31, "det_sign", json!({"area_method": "sum"})),
-        ),
+        ("8 neighbours", "det_sign", json!({"neighbours": 8})),
+        ("area_method sum", "det_sign", json!({"area_method": "sum"})),
     ];
-    for (name, req) in knobs {
+    for (name, stability, overrides) in knobs {
+        let req = sweep_request(31, stability, overrides);
         let (v, w, c) = run_sweep(&req);
         let m = &v["metrics"];
         println!(
@@ -734,7 +665,7 @@ fn sweep_tables() {
         };
         let seed_sol = solve_home(&model, [-0.25, 0.2725], 1e-10);
         let seed = sweep::accept(&model, &s, &[-0.25, 0.2725], &seed_sol, None).expect("seed");
-        let c0 = cpu_ms();
+        let c0 = process_cpu_ms();
         let t0 = Instant::now();
         let w = sweep::wave(
             &model,
@@ -747,7 +678,7 @@ fn sweep_tables() {
         );
         let wall = t0.elapsed().as_secs_f64() * 1e3;
         black_box(w);
-        println!("| {threads} | {wall:.0} | {:.0} |", cpu_ms() - c0);
+        println!("| {threads} | {wall:.0} | {:.0} |", process_cpu_ms() - c0);
     }
 }
 
