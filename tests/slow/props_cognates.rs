@@ -405,7 +405,11 @@ proptest! {
         }
     }
 
-    /// §6.3-9: with `auto` spacing the chord error drops ×¼ per doubling of N.
+    /// §6.3-9: with `auto` spacing the chord error drops ×¼ per doubling of N, measured as the
+    /// log-log slope over three doublings (§8's criterion): a single doubling's ratio depends on
+    /// where the grid falls on a sharply curved stretch (one random linkage: ×4.00, ×3.98, ×2.96,
+    /// ×3.59, ×4.10 over N = 256…8192; 1500 linkages: one-doubling minimum 3.04, over three
+    /// doublings 3.58, median 4.00).
     #[test]
     fn chord_error_is_second_order(lk in linkage()) {
         prop_assume!(lk.assemblable() && lk.regular_point());
@@ -416,11 +420,10 @@ proptest! {
         prop_assume!(g.margin.abs() > 0.05 * m.scale() && g.class != GrashofClass::ChangePoint);
         prop_assume!(g.kind != LinkageType::ChangePoint);
         let e1 = chord_error(&m, 512, Spacing::Auto, 8);
-        let e2 = chord_error(&m, 1024, Spacing::Auto, 8);
+        let e2 = chord_error(&m, 4096, Spacing::Auto, 8);
         prop_assume!(e1 > 1e-12 * m.scale());
-        // Second order: at least ×3 per doubling (×4 asymptotically; more while fine features such
-        // as cusps are still being resolved).
-        let ratio = e1 / e2;
-        prop_assert!(ratio >= 3.0, "ratio {ratio} ({e1:e} → {e2:e})");
+        // Second order: at least ×3 per doubling on average (×4 asymptotically).
+        let ratio = (e1 / e2).cbrt();
+        prop_assert!(ratio >= 3.0, "ratio per doubling {ratio} ({e1:e} at N = 512 → {e2:e} at 4096)");
     }
 }
