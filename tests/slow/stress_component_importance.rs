@@ -501,28 +501,20 @@ fn hazard_rate_overflow_is_typed() {
 /// zero index column with a warning (not NaN).
 #[test]
 fn tiny_and_zero_failure_probabilities() {
-    let mut r = paper();
-    r.overrides.clear();
-    r.times_h = vec![1e-6];
-    for c in &mut r.components {
-        c.weibull = Some(Weibull {
-            eta_h: 1e6,
-            beta: 20.0,
-        }); // F = 1e-240
-    }
-    let out = ok(r);
+    // The paper's graph at one time t with every component Weibull(η, β = 20): F = (t/η)^20.
+    let at = |t: f64, eta_h: f64| {
+        let mut r = paper();
+        r.overrides.clear();
+        r.times_h = vec![t];
+        for c in &mut r.components {
+            c.weibull = Some(Weibull { eta_h, beta: 20.0 });
+        }
+        r
+    };
+    let out = ok(at(1e-6, 1e6)); // F = 1e-240
     let fp = out.results[0].fp_probability.as_ref().unwrap();
     assert!((fp.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{fp:?}");
-    let mut r = paper();
-    r.overrides.clear();
-    r.times_h = vec![1e-10];
-    for c in &mut r.components {
-        c.weibull = Some(Weibull {
-            eta_h: 1e10,
-            beta: 20.0,
-        }); // F = 1e-400 → 0
-    }
-    let out = ok(r);
+    let out = ok(at(1e-10, 1e10)); // F = 1e-400 → 0
     assert!(has_warning(&out, "ZERO_INDEX"));
     assert!(out.results[0].ci.iter().all(|&c| c == 0.0));
 }
