@@ -216,9 +216,11 @@ proptest! {
 
     /// Column permutation permutes φ and leaves predictions unchanged. Two features inducing the
     /// same partition of a node tie, and the tie rule (lower feature index first) then picks a
-    /// different feature after the permutation; continuous features and min_child_weight 8 keep
-    /// such ties out (with ≥ 8 rows per child, two independent uniform features essentially
-    /// never cut a node the same way).
+    /// different feature after the permutation; continuous features and min_child_weight 8 make
+    /// such ties rare, not impossible (a random seed found one: two features cutting a 16-row
+    /// node into the same halves). So the trees are compared first: they must be the permuted
+    /// trees, except from a node where the two chosen splits tie (equal loss change and cover),
+    /// after which φ is not compared.
     #[test]
     fn column_permutation_permutes_phi(seed in any::<u64>()) {
         // Continuous values from a seed (shrinking cannot collapse them into ties).
@@ -236,6 +238,18 @@ proptest! {
             y: ds.y.clone(),
         };
         let (mp, xp) = trained(&permuted, &p);
+        let first_difference = m.trees.iter().zip(&mp.trees).find_map(|(t, tp)| {
+            t.nodes.iter().zip(&tp.nodes).find(|(a, b)| {
+                a.is_leaf() != b.is_leaf()
+                    || (!a.is_leaf() && (a.feature as usize != perm[b.feature as usize] || a.threshold.to_bits() != b.threshold.to_bits()))
+            })
+        });
+        if let Some((a, b)) = first_difference {
+            let tie = !a.is_leaf() && !b.is_leaf() && a.cover.to_bits() == b.cover.to_bits()
+                && (a.loss_change - b.loss_change).abs() <= 1e-12 * a.loss_change.abs().max(1.0);
+            prop_assert!(tie, "the permuted trees differ without a tie: {a:?} vs {b:?}");
+            return Ok(());
+        }
         let tol = 1e-9 * scale(&m);
         for r in [0usize, 5, 17, 39, 77, 119] {
             let (row, rowp) = (x.row(r), xp.row(r));
