@@ -223,10 +223,7 @@ fn degenerate_boundary_conditions_are_typed_errors() {
 /// Random sweep over the hazard draws (fixed seed).
 #[test]
 fn random_hazard_sweep() {
-    let n: usize = std::env::var("STRESS_CASES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(20_000);
+    let n = crate::support::proptest_cfg::stress_cases(20_000);
     let mut rng = ChaCha8Rng::seed_from_u64(0x00ca_11a0);
     let mut ok = 0usize;
     let mut errors = std::collections::BTreeMap::<String, usize>::new();

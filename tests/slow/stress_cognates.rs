@@ -22,12 +22,11 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
 use crate::support::finite::first_null_or_non_finite;
+use crate::support::proptest_cfg;
 
+/// `STRESS_CASES`, default 400.
 fn stress_cases() -> usize {
-    std::env::var("STRESS_CASES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(400)
+    proptest_cfg::stress_cases(400)
 }
 
 const ALL_OPTIONS: &str = r#"{"curves": true, "points_per_circuit": 32, "verify": ["sync", "implicit", "hausdorff"],

@@ -17,12 +17,11 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
 use crate::support::finite::assert_finite;
+use crate::support::proptest_cfg;
 
+/// `STRESS_CASES`, default 300.
 fn stress_cases() -> usize {
-    std::env::var("STRESS_CASES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(300)
+    proptest_cfg::stress_cases(300)
 }
 
 fn train(body: Value) -> Result<TrainResponse, CalcFailure> {

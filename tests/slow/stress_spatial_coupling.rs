@@ -20,13 +20,12 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
 use crate::support::finite::first_null_or_non_finite;
+use crate::support::proptest_cfg;
 use crate::support::spatial_coupling::num;
 
+/// `STRESS_CASES`, default 3000.
 fn stress_cases() -> usize {
-    std::env::var("STRESS_CASES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(3000)
+    proptest_cfg::stress_cases(3000)
 }
 
 const ALL: &str = r#"{"contact": true, "relative_1": true, "relative_2": true, "frames": true,

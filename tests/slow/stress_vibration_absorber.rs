@@ -8,6 +8,7 @@ use std::f64::consts::PI;
 use std::time::Duration;
 
 use crate::support::finite::first_null_or_non_finite;
+use crate::support::proptest_cfg;
 use mechcalc::calc::vibration_absorber::compute::build_model;
 use mechcalc::calc::vibration_absorber::input::{Forcing, FreqRef, VibrationAbsorberInput};
 use mechcalc::calc::vibration_absorber::{VibrationAbsorberRequest, run};
@@ -19,11 +20,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
+/// `STRESS_CASES`, default 60.
 fn stress_cases() -> usize {
-    std::env::var("STRESS_CASES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(60)
+    proptest_cfg::stress_cases(60)
 }
 
 fn request(v: &Value) -> VibrationAbsorberRequest {
