@@ -25,8 +25,8 @@
 )]
 
 use crate::support::spatial_coupling::{
-    answer, close, close_angle, closure_residual, dang, fd_error, fd_error_extrapolated, num,
-    random_config, v3,
+    Differences, answer, close, close_angle, closure_residual, dang, fd_error, num, random_config,
+    v3,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -311,7 +311,12 @@ fn other_assembly_mode_and_di12() {
         EXACT,
         "ω32 flips with σ",
     );
-    let fd = crate::support::spatial_coupling::fd_error(15.0, 15.0, 1.0, -1, 30.0, 1.0);
+    let fd = crate::support::spatial_coupling::fd_error(
+        (15.0, 15.0, 1.0, -1),
+        30.0,
+        1.0,
+        Differences::Central,
+    );
     assert!(fd < 1e-8, "σ = −1 rates vs central differences: {fd:e}");
     close(
         num(&q["di12_dtheta1"]),
@@ -555,7 +560,12 @@ fn rates_match_central_differences_of_positions() {
         } else {
             rng.random_range(-50.0..50.0)
         };
-        let e = fd_error_extrapolated(alpha, beta, a, sigma, t, omega1);
+        let e = fd_error(
+            (alpha, beta, a, sigma),
+            t,
+            omega1,
+            Differences::Extrapolated,
+        );
         // The plain difference's truncation h²/6·f''' grows with 1/|cos 2α|³ and 1/min|D|³ and
         // passes 1e-6 near the sampled min|D|/max|D| = 1e-3: compare with the Richardson
         // extrapolation of h and h/2 (O(h⁴)), whose own error is far below the bound.
@@ -568,7 +578,12 @@ fn rates_match_central_differences_of_positions() {
     eprintln!("worst rate vs extrapolated central differences (h = 1e-5 rad, h/2): {worst:e}");
     // The spec's bound (< 1e-8) on its own validation cases.
     for r in REFERENCE {
-        let e = fd_error(r.alpha, r.beta, r.a, r.sigma, r.theta1 + 7.0, 1.0);
+        let e = fd_error(
+            (r.alpha, r.beta, r.a, r.sigma),
+            r.theta1 + 7.0,
+            1.0,
+            Differences::Central,
+        );
         assert!(
             e < 1e-8,
             "α={} β={} θ1={}: FD error {e:e}",

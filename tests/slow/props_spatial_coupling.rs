@@ -17,7 +17,7 @@ use serde_json::{Value, json};
 
 use crate::support::proptest_cfg::cases;
 use crate::support::spatial_coupling::{
-    answer, closure_residual, cross, dang, dot, fd_error_extrapolated, num, sub, v3,
+    Differences, answer, closure_residual, cross, dang, dot, fd_error, num, sub, v3,
 };
 
 /// α with |cos 2α| ≥ 0.05 (either side of 45°), β giving a valid plane with min|D|/max|D| ≥ 1e-3.
@@ -192,7 +192,7 @@ proptest! {
     /// the plain difference's own truncation error passes the bound).
     #[test]
     fn derivatives_match_central_differences((alpha, beta, a, sigma) in config(), t in -360f64..360.0) {
-        let e = fd_error_extrapolated(alpha, beta, a, sigma, t, 1.0);
+        let e = fd_error((alpha, beta, a, sigma), t, 1.0, Differences::Extrapolated);
         prop_assert!(e < 1e-6, "FD error {e:e}");
     }
 

@@ -176,35 +176,25 @@ pub fn random_config(rng: &mut ChaCha8Rng) -> (f64, f64, f64, i64, f64) {
     }
 }
 
-/// Largest |analytic − central difference| over every rate of one configuration, relative to
-/// the rate's scale, with h = 1e-5 rad (spec §6). The returned positions at θ1 ± h are two
+/// The reference of [`fd_error`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Differences {
+    /// Central differences at h = 1e-5 rad (spec §6).
+    Central,
+    /// Richardson extrapolation of the central differences at h and h/2 (truncation O(h⁴)
+    /// instead of O(h²)): for random configurations, whose truncation error h²/6·f''' grows
+    /// like 1/min|D|³ and passes 1e-6 near the sampled min|D|/max|D| = 1e-3.
+    Extrapolated,
+}
+
+/// Largest |analytic − finite difference| over every rate of one configuration, relative to
+/// the rate's scale, with h = 1e-5 rad. The returned positions at θ1 ± h (and θ1 ± h/2) are
 /// further requests.
-pub fn fd_error(alpha: f64, beta: f64, a: f64, sigma: i64, t: f64, omega1: f64) -> f64 {
-    rate_error(alpha, beta, a, sigma, t, omega1, false)
-}
-
-/// [`fd_error`] against the Richardson extrapolation of the central differences at h and h/2
-/// (truncation O(h⁴) instead of O(h²)): for random configurations, whose truncation error
-/// h²/6·f''' grows like 1/min|D|³ and passes 1e-6 near the sampled min|D|/max|D| = 1e-3.
-pub fn fd_error_extrapolated(
-    alpha: f64,
-    beta: f64,
-    a: f64,
-    sigma: i64,
+pub fn fd_error(
+    (alpha, beta, a, sigma): (f64, f64, f64, i64),
     t: f64,
     omega1: f64,
-) -> f64 {
-    rate_error(alpha, beta, a, sigma, t, omega1, true)
-}
-
-fn rate_error(
-    alpha: f64,
-    beta: f64,
-    a: f64,
-    sigma: i64,
-    t: f64,
-    omega1: f64,
-    extrapolate: bool,
+    differences: Differences,
 ) -> f64 {
     let h_rad: f64 = 1e-5;
     let h = h_rad.to_degrees();
@@ -219,7 +209,10 @@ fn rate_error(
     let c = body(t);
     // (answer at θ1 + s, at θ1 − s, input time between them at ω1) for s = h and, when
     // extrapolating, s = h/2.
-    let fractions: &[f64] = if extrapolate { &[1.0, 0.5] } else { &[1.0] };
+    let fractions: &[f64] = match differences {
+        Differences::Central => &[1.0],
+        Differences::Extrapolated => &[1.0, 0.5],
+    };
     let steps: Vec<(Value, Value, f64)> = fractions
         .iter()
         .map(|f| (body(t + f * h), body(t - f * h), 2.0 * f * h_rad / omega1))
