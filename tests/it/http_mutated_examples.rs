@@ -68,15 +68,6 @@ fn mutations(original: &Value, pointer: &str) -> Vec<Value> {
     out
 }
 
-fn all_numbers_finite(v: &Value) -> bool {
-    match v {
-        Value::Number(n) => n.as_f64().is_some_and(f64::is_finite),
-        Value::Array(a) => a.iter().all(all_numbers_finite),
-        Value::Object(m) => m.values().all(all_numbers_finite),
-        _ => true,
-    }
-}
-
 #[tokio::test]
 async fn mutated_examples_never_give_500() {
     let api = Path::new(env!("CARGO_MANIFEST_DIR")).join("api");
@@ -106,7 +97,9 @@ async fn mutated_examples_never_give_500() {
                 let r = common::post_json_to(AppState::new(config.clone()), endpoint, &body).await;
                 let status = r.status.as_u16();
                 let ok = match status {
-                    200 => r.content_type() == "application/json" && all_numbers_finite(&r.json()),
+                    // JSON text has no NaN: a non-finite number in an answer is the service's
+                    // logged 500 (src/http/finite.rs), which fails below.
+                    200 => r.content_type() == "application/json" && r.json().is_object(),
                     400 | 413 | 422 => r.content_type() == "application/problem+json",
                     _ => false,
                 };

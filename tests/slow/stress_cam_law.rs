@@ -10,7 +10,7 @@ use mechcalc::calc::cam_law::wire::EvaluateRequest;
 use mechcalc::numerics::Budget;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde_json::{Value, json};
+use serde_json::json;
 
 const COEFFICIENT_DRAWS: [f64; 12] = [
     0.0,
@@ -296,16 +296,6 @@ fn falls_and_sign_changes() {
     }
 }
 
-fn all_numbers_finite(v: &Value) -> bool {
-    match v {
-        Value::Number(n) => n.as_f64().is_some_and(f64::is_finite),
-        Value::Array(a) => a.iter().all(all_numbers_finite),
-        Value::Object(o) => o.values().all(all_numbers_finite),
-        Value::Null => false,
-        Value::Bool(_) | Value::String(_) => true,
-    }
-}
-
 /// The endpoint under extreme inputs: a typed failure or an all-finite response.
 #[test]
 fn endpoint_extremes() {
@@ -342,7 +332,10 @@ fn endpoint_extremes() {
         match run(req, &b) {
             Ok(resp) => {
                 let v = serde_json::to_value(&resp).expect("serializes");
-                assert!(all_numbers_finite(&v), "non-finite number in {v}");
+                assert!(
+                    crate::support::finite::all_numbers_finite(&v),
+                    "non-finite number in {v}"
+                );
                 n_ok += 1;
             }
             Err(e) => assert!(

@@ -36,49 +36,11 @@ fn all_outputs(mut r: ComponentImportanceRequest) -> ComponentImportanceRequest 
     r
 }
 
-/// Every number of a response is finite (serde_json would silently write NaN/∞ as null).
+/// Every number of a response is finite (serde_json would silently write NaN/∞ as null), and
+/// each time's ranks are a permutation of 1..n.
 fn assert_finite(resp: &ComponentImportanceResponse) {
-    let mut bad = Vec::new();
-    let mut chk = |what: &str, v: &[f64]| {
-        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-            bad.push(format!("{what}[{i}] = {}", v[i]));
-        }
-    };
-    for (t, r) in resp.results.iter().enumerate() {
-        chk(&format!("t{t} ci"), &r.ci);
-        chk(&format!("t{t} time"), &[r.time_h]);
-        for (name, v) in [
-            ("fp_probability", &r.fp_probability),
-            ("fp_risk", &r.fp_risk),
-            ("fp_probability_raw", &r.fp_probability_raw),
-            ("fp_risk_raw", &r.fp_risk_raw),
-            ("weights_probability", &r.weights_probability),
-            ("weights_risk", &r.weights_risk),
-            ("F", &r.f),
-            ("lambda", &r.lambda_per_h),
-            ("RI", &r.ri_per_h),
-        ] {
-            if let Some(v) = v {
-                chk(&format!("t{t} {name}"), v);
-            }
-        }
-        if let Some(tb) = &r.tail_bound {
-            let v: Vec<f64> = [tb.probability, tb.risk].into_iter().flatten().collect();
-            chk(&format!("t{t} tail_bound"), &v);
-        }
-        if let Some(k) = &r.kendall_tau_b {
-            let v: Vec<f64> = [
-                k.out_degree,
-                k.in_degree,
-                k.betweenness,
-                k.closeness_out,
-                k.pagerank_reversed,
-            ]
-            .into_iter()
-            .flatten()
-            .collect();
-            chk(&format!("t{t} tau"), &v);
-        }
+    crate::support::finite::assert_finite(resp);
+    for r in &resp.results {
         let mut ranks = r.rank.clone();
         ranks.sort_unstable();
         assert_eq!(
@@ -86,32 +48,6 @@ fn assert_finite(resp: &ComponentImportanceResponse) {
             (1..=u32::try_from(r.ci.len()).unwrap()).collect::<Vec<_>>()
         );
     }
-    if let Some(m) = &resp.matrices {
-        for (name, v) in [
-            ("efficiency", &m.efficiency),
-            ("level_weights", &m.level_weights),
-            ("T", &m.t),
-            ("HE_diag", &m.he_diag_display),
-        ] {
-            chk(name, v);
-        }
-        for (name, e) in [("B", &m.edge_betweenness), ("Hc", &m.hc), ("HE", &m.he)] {
-            chk(name, &e.iter().map(|x| x.value).collect::<Vec<_>>());
-        }
-    }
-    if let Some(c) = &resp.centralities {
-        for (name, v) in [
-            ("out", &c.out_degree),
-            ("in", &c.in_degree),
-            ("bc", &c.betweenness),
-            ("cl", &c.closeness_out),
-            ("pr", &c.pagerank_reversed),
-        ] {
-            chk(name, v);
-        }
-    }
-    chk("elapsed", &[resp.meta.elapsed_ms]);
-    assert!(bad.is_empty(), "non-finite outputs: {bad:?}");
 }
 
 fn ok(r: ComponentImportanceRequest) -> ComponentImportanceResponse {
