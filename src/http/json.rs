@@ -151,23 +151,11 @@ impl<T: DeserializeOwned + utoipa::ToSchema + Send + 'static> FromRequest<AppSta
         let inline = bytes.len() <= INLINE_DECODE_BYTES;
         let decode_and_check = move || {
             let v = decode(&bytes)?;
-            let unchecked = super::shape::check(&schema, &bytes)?;
-            Ok((ApiJson(v), unchecked))
-        };
-        let keep = |r: Result<(Self, Vec<(String, String)>), ApiError>| {
-            r.map(|(v, unchecked)| {
-                if !unchecked.is_empty() {
-                    let _ = super::pool::REQUEST_INFO.try_with(|i| {
-                        if let Ok(mut g) = i.unchecked_bounds.lock() {
-                            *g = unchecked;
-                        }
-                    });
-                }
-                v
-            })
+            super::shape::check(&schema, &bytes)?;
+            Ok(ApiJson(v))
         };
         if inline {
-            return keep(decode_and_check());
+            return decode_and_check();
         }
         // A large body takes milliseconds to decode: do it off the threads that serve
         // connections, at most `DECODE_SLOTS` at once.
@@ -175,11 +163,9 @@ impl<T: DeserializeOwned + utoipa::ToSchema + Send + 'static> FromRequest<AppSta
             .acquire()
             .await
             .map_err(|_| ApiError::internal())?;
-        keep(
-            tokio::task::spawn_blocking(decode_and_check)
-                .await
-                .map_err(|_| ApiError::internal())?,
-        )
+        tokio::task::spawn_blocking(decode_and_check)
+            .await
+            .map_err(|_| ApiError::internal())?
     }
 }
 

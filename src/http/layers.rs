@@ -96,7 +96,6 @@ pub async fn log_request(req: Request, next: Next) -> Response {
         route: route.clone(),
         body_bytes,
         progress: None,
-        unchecked_bounds: std::sync::Arc::default(),
     };
     let resp = REQUEST_INFO
         .scope(info, next.run(req).instrument(span))

@@ -271,14 +271,6 @@ where
 {
     let max_bytes = state.config.max_response_bytes;
     let arrived = std::time::Instant::now();
-    let unchecked = pool::REQUEST_INFO
-        .try_with(|i| {
-            i.unchecked_bounds
-                .lock()
-                .map(|g| g.clone())
-                .unwrap_or_default()
-        })
-        .unwrap_or_default();
     let (body, compute, encoding, started) = state
         .pool
         .run(demand, move |budget| {
@@ -286,11 +278,6 @@ where
             // The limit reaches the module, which refuses an oversized answer before computing.
             let budget = &budget.clone().with_max_response_bytes(max_bytes);
             let out = job(budget).map_err(ApiError::from)?;
-            // The module accepted the request: documented bounds it did not check (fields its
-            // mode ignores) still make it invalid.
-            if let Some(e) = shape::bounds_error(&unchecked) {
-                return Err(e);
-            }
             let computed = std::time::Instant::now();
             let body = encode(&out)?;
             drop(out);

@@ -85,9 +85,6 @@ pub struct RequestInfo {
     pub body_bytes: usize,
     /// Progress sink of a streaming request (`Accept: text/event-stream`).
     pub progress: Option<Arc<crate::numerics::budget::ProgressSink>>,
-    /// Documented bounds the request breaks in fields its module may ignore (set by the JSON
-    /// extractor, read by `run_calc`; see [`super::shape::bounds_error`]).
-    pub unchecked_bounds: Arc<std::sync::Mutex<Vec<(String, String)>>>,
 }
 
 /// Where a job runs.

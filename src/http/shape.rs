@@ -102,13 +102,13 @@ fn validator(schema: &str, bounded: bool) -> Compiled {
 
 /// Validates a decoded request's JSON against the shape of schema `schema`; a 422 listing every
 /// offending member by JSON pointer when it does not fit.
-pub fn check(schema: &str, body: &[u8]) -> Result<Vec<(String, String)>, ApiError> {
+pub fn check(schema: &str, body: &[u8]) -> Result<(), ApiError> {
     let Some(v) = validator(schema, false) else {
         // A schema that does not compile is a bug (logged above); the module validator still runs.
-        return Ok(Vec::new());
+        return Ok(());
     };
     let Ok(value) = serde_json::from_slice::<Value>(body) else {
-        return Ok(Vec::new());
+        return Ok(());
     };
     let mut found = Vec::new();
     for e in v.iter_errors(&value).take(20) {
@@ -121,40 +121,7 @@ pub fn check(schema: &str, body: &[u8]) -> Result<Vec<(String, String)>, ApiErro
             Some(a) => a.with_field(pointer, detail),
         });
     }
-    if let Some(e) = err {
-        return Err(e);
-    }
-    Ok(bound_violations(schema, &value))
-}
-
-/// The documented value bounds `value` breaks, as (pointer, detail). The module validators
-/// report these first, with their own codes; what is left here are bounds of fields a module
-/// ignores in the request's mode (for example a scalar that a sweep replaces), which the
-/// document still bounds: [`bounds_error`] turns them into a 422 once the module has accepted
-/// the request, so that no request the document rejects is answered with a 2xx.
-fn bound_violations(schema: &str, value: &Value) -> Vec<(String, String)> {
-    let Some(v) = validator(schema, true) else {
-        return Vec::new();
-    };
-    let mut found = Vec::new();
-    for e in v.iter_errors(value).take(20) {
-        flatten(&e, &mut found);
-    }
-    found
-}
-
-/// The 422 for documented bounds that the module did not check: bounds of fields a module may
-/// ignore in the request's mode, found by the document's own bounded schema after the shape check.
-#[must_use]
-pub fn bounds_error(violations: &[(String, String)]) -> Option<ApiError> {
-    let mut err: Option<ApiError> = None;
-    for (pointer, detail) in violations {
-        err = Some(match err {
-            None => ApiError::invalid_field(pointer.clone(), detail.clone()),
-            Some(a) => a.with_field(pointer.clone(), detail.clone()),
-        });
-    }
-    err
+    err.map_or(Ok(()), Err)
 }
 
 /// (pointer, message) of an error; a failed `oneOf`/`anyOf` is explained by the alternative that
