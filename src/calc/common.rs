@@ -25,6 +25,7 @@ use utoipa::openapi::schema::{ObjectBuilder, Schema, SchemaType, Type};
 
 use super::bounds::Range;
 use super::problem::{CalcFailure, FieldIssue, ProblemClass, Validator};
+use super::rules::CrossRule;
 use crate::numerics::Budget;
 
 /// Bound of every request's `time_limit_ms` \[ms\]: from 1 ms to 10 minutes.
@@ -70,7 +71,9 @@ impl Warning {
 
 /// A sign on the wire: the integer `1` or `-1` (schema `Sign`). What it selects (an assembly
 /// mode, a branch, a side) is stated by the field that carries it.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, crate::calc::Rules,
+)]
 #[serde(try_from = "i64", into = "i64")]
 pub enum Sign {
     /// `1`.
@@ -145,13 +148,17 @@ pub const SHARD_INDEX: Range = Range::int(0, 9_999);
 /// operations), so the answers of shards `0..count`, merged by the rule of the endpoint's
 /// [`ShardOut`], equal the unsharded answer number for number. Budgets (`time_limit_ms`) apply
 /// to each shard on its own.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[serde(deny_unknown_fields)]
 pub struct Shard {
     /// Block computed by this request, 0 ≤ index < count.
+    #[rule(range = SHARD_INDEX)]
     #[schema(example = 0)]
     pub index: u32,
     /// Number of blocks the sweep is split into (1 = the whole sweep).
+    #[rule(range = SHARD_COUNT)]
     #[schema(example = 4)]
     pub count: u32,
 }
@@ -221,6 +228,30 @@ pub struct ShardOut {
     pub end: u64,
     /// Items of the whole (unsharded) sweep.
     pub total: u64,
+}
+
+/// A shard's index lies below its count.
+pub const SHARD_INDEX_BELOW_COUNT: CrossRule = CrossRule::invalid(
+    "SHARD_INDEX_BELOW_COUNT",
+    &["/shard/index", "/shard/count"],
+    "shard.index < shard.count.",
+);
+
+/// The rule between the two fields of a top-level `shard` (their ranges are checked at the door).
+pub fn shard_rule(v: &mut Validator, shard: Option<Shard>) -> Option<Shard> {
+    let s = shard?;
+    v.ensure_rule(
+        s.index < s.count,
+        &SHARD_INDEX_BELOW_COUNT,
+        "/shard/index",
+        || {
+            format!(
+                "shard.index must be below shard.count = {}, got {}",
+                s.count, s.index
+            )
+        },
+    )
+    .then_some(s)
 }
 
 /// Validates an optional top-level `shard` (pointers `/shard/index`, `/shard/count`).
@@ -374,8 +405,18 @@ impl ResponseSize {
 /// Code of an answer that would exceed the service's `--max-response-bytes`.
 pub const RESPONSE_TOO_LARGE: &str = "RESPONSE_TOO_LARGE";
 
-crate::schema_bounds! {
-    Shard { index: SHARD_INDEX, count: SHARD_COUNT },
+/// The answer fits the service's `--max-response-bytes` (every endpoint lists it).
+pub const RESPONSE_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
+    RESPONSE_TOO_LARGE,
+    &[],
+    "The answer, estimated from the request before computing (and measured after encoding), \
+     fits the service's --max-response-bytes; the failure points at the option driving its size.",
+);
+
+/// Empty: the per-field rules of the shared types are declared on the types (`#[rule]`).
+#[must_use]
+pub fn schema_bounds() -> Vec<crate::calc::SchemaBound> {
+    Vec::new()
 }
 
 #[cfg(test)]

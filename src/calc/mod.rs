@@ -19,23 +19,45 @@ pub mod continuum_workspace;
 pub mod irefc;
 pub mod machining_size;
 pub mod problem;
+pub mod rules;
 pub mod spatial_coupling;
 pub mod vibration_absorber;
 
 pub use bounds::{Range, SchemaBound};
 pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validator};
+pub use rules::{CrossRule, Rules};
+
+/// The per-field rules of every request type (`#[rule(...)]`, see [`rules`]), for the OpenAPI
+/// document.
+#[must_use]
+pub fn document_rules() -> rules::DocRules {
+    rules::DocRules::default()
+        .of::<bezier_motion::BezierMotionRequest>()
+        .of::<bus_fuel_economy::BusFuelEconomyRequest>()
+        .of::<bus_fuel_economy::MotorMapRequest>()
+        .of::<cam_law::EvaluateRequest>()
+        .of::<cam_law_fit::FitCamLawRequest>()
+        .of::<cognates::CognatesRequest>()
+        .of::<component_importance::ComponentImportanceRequest>()
+        .of::<continuum_workspace::ContinuumWorkspaceRequest>()
+        .of::<irefc::IrefcStressRequest>()
+        .of::<irefc::IrefcEfficiencyRequest>()
+        .of::<machining_size::TrainRequest>()
+        .of::<machining_size::PredictRequest>()
+        .of::<machining_size::AnalyzeRequest>()
+        .of::<spatial_coupling::SpatialCouplingRequest>()
+        .of::<vibration_absorber::VibrationAbsorberRequest>()
+}
 
 /// Every module's documented request bounds (the `schema_bounds!` tables), for the OpenAPI
 /// document.
 #[must_use]
 pub fn schema_bounds() -> Vec<SchemaBound> {
     [
-        crate::numerics::budget::schema_bounds(),
         common::schema_bounds(),
         bezier_motion::wire::schema_bounds(),
         bus_fuel_economy::wire::schema_bounds(),
         bus_fuel_economy::wire::variant_bounds(),
-        cam_law::wire::schema_bounds(),
         cam_law_fit::wire::schema_bounds(),
         cognates::wire::schema_bounds(),
         cognates::wire::variant_bounds(),

@@ -7,6 +7,7 @@
 use std::fmt::Display;
 
 use super::bounds::Range;
+use super::rules::CrossRule;
 
 /// One offending input field: an RFC 6901 JSON pointer into the request body and what is wrong.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -108,7 +109,7 @@ pub const INVALID_INPUT: &str = "INVALID_INPUT";
 /// ```
 #[derive(Debug)]
 pub struct Validator {
-    issues: Vec<(&'static str, FieldIssue)>,
+    issues: Vec<(&'static str, Option<ProblemClass>, FieldIssue)>,
     /// The code of the plain checks (`push`, `ensure`, `finite`, `all_in`, `range`, `uint`).
     code: &'static str,
     /// The failure's class from its code; `None`: always [`ProblemClass::InvalidInput`].
@@ -173,11 +174,43 @@ impl Validator {
     ) {
         self.issues.push((
             code,
+            None,
             FieldIssue {
                 pointer: pointer.into(),
                 detail: detail.into(),
             },
         ));
+    }
+
+    /// Record a failure of a rule between fields ([`CrossRule`]) at `pointer`: its code, its class.
+    pub fn rule(
+        &mut self,
+        rule: &CrossRule,
+        pointer: impl Into<String>,
+        detail: impl Into<String>,
+    ) {
+        self.issues.push((
+            rule.code,
+            Some(rule.class),
+            FieldIssue {
+                pointer: pointer.into(),
+                detail: detail.into(),
+            },
+        ));
+    }
+
+    /// Record a failure of `rule` at `pointer` unless `ok`; returns `ok`.
+    pub fn ensure_rule(
+        &mut self,
+        ok: bool,
+        rule: &CrossRule,
+        pointer: impl Into<String>,
+        detail: impl FnOnce() -> String,
+    ) -> bool {
+        if !ok {
+            self.rule(rule, pointer, detail());
+        }
+        ok
     }
 
     /// Record a problem at `pointer` unless `ok`; returns `ok`.
@@ -304,7 +337,7 @@ impl Validator {
 
     /// The problems recorded so far.
     pub fn issues(&self) -> impl Iterator<Item = &FieldIssue> {
-        self.issues.iter().map(|(_, i)| i)
+        self.issues.iter().map(|(_, _, i)| i)
     }
 
     /// Move every problem of `other` into this validator.
@@ -328,26 +361,27 @@ impl Validator {
     /// [`ProblemClass::InvalidInput`] (or, for a [`Validator::coded`] validator, the class of
     /// that code).
     pub fn finish(self) -> Result<(), CalcFailure> {
-        let Some(&(code, _)) = self.issues.first() else {
+        let Some(&(code, class, _)) = self.issues.first() else {
             return Ok(());
         };
         let n = self.issues.len();
         let detail = if n == 1 {
-            format!("{} {}", self.issues[0].1.pointer, self.issues[0].1.detail)
+            format!("{} {}", self.issues[0].2.pointer, self.issues[0].2.detail)
         } else {
             format!("{n} fields failed validation")
         };
-        let tag = self.class_of.is_some() && self.issues.iter().any(|(c, _)| *c != code);
+        let tag = self.issues.iter().any(|(c, _, _)| *c != code);
         Err(CalcFailure {
-            class: self
-                .class_of
-                .map_or(ProblemClass::InvalidInput, |f| f(code)),
+            class: class.unwrap_or_else(|| {
+                self.class_of
+                    .map_or(ProblemClass::InvalidInput, |f| f(code))
+            }),
             code,
             detail,
             errors: self
                 .issues
                 .into_iter()
-                .map(|(c, mut issue)| {
+                .map(|(c, _, mut issue)| {
                     if tag {
                         issue.detail = format!("{c}: {}", issue.detail);
                     }

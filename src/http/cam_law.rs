@@ -3,9 +3,8 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::cam_law::{self, wire::EvaluateRequest, wire::EvaluateResponse};
-use crate::calc::common::TimeLimited;
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
+use crate::calc::cam_law::{self, EvaluateInput, wire::EvaluateRequest, wire::EvaluateResponse};
 
 /// Evaluate a cam motion law: s, v, a, jerk at given abscissae, knots, exact peaks and jumps.
 ///
@@ -26,8 +25,10 @@ use crate::calc::common::TimeLimited;
 )]
 pub async fn evaluate(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<EvaluateRequest>,
+    Valid { input, limit, .. }: Valid<EvaluateRequest, EvaluateInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
-    run_calc(&state, limit, move |budget| cam_law::run(req, budget)).await
+    run_calc(&state, limit, move |budget| {
+        cam_law::run_valid(&input, budget)
+    })
+    .await
 }

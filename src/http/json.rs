@@ -1,5 +1,7 @@
-//! The JSON request extractor: content-type check (415), size limit (413), syntax (400) and
-//! data errors (422) with a JSON pointer taken from serde's path.
+//! The door: content-type check (415), size limit (413), one typed parse of the body (400 when it
+//! is not JSON; 422 with serde's JSON pointer for a wrong type, an unknown or missing member),
+//! then every per-field rule the wire types declare ([`crate::calc::rules`]), all before the
+//! request reaches the compute pool.
 
 use std::time::Duration;
 
@@ -10,6 +12,8 @@ use serde::de::DeserializeOwned;
 
 use super::problem::ApiError;
 use super::state::AppState;
+use crate::calc::common::TimeLimited;
+use crate::calc::{CalcFailure, Rules};
 
 /// A JSON request body decoded into `T`, with every failure mapped to problem+json.
 #[derive(Debug)]
@@ -67,32 +71,33 @@ fn missing_field_in(message: &str) -> Option<&str> {
 /// Decode `bytes` as `T`, mapping failures: syntax/EOF → 400, data → 422 with a pointer.
 pub fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
     let mut de = serde_json::Deserializer::from_slice(bytes);
-    let value = serde_path_to_error::deserialize(&mut de).map_err(|err| {
-        let mut pointer = pointer_of(err.path());
-        let inner = err.into_inner();
-        let message = strip_position(&inner.to_string());
-        match inner.classify() {
-            serde_json::error::Category::Data => {
-                if let Some(field) = missing_field_in(&message) {
-                    pointer.push('/');
-                    pointer.push_str(&escape_token(field));
+    let value =
+        serde_path_to_error::deserialize(super::strict::Strict(&mut de)).map_err(|err| {
+            let mut pointer = pointer_of(err.path());
+            let inner = err.into_inner();
+            let message = strip_position(&inner.to_string());
+            match inner.classify() {
+                serde_json::error::Category::Data => {
+                    if let Some(field) = missing_field_in(&message) {
+                        pointer.push('/');
+                        pointer.push_str(&escape_token(field));
+                    }
+                    ApiError::invalid_field(pointer, message)
                 }
-                ApiError::invalid_field(pointer, message)
-            }
-            _ => {
-                let e = ApiError::malformed_json(format!(
-                    "{message} at line {}, column {}",
-                    inner.line(),
-                    inner.column()
-                ));
-                if pointer.is_empty() {
-                    e
-                } else {
-                    e.with_field(pointer, message)
+                _ => {
+                    let e = ApiError::malformed_json(format!(
+                        "{message} at line {}, column {}",
+                        inner.line(),
+                        inner.column()
+                    ));
+                    if pointer.is_empty() {
+                        e
+                    } else {
+                        e.with_field(pointer, message)
+                    }
                 }
             }
-        }
-    })?;
+        })?;
     de.end().map_err(|e| {
         ApiError::malformed_json(format!("trailing characters after the JSON value: {e}"))
     })?;
@@ -120,52 +125,101 @@ fn decode_slots() -> &'static tokio::sync::Semaphore {
     })
 }
 
-impl<T: DeserializeOwned + utoipa::ToSchema + Send + 'static> FromRequest<AppState> for ApiJson<T> {
+/// Read the body: content type, size, time; every failure as problem+json.
+async fn body_bytes(req: Request, state: &AppState) -> Result<Bytes, ApiError> {
+    let ct = req
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .map(|v| v.to_str().unwrap_or("(non-ASCII)").to_owned());
+    match ct.as_deref() {
+        Some(c) if is_json(c) => {}
+        other => return Err(ApiError::unsupported_media_type(other)),
+    }
+    let limit = state.config.max_body_bytes;
+    let timeout_ms = state.config.body_timeout_ms;
+    let read = Bytes::from_request(req, state);
+    tokio::time::timeout(Duration::from_millis(timeout_ms.max(1)), read)
+        .await
+        .map_err(|_| ApiError::request_timeout(timeout_ms))?
+        .map_err(|rejection| {
+            if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE {
+                ApiError::body_too_large(limit)
+            } else {
+                ApiError::malformed_json(format!("could not read the request body: {rejection}"))
+            }
+        })
+}
+
+/// Run `work` on the bytes: inline for a small body (microseconds), else off the threads that
+/// serve connections, at most `DECODE_SLOTS` large bodies at once.
+async fn off_the_connection<R: Send + 'static>(
+    bytes: Bytes,
+    work: impl FnOnce(Bytes) -> Result<R, ApiError> + Send + 'static,
+) -> Result<R, ApiError> {
+    if bytes.len() <= INLINE_DECODE_BYTES {
+        return work(bytes);
+    }
+    let _permit = decode_slots()
+        .acquire()
+        .await
+        .map_err(|_| ApiError::internal())?;
+    tokio::task::spawn_blocking(move || work(bytes))
+        .await
+        .map_err(|_| ApiError::internal())?
+}
+
+/// Decode a body as `T` (one typed parse) and check every per-field rule `T` declares.
+///
+/// # Errors
+/// 400 when the body is not JSON; 422 listing the offending fields.
+pub fn decode_checked<T: DeserializeOwned + Rules>(bytes: &[u8]) -> Result<T, ApiError> {
+    let v: T = decode(bytes)?;
+    crate::calc::rules::check(&v)?;
+    Ok(v)
+}
+
+impl<T: DeserializeOwned + Rules + Send + 'static> FromRequest<AppState> for ApiJson<T> {
     type Rejection = ApiError;
 
     async fn from_request(req: Request, state: &AppState) -> Result<Self, Self::Rejection> {
-        let ct = req
-            .headers()
-            .get(header::CONTENT_TYPE)
-            .map(|v| v.to_str().unwrap_or("(non-ASCII)").to_owned());
-        match ct.as_deref() {
-            Some(c) if is_json(c) => {}
-            other => return Err(ApiError::unsupported_media_type(other)),
-        }
-        let limit = state.config.max_body_bytes;
-        let timeout_ms = state.config.body_timeout_ms;
-        let read = Bytes::from_request(req, state);
-        let bytes = tokio::time::timeout(Duration::from_millis(timeout_ms.max(1)), read)
-            .await
-            .map_err(|_| ApiError::request_timeout(timeout_ms))?
-            .map_err(|rejection| {
-                if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE {
-                    ApiError::body_too_large(limit)
-                } else {
-                    ApiError::malformed_json(format!(
-                        "could not read the request body: {rejection}"
-                    ))
-                }
-            })?;
-        let schema = T::name();
-        let inline = bytes.len() <= INLINE_DECODE_BYTES;
-        let decode_and_check = move || {
-            let v = decode(&bytes)?;
-            super::shape::check(&schema, &bytes)?;
-            Ok(ApiJson(v))
-        };
-        if inline {
-            return decode_and_check();
-        }
-        // A large body takes milliseconds to decode: do it off the threads that serve
-        // connections, at most `DECODE_SLOTS` at once.
-        let _permit = decode_slots()
-            .acquire()
-            .await
-            .map_err(|_| ApiError::internal())?;
-        tokio::task::spawn_blocking(decode_and_check)
-            .await
-            .map_err(|_| ApiError::internal())?
+        let bytes = body_bytes(req, state).await?;
+        off_the_connection(bytes, |b| decode_checked(&b).map(ApiJson)).await
+    }
+}
+
+/// The request of an endpoint through the whole door: decoded (one typed parse), every per-field
+/// rule checked, then converted into the module's validated input `I` (the rules between
+/// fields), all before anything is queued. `limit` is the request's `time_limit_ms`.
+#[derive(Debug)]
+pub struct Valid<R, I> {
+    /// The validated input.
+    pub input: I,
+    /// The request's own time limit.
+    pub limit: Option<Duration>,
+    _wire: std::marker::PhantomData<fn() -> R>,
+}
+
+impl<R, I> FromRequest<AppState> for Valid<R, I>
+where
+    R: DeserializeOwned + Rules + TimeLimited + Send + 'static,
+    I: TryFrom<R, Error = CalcFailure> + Send + 'static,
+{
+    type Rejection = ApiError;
+
+    async fn from_request(req: Request, state: &AppState) -> Result<Self, Self::Rejection> {
+        let bytes = body_bytes(req, state).await?;
+        off_the_connection(bytes, |b| {
+            let wire: R = decode_checked(&b)?;
+            drop(b);
+            let limit = wire.time_limit();
+            let input = I::try_from(wire)?;
+            Ok(Self {
+                input,
+                limit,
+                _wire: std::marker::PhantomData,
+            })
+        })
+        .await
     }
 }
 

@@ -22,10 +22,10 @@ pub mod picture;
 pub mod pool;
 pub mod problem;
 pub mod serve;
-pub mod shape;
 pub mod spatial_coupling;
 pub mod state;
 pub mod stream;
+pub mod strict;
 pub mod telemetry;
 pub mod vibration_absorber;
 
@@ -49,7 +49,7 @@ use utoipa_axum::routes;
 use crate::calc::CalcFailure;
 use crate::numerics::Budget;
 
-pub use json::ApiJson;
+pub use json::{ApiJson, Valid};
 pub use problem::{ApiError, Problem, ProblemField};
 pub use state::AppState;
 
@@ -159,6 +159,17 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(vibration_absorber::analyse))
         .route(routes!(bezier_motion::solve))
         .finish()
+}
+
+/// The rules between fields (and of feasibility) of each POST operation, for the document's
+/// `x-cross-field-rules` (see [`crate::calc::rules::CrossRule`]).
+#[must_use]
+pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRule])> {
+    use crate::calc;
+    vec![(
+        "/v1/cam-law/evaluate",
+        calc::cam_law::input::CROSS_FIELD_RULES,
+    )]
 }
 
 /// The document as utoipa generates it, before [`openapi::document`] completes it.

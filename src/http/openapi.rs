@@ -20,6 +20,7 @@ use utoipa::openapi::path::Paths;
 use utoipa::openapi::{RefOr, schema::Schema};
 use utoipa_axum::router::OpenApiRouter;
 
+use crate::calc::rules::{DocRules, Kind};
 use crate::calc::{Range, SchemaBound};
 
 use super::AppState;
@@ -102,6 +103,7 @@ fn build() -> (Value, Vec<String>) {
             unsigned_32_bit_range(s);
         }
         problems.extend(apply_bounds(schemas, &crate::calc::schema_bounds()));
+        problems.extend(apply_rules(schemas, &crate::calc::document_rules()));
         close_tagged_enums(schemas);
     }
     let request_roots: Vec<String> = doc
@@ -125,6 +127,7 @@ fn build() -> (Value, Vec<String>) {
     {
         allow_null_for_optional_request_fields(schemas, &request_roots);
     }
+    document_cross_field_rules(&mut doc);
     document_alternative_media_types(&mut doc);
     unescape_unit_brackets(&mut doc);
     (doc, problems)
@@ -140,14 +143,23 @@ fn literal_bounds(schemas: &Map<String, Value>) -> Vec<String> {
         };
         for (prop, body) in props {
             for (path, s) in [("", body), ("/items", &body["items"])] {
-                for key in ["minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"] {
+                for key in [
+                    "minimum",
+                    "maximum",
+                    "exclusiveMinimum",
+                    "exclusiveMaximum",
+                    "minItems",
+                    "maxItems",
+                    "minLength",
+                    "maxLength",
+                ] {
                     let Some(v) = s.get(key) else { continue };
                     let unsigned_zero =
                         key == "minimum" && v.as_f64() == Some(0.0) && type_is(s, "integer");
                     if !unsigned_zero {
                         out.push(format!(
-                            "{name}.{prop}{path}: `{key}` is written as a literal; declare it in the \
-                             module's schema_bounds! table"
+                            "{name}.{prop}{path}: `{key}` is written as a literal; declare it as a \
+                             #[rule(...)] on the field"
                         ));
                     }
                 }
@@ -193,6 +205,118 @@ fn apply_bounds(schemas: &mut Map<String, Value>, bounds: &[SchemaBound]) -> Vec
         }
     }
     missing
+}
+
+/// Writes each declared rule ([`crate::calc::rules`]) into its schema; returns the rules whose
+/// place does not exist in the document.
+fn apply_rules(schemas: &mut Map<String, Value>, rules: &DocRules) -> Vec<String> {
+    let mut missing = Vec::new();
+    for r in &rules.rules {
+        let target = schemas.get_mut(r.schema.as_ref()).and_then(|s| {
+            if r.pointer.is_empty() {
+                Some(s)
+            } else {
+                s.pointer_mut(r.pointer)
+            }
+        });
+        let Some(t) = target.and_then(Value::as_object_mut) else {
+            missing.push(format!(
+                "rule for {}{} names no place in the document",
+                r.schema, r.pointer
+            ));
+            continue;
+        };
+        match r.kind {
+            Kind::Range(range) => write_range(t, &range),
+            Kind::Len { min, max, string } => {
+                let (lo, hi) = if string {
+                    ("minLength", "maxLength")
+                } else {
+                    ("minItems", "maxItems")
+                };
+                if let Some(n) = min {
+                    t.insert(lo.to_owned(), json!(n));
+                }
+                if let Some(n) = max {
+                    t.insert(hi.to_owned(), json!(n));
+                }
+            }
+            Kind::OneOf(names) => {
+                let props = t.get("properties").cloned().unwrap_or_else(|| json!({}));
+                let alternatives: Vec<Value> = names
+                    .iter()
+                    .map(|given| {
+                        let mut p = Map::new();
+                        for name in names {
+                            let s = if name == given {
+                                non_null(props.get(*name).cloned().unwrap_or_else(|| json!({})))
+                            } else {
+                                json!({"type": "null"})
+                            };
+                            p.insert((*name).to_owned(), s);
+                        }
+                        json!({"required": [given], "properties": p})
+                    })
+                    .collect();
+                t.insert("oneOf".to_owned(), Value::Array(alternatives));
+            }
+        }
+    }
+    missing
+}
+
+/// The schema of a property without its `null` alternative (the given branch of a `oneOf`).
+fn non_null(mut s: Value) -> Value {
+    let Some(obj) = s.as_object_mut() else {
+        return s;
+    };
+    obj.remove("description");
+    obj.remove("default");
+    obj.remove("example");
+    obj.remove("examples");
+    if let Some(Value::Array(types)) = obj.get_mut("type") {
+        types.retain(|t| t != "null");
+        if types.len() == 1 {
+            let t = types[0].clone();
+            obj.insert("type".to_owned(), t);
+        }
+    }
+    if let Some(Value::Array(alts)) = obj.get_mut("oneOf") {
+        alts.retain(|a| a.get("type") != Some(&json!("null")));
+        if alts.len() == 1 {
+            let only = alts[0].clone();
+            obj.remove("oneOf");
+            if let Some(o) = only.as_object() {
+                for (k, v) in o {
+                    obj.insert(k.clone(), v.clone());
+                }
+            }
+        }
+    }
+    s
+}
+
+/// Each POST operation lists the rules between fields (and of feasibility) that its requests
+/// can break beyond the schema, under `x-cross-field-rules`: `[{code, pointers, rule}]`. A 422
+/// for a request the schema accepts carries one of these codes.
+fn document_cross_field_rules(doc: &mut Value) {
+    let Some(paths) = doc.get_mut("paths").and_then(Value::as_object_mut) else {
+        return;
+    };
+    for (route, rules) in super::cross_field_rules() {
+        let Some(op) = paths
+            .get_mut(route)
+            .and_then(|p| p.get_mut("post"))
+            .and_then(Value::as_object_mut)
+        else {
+            continue;
+        };
+        let list: Vec<Value> = rules
+            .iter()
+            .map(|r| json!({"code": r.code, "pointers": r.pointers, "rule": r.rule}))
+            .collect();
+        op.insert("x-cross-field-rules".to_owned(), Value::Array(list));
+    }
 }
 
 /// A bound as JSON Schema 2020-12 keywords; integer ranges are written as integers.

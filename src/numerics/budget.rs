@@ -309,7 +309,3 @@ pub struct SolverReport {
     /// Wall-clock time spent in the solver \[ms\].
     pub elapsed_ms: f64,
 }
-
-crate::schema_bounds! {
-    SolverReport { elapsed_ms: crate::calc::Range::FINITE.min(0.0) },
-}

@@ -47,23 +47,23 @@ pub const MAX_FACTORS: usize = 201;
 pub const MAX_INERTIAS: usize = 16;
 
 /// Request of `POST /v1/bezier-motion-law`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::BezierMotionRequest)]
 #[serde(deny_unknown_fields)]
 pub struct BezierMotionRequest {
     /// `simulate` (evaluate the law `motion.gamma_rad`) or `optimize` (default: the optimal law,
     /// evaluated beside the reference law `motion.gamma_rad`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub mode: Mode,
     /// The compliant drive.
     pub system: SystemIn,
     /// The move and its Bezier law.
     pub motion: MotionIn,
     /// Optimisation settings (used in `optimize` mode).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub optimize: OptimizeIn,
     /// Optional outputs.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: OutputsIn,
     /// Wall-clock budget of this request \[ms\] (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -78,7 +78,9 @@ impl TimeLimited for BezierMotionRequest {
 }
 
 /// What to compute.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bezier_motion::Mode)]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
@@ -90,7 +92,7 @@ pub enum Mode {
 }
 
 /// The drive: inertia (list or equivalent value), joint stiffness and damping, reducer ratio.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::SystemIn)]
 #[serde(deny_unknown_fields)]
 pub struct SystemIn {
@@ -117,9 +119,10 @@ pub struct SystemIn {
 }
 
 /// The move: total rotation, time, and the Bezier law's shape and free ordinates.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::MotionIn)]
 #[serde(deny_unknown_fields)]
+#[rules(legacy_nulls)]
 pub struct MotionIn {
     /// Total motor rotation `Phi` \[rad\], ≠ 0. Exactly one of this and `Phi_rev`.
     #[serde(rename = "Phi_rad", default, skip_serializing_if = "Option::is_none")]
@@ -173,7 +176,9 @@ fn default_p() -> u64 {
 }
 
 /// How to choose among the zero-energy laws.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bezier_motion::Objective)]
 #[serde(rename_all = "snake_case")]
 pub enum ObjectiveIn {
@@ -187,12 +192,12 @@ pub enum ObjectiveIn {
 }
 
 /// Optimisation settings.
-#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::OptimizeIn)]
 #[serde(deny_unknown_fields)]
 pub struct OptimizeIn {
     /// Secondary objective. Default `min_deviation`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub objective: ObjectiveIn,
     /// Robust extension (not in the paper): also zero the residual energy for `k·(1−δ)` and
     /// `k·(1+δ)` (6 constraints: exact when p ≥ 6). Ignored with a warning in `simulate`.
@@ -202,12 +207,12 @@ pub struct OptimizeIn {
 }
 
 /// Optional outputs.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::OutputsIn)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsIn {
     /// Peak |φ'|, |φ''|, |φ'''|, least velocity and reversal check. Default true.
-    #[serde(default = "yes")]
+    #[serde(default = "yes", deserialize_with = "crate::calc::rules::null_true")]
     pub kinematic_peaks: bool,
     /// Sampled response during and after the move.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -230,26 +235,26 @@ impl Default for OutputsIn {
 }
 
 /// Time-history sampling. Requires `rho_max ≤ 1.6e6` (sub-step budget).
-#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::TimeHistoryIn)]
 #[serde(deny_unknown_fields)]
 pub struct TimeHistoryIn {
     /// Uniform samples on [0, T], both ends included (0 = none).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     #[schema(example = 200)]
     pub n_samples: u64,
     /// Length of the free-vibration window after T \[s\].
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     #[schema(example = 0.5)]
     pub t_after_s: f64,
     /// Samples in (T, T + t_after_s].
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     #[schema(example = 100)]
     pub n_after: u64,
 }
 
 /// Stiffness sensitivity sweep.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::SensitivityIn)]
 #[serde(deny_unknown_fields)]
 pub struct SensitivityIn {

@@ -19,25 +19,25 @@ use crate::numerics::SolverReport;
 // ---------------------------------------------------------------------------------------------
 
 /// Drive-cycle energy and fuel economy of a battery-electric bus for 1..8 motors over 1..16 cycles.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::BusFuelEconomyRequest)]
 #[serde(deny_unknown_fields)]
 pub struct BusFuelEconomyRequest {
     /// Vehicle (defaults: the paper's 12 m bus, Tables 2-3).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub vehicle: VehicleSpec,
     /// Inverter (η_Inv).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub inverter: InverterSpec,
     /// Battery model (default: constant efficiency 1).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub battery: BatterySpec,
     /// Drive cycles: built-in names `manhattan`, `hwfet`, `hdudds` or custom traces (1..16).
     pub cycles: Vec<CycleSpec>,
     /// Traction motors to compare (1..8); the first is the reference of `fe_change_pct`.
     pub motors: Vec<MotorSpec>,
     /// Simulation options.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub options: OptionsSpec,
     /// Simulate only block `index` of `count` near-equal contiguous blocks of the motor × cycle
     /// pairs (motor-major, as `results`): the answers of shards 0..count, merged as `shard` in
@@ -58,9 +58,10 @@ impl crate::calc::common::TimeLimited for BusFuelEconomyRequest {
 }
 
 /// Vehicle of the backward longitudinal model (§3.1, paper eq. 4-5).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::VehicleSpec)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct VehicleSpec {
     /// Curb mass \[kg\].
     #[schema(example = 12500.0)]
@@ -128,9 +129,10 @@ impl Default for VehicleSpec {
 }
 
 /// Inverter (§3.2).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::InverterSpec)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct InverterSpec {
     /// Inverter efficiency η_Inv [-], applied in both power directions (service minimum 0.01).
     #[schema(example = 0.95)]
@@ -144,7 +146,9 @@ impl Default for InverterSpec {
 }
 
 /// Battery model selector (§3.3).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bus_fuel_economy::BatteryModel)]
 #[serde(rename_all = "snake_case")]
 pub enum BatteryModel {
@@ -157,12 +161,12 @@ pub enum BatteryModel {
 }
 
 /// Battery (§3.3). Fields of the other model are rejected.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::BatterySpec)]
 #[serde(deny_unknown_fields)]
 pub struct BatterySpec {
     /// `constant` (default) or `ecm_2rc`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub model: BatteryModel,
     /// constant: battery efficiency η_Bat [-] (default 1.0, service minimum 0.01).
     #[schema(example = 1.0)]
@@ -198,7 +202,7 @@ pub struct BatterySpec {
 }
 
 /// A drive cycle: a built-in name or a custom trace (§3.4).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::CycleSpec)]
 #[serde(untagged)]
 pub enum CycleSpec {
@@ -210,7 +214,7 @@ pub enum CycleSpec {
 
 /// A custom speed trace: 2..200 000 samples, time steps in [0.001, 60] s, speeds in [0, 200] m/s.
 /// Give exactly one of `speed_kmh` and `speed_mps`.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::CustomCycle)]
 #[serde(deny_unknown_fields)]
 pub struct CustomCycle {
@@ -227,7 +231,7 @@ pub struct CustomCycle {
 }
 
 /// Torque envelope given as a table: T_max linear in speed, held constant outside the table.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::EnvelopeTable)]
 #[serde(deny_unknown_fields)]
 pub struct EnvelopeTable {
@@ -238,7 +242,7 @@ pub struct EnvelopeTable {
 }
 
 /// Traction motor (§3.5), selected by `model`.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::MotorSpec)]
 #[serde(tag = "model", rename_all = "snake_case")]
 pub enum MotorSpec {
@@ -266,7 +270,7 @@ impl MotorSpec {
 }
 
 /// Constant-efficiency motor with a torque/power envelope.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::ConstantMotor)]
 #[serde(deny_unknown_fields)]
 pub struct ConstantMotor {
@@ -290,7 +294,7 @@ pub struct ConstantMotor {
 }
 
 /// Motor given by an efficiency map (motoring, optional generating table).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::EfficiencyMapMotor)]
 #[serde(deny_unknown_fields)]
 pub struct EfficiencyMapMotor {
@@ -316,7 +320,7 @@ pub struct EfficiencyMapMotor {
 }
 
 /// Motor given by a total-loss map.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::LossMapMotor)]
 #[serde(deny_unknown_fields)]
 pub struct LossMapMotor {
@@ -340,7 +344,7 @@ pub struct LossMapMotor {
 }
 
 /// Back-EMF measurement from which ψ_m is derived: ψ_m = V_peak_phase / (p·2π·at_rpm/60).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::BackEmf)]
 #[serde(deny_unknown_fields)]
 pub struct BackEmf {
@@ -353,7 +357,7 @@ pub struct BackEmf {
 }
 
 /// AC resistance factor k_AC(f_e, T_w) of the winding (§5.5 item 4).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::AcFactorSpec)]
 #[serde(tag = "model", rename_all = "snake_case")]
 pub enum AcFactorSpec {
@@ -367,13 +371,13 @@ pub enum AcFactorSpec {
 }
 
 /// No AC effect (k_AC = 1).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::NoAcFactor)]
 #[serde(deny_unknown_fields)]
 pub struct NoAcFactor {}
 
 /// k_AC table.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::AcFactorTable)]
 #[serde(deny_unknown_fields)]
 pub struct AcFactorTable {
@@ -384,7 +388,7 @@ pub struct AcFactorTable {
 }
 
 /// Dowell parameters (rectangular conductors in layers).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::DowellSpec)]
 #[serde(deny_unknown_fields)]
 pub struct DowellSpec {
@@ -406,9 +410,10 @@ pub struct DowellSpec {
 }
 
 /// Iron loss P_fe = (k_h ω_e + k_e ω_e²)·|ψ|².
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::IronSpec)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct IronSpec {
     /// Hysteresis coefficient k_h [W/(Wb²·rad/s)] (≥ 0).
     #[schema(example = 3.0)]
@@ -419,9 +424,10 @@ pub struct IronSpec {
 }
 
 /// Mechanical loss P_mech = c_fric ω_m + c_wind ω_m³.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::MechSpec)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct MechSpec {
     /// Friction torque [N·m] (≥ 0).
     #[schema(example = 0.0)]
@@ -432,7 +438,7 @@ pub struct MechSpec {
 }
 
 /// Parametric IPMSM (amplitude-invariant dq model, peak values; §5.5 item 4).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::IpmsmMotor)]
 #[serde(deny_unknown_fields)]
 pub struct IpmsmMotor {
@@ -493,7 +499,9 @@ pub struct IpmsmMotor {
 }
 
 /// Handling of traction demand above the motor envelope (§5.4).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bus_fuel_economy::Mode)]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
@@ -507,7 +515,9 @@ pub enum Mode {
 }
 
 /// Motor terminal power convention (§5.6).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bus_fuel_economy::PowerConvention)]
 #[serde(rename_all = "snake_case")]
 pub enum PowerConvention {
@@ -519,7 +529,9 @@ pub enum PowerConvention {
 }
 
 /// How an `ipmsm` motor's loss is evaluated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bus_fuel_economy::MotorEval)]
 #[serde(rename_all = "snake_case")]
 pub enum MotorEval {
@@ -530,7 +542,9 @@ pub enum MotorEval {
 }
 
 /// Optional, costly outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bus_fuel_economy::OutputKind)]
 #[serde(rename_all = "snake_case")]
 pub enum OutputKind {
@@ -545,7 +559,7 @@ pub enum OutputKind {
 }
 
 /// Grid of a precomputed loss / efficiency map.
-#[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::GridSpec)]
 #[serde(deny_unknown_fields)]
 pub struct GridSpec {
@@ -567,7 +581,7 @@ impl Default for GridSpec {
 }
 
 /// Bins of the operating-point histogram.
-#[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::HistogramSpec)]
 #[serde(deny_unknown_fields)]
 pub struct HistogramSpec {
@@ -589,15 +603,16 @@ impl Default for HistogramSpec {
 }
 
 /// Simulation options (§3.6).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::OptionsSpec)]
 #[serde(deny_unknown_fields)]
+#[rules(legacy_nulls)]
 pub struct OptionsSpec {
     /// Envelope policy: `backward` (default), `clip` or `forward`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub mode: Mode,
     /// `paper` (default, eq. 2-3) or `loss` (additive losses).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub power_convention: PowerConvention,
     /// Split each cycle interval into k equal pieces (1..32; accuracy knob; default 1).
     #[serde(default = "default_substeps")]
@@ -910,17 +925,17 @@ pub struct Echo {
 // ---------------------------------------------------------------------------------------------
 
 /// `POST /v1/bus-fuel-economy/motor-map`: envelope, loss and efficiency maps of one motor.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::MotorMapRequest)]
 #[serde(deny_unknown_fields)]
 pub struct MotorMapRequest {
     /// The motor (any model of the main endpoint).
     pub motor: MotorSpec,
     /// Grid (default 250 rpm × 50 N·m); speeds 0..n_max, torques ±T_max(0) at multiples of the step.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub grid: GridSpec,
     /// Also return the ipmsm loss components and operating modes.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub include_components: bool,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]

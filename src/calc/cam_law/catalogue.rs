@@ -14,7 +14,9 @@ use utoipa::ToSchema;
 use super::law::Sample;
 
 /// A named classic motion law of Appendix A.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cam_law::NamedLaw)]
 #[serde(rename_all = "snake_case")]
 pub enum NamedLaw {

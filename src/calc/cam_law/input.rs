@@ -1,16 +1,91 @@
-//! Validation of an [`EvaluateRequest`] into an [`EvaluateInput`] (spec §2, §8b), collecting every
-//! offending field with its JSON pointer.
+//! The rules between fields of an [`EvaluateRequest`] (spec §2, §8b), turning it into an
+//! [`EvaluateInput`]. Every per-field rule (ranges, lengths, exactly one of `coefficients`/`law`
+//! and of `values`/`grid`) is declared on the wire types and checked at the door; what is left here
+//! is what JSON Schema cannot state, each rule with its own code ([`CROSS_FIELD_RULES`]).
 
 use super::catalogue::NamedLaw;
 use super::law::{
     BoundaryConditions, LawError, LawNotice, MIN_RELATIVE_INTERVAL, Quantity,
     normalize_coefficients,
 };
-use super::wire::{
-    AbscissaIn, BOUNDARY_VALUE, COEFFICIENT, ConstraintsIn, EvaluateRequest, GRID_COUNT,
-    MAX_POINTS, Units,
-};
-use crate::calc::{CalcFailure, Validator};
+use super::wire::{AbscissaIn, ConstraintsIn, EvaluateRequest, Units};
+use crate::calc::{CalcFailure, CrossRule, Validator};
+
+/// The coefficients sum to 1 within [`SUM_TOL`] unless `normalize` is set.
+pub const COEFFICIENT_SUM: CrossRule = CrossRule::invalid(
+    "COEFFICIENT_SUM",
+    &["/coefficients", "/normalize"],
+    "The coefficients sum to 1 within 1e-3, unless `normalize` is true (then any positive sum).",
+);
+/// Both acceleration pulses hold some duration.
+pub const EMPTY_PULSE: CrossRule = CrossRule::invalid(
+    "EMPTY_PULSE",
+    &["/coefficients"],
+    "Both acceleration pulses are non-empty: c0 + c1 + c2 and c4 + c5 + c6 each at least 1e-9 of the sum.",
+);
+/// Abscissae strictly increase; a grid's end lies beyond its start.
+pub const ABSCISSA_ORDER: CrossRule = CrossRule::invalid(
+    "ABSCISSA_ORDER",
+    &["/abscissa/values/*", "/abscissa/grid/end"],
+    "Abscissae strictly increase; a grid's `end` is greater than its `start`.",
+);
+/// The segment has a positive, resolvable length.
+pub const SEGMENT_INTERVAL: CrossRule = CrossRule::invalid(
+    "SEGMENT_INTERVAL",
+    &["/constraints/t_a", "/constraints/t_b"],
+    "t_b > t_a (each defaulting to the first/last abscissa, else 0 and 1), and t_b − t_a exceeds \
+     1e-12·max(|t_a|, |t_b|) so the knots stay distinct.",
+);
+/// Every abscissa lies inside the segment.
+pub const ABSCISSA_OUTSIDE: CrossRule = CrossRule::invalid(
+    "ABSCISSA_OUTSIDE",
+    &[
+        "/abscissa/values/*",
+        "/abscissa/grid/start",
+        "/abscissa/grid/end",
+        "/constraints/t_a",
+        "/constraints/t_b",
+    ],
+    "Every abscissa lies in [t_a, t_b] within 1e-9·(t_b − t_a) (values within that tolerance are clamped).",
+);
+/// Named laws outside the 7-segment class take zero end rates only.
+pub const CLOSED_FORM_RATES: CrossRule = CrossRule::invalid(
+    "CLOSED_FORM_RATES",
+    &[
+        "/law",
+        "/constraints/v_a",
+        "/constraints/v_b",
+        "/constraints/a_a",
+        "/constraints/a_b",
+    ],
+    "A named law outside the 7-segment class (constant_velocity, cubic, polynomial_*, \
+     double_harmonic) requires zero end velocities and accelerations.",
+);
+/// The law's values stay within f64.
+pub const LAW_OVERFLOW: CrossRule = CrossRule::too_large(
+    "LAW_OVERFLOW",
+    &["/constraints"],
+    "The law's peaks stay finite in f64 (a very short interval with a large rise or large end rates overflows).",
+);
+/// The evaluated curves stay within f64.
+pub const NON_FINITE_RESULT: CrossRule = CrossRule::too_large(
+    "NON_FINITE_RESULT",
+    &["/constraints", "/abscissa"],
+    "Every reported number is finite in f64.",
+);
+
+/// The rules between fields of `POST /v1/cam-law/evaluate`, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    COEFFICIENT_SUM,
+    EMPTY_PULSE,
+    ABSCISSA_ORDER,
+    SEGMENT_INTERVAL,
+    ABSCISSA_OUTSIDE,
+    CLOSED_FORM_RATES,
+    LAW_OVERFLOW,
+    NON_FINITE_RESULT,
+    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
+];
 
 /// Coefficients must sum to 1 within this unless `normalize` is set (spec §2).
 pub const SUM_TOL: f64 = 1e-3;
@@ -83,91 +158,49 @@ impl Abscissa {
 }
 
 fn check_abscissa(v: &mut Validator, a: Option<AbscissaIn>) -> Option<Abscissa> {
+    // Exactly one of `values`/`grid`, lengths and ranges: checked at the door.
     let a = a?;
-    match (a.values, a.grid) {
-        (Some(_), Some(_)) => {
-            v.push(
-                "/abscissa",
-                "give exactly one of `values` or `grid`, got both",
+    if let Some(values) = a.values {
+        if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
+            v.rule(
+                &ABSCISSA_ORDER,
+                format!("/abscissa/values/{}", i + 1),
+                format!(
+                    "abscissae must be strictly increasing, got {} after {} at index {i}",
+                    values[i + 1],
+                    values[i]
+                ),
             );
-            None
+            return None;
         }
-        (None, None) => {
-            v.push(
-                "/abscissa",
-                "give exactly one of `values` or `grid`, got neither",
-            );
-            None
-        }
-        (Some(values), None) => {
-            let n = values.len();
-            if !(1..=MAX_POINTS).contains(&n) {
-                v.push(
-                    "/abscissa/values",
-                    format!("must hold 1..={MAX_POINTS} values, got {n}"),
-                );
-                return None;
-            }
-            if !v.all_finite("/abscissa/values", &values) {
-                return None;
-            }
-            if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
-                v.push(
-                    format!("/abscissa/values/{}", i + 1),
-                    format!(
-                        "abscissae must be strictly increasing, got {} after {} at index {i}",
-                        values[i + 1],
-                        values[i]
-                    ),
-                );
-                return None;
-            }
-            Some(Abscissa::Values(values))
-        }
-        (None, Some(g)) => {
-            let ok_start = v.finite("/abscissa/grid/start", g.start);
-            let ok_end = v.finite("/abscissa/grid/end", g.end);
-            let count = v
-                .uint("/abscissa/grid/count", "count", g.count, GRID_COUNT)
-                .then(|| usize::try_from(g.count).ok())
-                .flatten();
-            if ok_start && ok_end && g.end <= g.start {
-                v.push(
-                    "/abscissa/grid/end",
-                    format!("must be > start = {}, got {}", g.start, g.end),
-                );
-                return None;
-            }
-            let count = count?;
-            (ok_start && ok_end).then_some(Abscissa::Grid {
-                start: g.start,
-                end: g.end,
-                count,
-            })
-        }
+        return Some(Abscissa::Values(values));
     }
+    let g = a.grid?;
+    if g.end <= g.start {
+        v.rule(
+            &ABSCISSA_ORDER,
+            "/abscissa/grid/end",
+            format!("must be > start = {}, got {}", g.start, g.end),
+        );
+        return None;
+    }
+    // count ≤ MAX_POINTS (checked at the door): the conversion is exact.
+    let count = usize::try_from(g.count).ok()?;
+    Some(Abscissa::Grid {
+        start: g.start,
+        end: g.end,
+        count,
+    })
 }
 
 /// Validate the coefficients; returns them (as given) and whether a renormalization warning is due.
 fn check_coefficients(v: &mut Validator, c: &[f64], normalize: bool) -> Option<([f64; 7], bool)> {
-    let Ok(arr) = <[f64; 7]>::try_from(c) else {
-        v.push(
-            "/coefficients",
-            format!("must hold exactly 7 numbers c0..c6, got {}", c.len()),
-        );
-        return None;
-    };
-    let mut ok = true;
-    for (i, &x) in arr.iter().enumerate() {
-        let p = format!("/coefficients/{i}");
-        ok &= v.range(&p, &format!("coefficient c{i}"), x, COEFFICIENT);
-    }
-    if !ok {
-        return None;
-    }
+    // Seven non-negative numbers: checked at the door.
+    let arr = <[f64; 7]>::try_from(c).ok()?;
     let sum: f64 = arr.iter().sum();
     if !normalize && (sum - 1.0).abs() > SUM_TOL {
-        v.push(
+        v.rule(
+            &COEFFICIENT_SUM,
             "/coefficients",
             format!("coefficients must sum to 1 within {SUM_TOL} (or set normalize: true), got sum {sum}"),
         );
@@ -176,21 +209,23 @@ fn check_coefficients(v: &mut Validator, c: &[f64], normalize: bool) -> Option<(
     match normalize_coefficients(&arr) {
         Ok(_) => Some((arr, (sum - 1.0).abs() > SUM_SILENT_TOL)),
         Err(LawError::EmptyFirstPulse { area }) => {
-            v.push(
+            v.rule(
+                &EMPTY_PULSE,
                 "/coefficients",
                 format!("the first acceleration pulse (c0, c1, c2) is empty: normalized area {area:e} < 1e-9"),
             );
             None
         }
         Err(LawError::EmptySecondPulse { area }) => {
-            v.push(
+            v.rule(
+                &EMPTY_PULSE,
                 "/coefficients",
                 format!("the second acceleration pulse (c4, c5, c6) is empty: normalized area {area:e} < 1e-9"),
             );
             None
         }
         Err(e) => {
-            v.push("/coefficients", e.to_string());
+            v.rule(&EMPTY_PULSE, "/coefficients", e.to_string());
             None
         }
     }
@@ -203,21 +238,9 @@ fn law(
     req: &EvaluateRequest,
     warnings: &mut Vec<LawNotice>,
 ) -> Option<LawChoice> {
+    // Exactly one of the two: checked at the door.
     match (&req.coefficients, req.law) {
-        (Some(_), Some(_)) => {
-            v.push(
-                "/law",
-                "give exactly one of `coefficients` or `law`, got both",
-            );
-            None
-        }
-        (None, None) => {
-            v.push(
-                "/coefficients",
-                "give exactly one of `coefficients` or `law`, got neither",
-            );
-            None
-        }
+        (Some(_), Some(_)) | (None, None) => None,
         (Some(c), None) => check_coefficients(v, c, req.normalize).map(|(coefficients, warn)| {
             if warn {
                 warnings.push(LawNotice::CoefficientsRenormalized);
@@ -254,14 +277,9 @@ fn boundary(
         a_a: c.a_a.unwrap_or(0.0),
         a_b: c.a_b.unwrap_or(0.0),
     };
+    // Every given value and every abscissa is within BOUNDARY_VALUE (the door), so the defaulted
+    // values are too.
     let mut bc_ok = true;
-    for (name, value) in bc.named_values() {
-        let p = format!("/constraints/{name}");
-        bc_ok &= v.range(&p, name, value, BOUNDARY_VALUE);
-    }
-    if !bc_ok {
-        return (bc, false);
-    }
     let defaulted = |given: Option<f64>, what: &str| {
         if given.is_some() {
             String::new()
@@ -270,7 +288,8 @@ fn boundary(
         }
     };
     if bc.t_b <= bc.t_a {
-        v.push(
+        v.rule(
+            &SEGMENT_INTERVAL,
             "/constraints/t_b",
             format!(
                 "t_b must be > t_a = {}{}, got {}{}",
@@ -282,7 +301,8 @@ fn boundary(
         );
         bc_ok = false;
     } else if bc.t_b - bc.t_a <= MIN_RELATIVE_INTERVAL * bc.t_a.abs().max(bc.t_b.abs()) {
-        v.push(
+        v.rule(
+            &SEGMENT_INTERVAL,
             "/constraints/t_b",
             format!(
                 "t_b - t_a = {:e} is too short to resolve knots at this offset (must exceed {MIN_RELATIVE_INTERVAL:e}·max(|t_a|, |t_b|))",
@@ -305,8 +325,9 @@ fn closed_form_rates(v: &mut Validator, law: Option<&LawChoice>, bc: &BoundaryCo
         ("a_a", bc.a_a),
         ("a_b", bc.a_b),
     ] {
-        v.ensure(
+        v.ensure_rule(
             value == 0.0 || !value.is_finite(),
+            &CLOSED_FORM_RATES,
             format!("/constraints/{name}"),
             || {
                 format!(
@@ -336,17 +357,21 @@ fn abscissa_within(v: &mut Validator, a: &Abscissa, bc: &BoundaryConditions) {
                 } else {
                     String::new()
                 };
-                v.push(
+                v.rule(
+                    &ABSCISSA_OUTSIDE,
                     format!("/abscissa/values/{i}"),
                     format!("abscissa {x} lies outside {}{tail}", range()),
                 );
             }
         }
         Abscissa::Grid { start, end, .. } => {
-            v.ensure(*start >= lo, "/abscissa/grid/start", || {
-                format!("grid start {start} lies outside {}", range())
-            });
-            v.ensure(*end <= hi, "/abscissa/grid/end", || {
+            v.ensure_rule(
+                *start >= lo,
+                &ABSCISSA_OUTSIDE,
+                "/abscissa/grid/start",
+                || format!("grid start {start} lies outside {}", range()),
+            );
+            v.ensure_rule(*end <= hi, &ABSCISSA_OUTSIDE, "/abscissa/grid/end", || {
                 format!("grid end {end} lies outside {}", range())
             });
         }
@@ -358,7 +383,6 @@ impl TryFrom<EvaluateRequest> for EvaluateInput {
 
     fn try_from(req: EvaluateRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let mut warnings = Vec::new();
         let law = law(&mut v, &req, &mut warnings);
         let abscissa = check_abscissa(&mut v, req.abscissa);
@@ -368,18 +392,10 @@ impl TryFrom<EvaluateRequest> for EvaluateInput {
         if let (true, Some(a)) = (bc_ok, &abscissa) {
             abscissa_within(&mut v, a, &bc);
         }
-        if let Some(u) = &req.units {
-            u.validate(&mut v);
-        }
-
         v.finish()?;
-        // `finish` succeeded, so `law` was set (every `None` branch above pushed an issue).
+        // `finish` succeeded and the door admitted exactly one of `coefficients`/`law`.
         let Some(law) = law else {
-            return Err(CalcFailure::general(
-                crate::calc::ProblemClass::InvalidInput,
-                "INVALID_INPUT",
-                "no law given",
-            ));
+            return Err(crate::calc::rules::door_skipped("/coefficients"));
         };
         let requested = req.quantities.unwrap_or_else(|| Quantity::ALL.to_vec());
         let quantities = Quantity::ALL

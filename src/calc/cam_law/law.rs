@@ -142,7 +142,9 @@ impl BoundaryConditions {
 }
 
 /// A quantity of the motion law.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cam_law::Quantity)]
 #[serde(rename_all = "lowercase")]
 pub enum Quantity {

@@ -46,14 +46,24 @@ pub use wire::{EvaluateRequest, EvaluateResponse};
 use crate::calc::CalcFailure;
 use crate::numerics::Budget;
 
-/// Validate, compute and build the wire response of `POST /v1/cam-law/evaluate`.
+/// Compute and build the wire response of `POST /v1/cam-law/evaluate` for a request that passed
+/// the door (per-field rules, then the rules between fields in [`EvaluateInput::try_from`]).
 ///
 /// # Errors
-/// [`CalcFailure`] with every offending field (JSON pointers into the request) for invalid input;
+/// `RESPONSE_TOO_LARGE` before computing when the answer would exceed the budget's limit;
 /// `LAW_OVERFLOW` / `NON_FINITE_RESULT` when the law's values would overflow f64.
+pub fn run_valid(input: &EvaluateInput, budget: &Budget) -> Result<EvaluateResponse, CalcFailure> {
+    output::response_size(input).check(budget)?;
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, out))
+}
+
+/// The whole path of a request without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
+///
+/// # Errors
+/// As the endpoint: every offending field with its JSON pointer, or the calculation's failure.
 pub fn run(req: EvaluateRequest, budget: &Budget) -> Result<EvaluateResponse, CalcFailure> {
-    let input = EvaluateInput::try_from(req)?;
-    output::response_size(&input).check(budget)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, out))
+    crate::calc::rules::check(&req)?;
+    run_valid(&EvaluateInput::try_from(req)?, budget)
 }

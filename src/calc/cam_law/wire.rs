@@ -15,9 +15,10 @@ use crate::calc::Range;
 pub const MAX_POINTS: usize = 200_000;
 
 /// Request of `POST /v1/cam-law/evaluate`: exactly one of `coefficients` or `law`.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law::EvaluateRequest)]
 #[serde(deny_unknown_fields)]
+#[rules(one_of("coefficients", "law"))]
 #[schema(example = json!({
     "coefficients": [0.0645, 0.129, 0.1935, 0.0968, 0.2581, 0.2258, 0.0323],
     "constraints": {"t_a": 0.0, "t_b": 1.0, "s_a": 0.0, "s_b": 1.0, "v_a": 0.2, "v_b": 0.5, "a_a": 1.4, "a_b": 1.2},
@@ -30,7 +31,8 @@ pub struct EvaluateRequest {
     /// ≥ 0 summing to 1 within 1e-3 (renormalized; set `normalize` to accept any positive sum).
     /// Both pulses (c0..c2 and c4..c6) must be non-empty. Exclusive with `law`.
     #[serde(default)]
-    #[schema(min_items = 7, max_items = 7, example = json!([0.0645, 0.129, 0.1935, 0.0968, 0.2581, 0.2258, 0.0323]))]
+    #[rule(items = COEFFICIENT, min_items = 7, max_items = 7)]
+    #[schema(example = json!([0.0645, 0.129, 0.1935, 0.0968, 0.2581, 0.2258, 0.0323]))]
     pub coefficients: Option<Vec<f64>>,
     /// A classic law of spec Appendix A by name. Exclusive with `coefficients`. Laws outside
     /// the 7-segment class (constant_velocity, cubic, polynomial_*, double_harmonic) require zero
@@ -39,7 +41,7 @@ pub struct EvaluateRequest {
     #[schema(nullable = false)]
     pub law: Option<NamedLaw>,
     /// Boundary conditions of the motion segment (paper constraint vector λ).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub constraints: ConstraintsIn,
     /// Where to evaluate the curves; omit it to get only the law's description and peaks.
     #[serde(default)]
@@ -50,7 +52,7 @@ pub struct EvaluateRequest {
     pub quantities: Option<Vec<Quantity>>,
     /// Accept coefficients whose sum is any positive number (renormalized, warning
     /// `coefficients_renormalized`). Default false: the sum must be 1 within 1e-3.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub normalize: bool,
     /// Free-text unit labels, echoed back (spec §2).
     #[serde(default)]
@@ -58,6 +60,7 @@ pub struct EvaluateRequest {
     pub units: Option<Units>,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
 }
@@ -69,45 +72,55 @@ impl crate::calc::common::TimeLimited for EvaluateRequest {
 }
 
 /// Boundary conditions (spec §2). Every field is optional.
-#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law::ConstraintsIn)]
 #[serde(deny_unknown_fields)]
 pub struct ConstraintsIn {
     /// Segment start `t_a` \[x\]. Default: first abscissa (0 without an abscissa).
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 0.0)]
     pub t_a: Option<f64>,
     /// Segment end `t_b` \[x\], `> t_a`. Default: last abscissa (1 without an abscissa).
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 1.0)]
     pub t_b: Option<f64>,
     /// Displacement at the start `s_a` \[U\]. Default 0.
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 0.0)]
     pub s_a: Option<f64>,
     /// Displacement at the end `s_b` \[U\]. Default 1 (unit rise).
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 1.0)]
     pub s_b: Option<f64>,
     /// Velocity at the start `v_a` [U/x]. Default 0.
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 0.2)]
     pub v_a: Option<f64>,
     /// Velocity at the end `v_b` [U/x]. Default 0.
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 0.5)]
     pub v_b: Option<f64>,
     /// Acceleration at the start `a_a` [U/x²]. Default 0.
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 1.4)]
     pub a_a: Option<f64>,
     /// Acceleration at the end `a_b` [U/x²]. Default 0.
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 1.2)]
     pub a_b: Option<f64>,
 }
 
 /// Sample abscissae: exactly one of `values` or `grid`.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law::AbscissaIn)]
 #[serde(deny_unknown_fields)]
+#[rules(one_of("values", "grid"))]
 pub struct AbscissaIn {
     /// Explicit abscissae \[x\], strictly increasing, 1..200 000 values, all inside
     /// `[t_a − 1e-9·Δt, t_b + 1e-9·Δt]` (values within that tolerance are clamped).
     #[serde(default)]
-    #[schema(min_items = 1, max_items = 200000, example = json!([0.0, 0.25, 0.5, 0.75, 1.0]))]
+    #[rule(items = BOUNDARY_VALUE, min_items = 1, max_items = MAX_POINTS)]
+    #[schema(example = json!([0.0, 0.25, 0.5, 0.75, 1.0]))]
     pub values: Option<Vec<f64>>,
     /// Uniform grid `x_k = start + k·(end − start)/(count − 1)`, `k = 0..count−1`.
     #[serde(default)]
@@ -116,52 +129,45 @@ pub struct AbscissaIn {
 }
 
 /// A uniform grid including both ends.
-#[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law::GridIn)]
 #[serde(deny_unknown_fields)]
 pub struct GridIn {
     /// First abscissa \[x\].
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 0.0)]
     pub start: f64,
     /// Last abscissa \[x\], `> start`.
+    #[rule(range = BOUNDARY_VALUE)]
     #[schema(example = 1.0)]
     pub end: f64,
     /// Number of points, 2..200 000.
+    #[rule(range = GRID_COUNT)]
     #[schema(example = 300)]
     pub count: u64,
 }
 
 /// Free-text unit labels (not interpreted).
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cam_law::Units)]
 #[serde(deny_unknown_fields)]
 pub struct Units {
     /// Unit of the abscissa, e.g. "s" or "deg" (at most 32 characters).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(max_length = 32, example = "s")]
+    #[rule(max_length = MAX_UNIT_LABEL)]
+    #[schema(example = "s")]
     pub x: Option<String>,
     /// Unit of the displacement, e.g. "rad" or "mm" (at most 32 characters).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(max_length = 32, example = "rad")]
+    #[rule(max_length = MAX_UNIT_LABEL)]
+    #[schema(example = "rad")]
     pub s: Option<String>,
 }
 
 /// Longest accepted unit label, in characters (the `max_length` of [`Units`]).
 pub const MAX_UNIT_LABEL: usize = 32;
-
-impl Units {
-    /// Report every label longer than [`MAX_UNIT_LABEL`] at `/units/x` or `/units/s`.
-    pub fn validate(&self, v: &mut crate::calc::Validator) {
-        for (name, label) in [("x", &self.x), ("s", &self.s)] {
-            if let Some(l) = label {
-                let n = l.chars().count();
-                v.ensure(n <= MAX_UNIT_LABEL, format!("/units/{name}"), || {
-                    format!("unit label must have at most {MAX_UNIT_LABEL} characters, got {n}")
-                });
-            }
-        }
-    }
-}
 
 /// Warning codes (spec §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
@@ -279,25 +285,3 @@ pub const BOUNDARY_VALUE: Range = Range::FINITE
 pub const COEFFICIENT: Range = Range::FINITE.min(0.0);
 /// Points of a uniform abscissa grid.
 pub const GRID_COUNT: Range = Range::int(2, MAX_POINTS as i64);
-
-// The documented bounds of this module's wire types: the validator (input.rs) checks the same
-// constants, and tests/it/contract_bounds.rs probes both.
-crate::schema_bounds! {
-    EvaluateRequest {
-        coefficients @items: COEFFICIENT,
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    ConstraintsIn {
-        t_a: BOUNDARY_VALUE,
-        t_b: BOUNDARY_VALUE,
-        s_a: BOUNDARY_VALUE,
-        s_b: BOUNDARY_VALUE,
-        v_a: BOUNDARY_VALUE,
-        v_b: BOUNDARY_VALUE,
-        a_a: BOUNDARY_VALUE,
-        a_b: BOUNDARY_VALUE,
-    },
-    GridIn {
-        count: GRID_COUNT,
-    },
-}

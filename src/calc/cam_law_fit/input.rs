@@ -746,9 +746,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
 
     let (initial, fixed_zero, initial_pointer) = check_initial(&req, &mut v);
     let (curve_count, curve_quantities) = check_curves(&req, &mut v);
-    if let Some(u) = &req.units {
-        u.validate(&mut v);
-    }
+    // The unit labels' lengths are checked at the door (`cam_law::Units`).
 
     v.finish()?;
     // Every `None` below was reported above, so `finish` has failed already; these are

@@ -22,7 +22,7 @@ pub const MAX_CURVE_COUNT: u64 = 100_000;
 
 /// Request of `POST /v1/fit-cam-law`: identify the 7 duration coefficients of the general
 /// modified-trapezoidal law from sampled motion of one segment (spec §2).
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::FitCamLawRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
@@ -46,16 +46,16 @@ pub struct FitCamLawRequest {
     pub fit_on: Option<FitQuantity>,
     /// Differentiate a lower channel numerically when the `fit_on` channel is absent
     /// (s → v → a only; second-order differences as numpy `gradient`, spec §3.3). Default false.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub derive_missing: bool,
     /// Boundary conditions of the segment (paper constraint vector λ).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub constraints: FitConstraints,
     /// Distance used by the objective.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub objective: ObjectiveIn,
     /// Optimizer choice and budgets.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub optimizer: OptimizerIn,
     /// Starting coefficients (7 numbers ≥ 0, normalized internally; both pulses c0..c2 and
     /// c4..c6 non-empty). Default all 1/7 (the paper's initial solution). Exclusive with
@@ -75,7 +75,7 @@ pub struct FitCamLawRequest {
     #[schema(min_items = 7, max_items = 7)]
     pub fixed_zero: Option<Vec<bool>>,
     /// Which expensive outputs to compute.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: OutputsIn,
     /// Free-text unit labels, echoed back.
     #[serde(default)]
@@ -94,7 +94,7 @@ impl crate::calc::common::TimeLimited for FitCamLawRequest {
 }
 
 /// Sample abscissae \[x\]: exactly one of `values` or `grid`.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::FitAbscissa)]
 #[serde(deny_unknown_fields)]
 pub struct FitAbscissa {
@@ -110,7 +110,7 @@ pub struct FitAbscissa {
 }
 
 /// A uniform grid including both ends.
-#[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::FitGrid)]
 #[serde(deny_unknown_fields)]
 pub struct FitGrid {
@@ -126,7 +126,7 @@ pub struct FitGrid {
 }
 
 /// Measured channels, each of length N (same as the abscissa).
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::Channels)]
 #[serde(deny_unknown_fields)]
 pub struct Channels {
@@ -142,7 +142,9 @@ pub struct Channels {
 }
 
 /// A measured quantity.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cam_law_fit::FitQuantity)]
 #[serde(rename_all = "snake_case")]
 pub enum FitQuantity {
@@ -155,7 +157,7 @@ pub enum FitQuantity {
 }
 
 /// Boundary conditions of the segment (spec §2). Every field is optional.
-#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::FitConstraints)]
 #[serde(deny_unknown_fields)]
 pub struct FitConstraints {
@@ -188,7 +190,9 @@ pub struct FitConstraints {
 }
 
 /// Distance between model and data (spec §3.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cam_law_fit::MetricName)]
 #[serde(rename_all = "snake_case")]
 pub enum MetricName {
@@ -201,12 +205,12 @@ pub enum MetricName {
 }
 
 /// Objective settings.
-#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::ObjectiveIn)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectiveIn {
     /// `euclidean` (default) or `dtw`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub metric: MetricName,
     /// DTW band radius `w` \[samples\], `0 ≤ w ≤ N`; default 1 (reproduces the paper). Ignored
     /// for `euclidean`.
@@ -216,7 +220,9 @@ pub struct ObjectiveIn {
 }
 
 /// Optimizer (spec §3.5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cam_law_fit::Method)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
@@ -235,12 +241,12 @@ pub enum Method {
 }
 
 /// Optimizer settings and budgets.
-#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::OptimizerIn)]
 #[serde(deny_unknown_fields)]
 pub struct OptimizerIn {
     /// Method (default `auto`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub method: Method,
     /// RNG seed; every stochastic method is reproducible per seed (default 0).
     #[serde(default)]
@@ -274,7 +280,7 @@ pub struct OptimizerIn {
 }
 
 /// GA settings (paper Table 2; spec §3.5.1). Every field is optional.
-#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::GaIn)]
 #[serde(deny_unknown_fields)]
 pub struct GaIn {
@@ -312,7 +318,7 @@ pub struct GaIn {
 }
 
 /// Optional outputs (spec §4).
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::OutputsIn)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsIn {
@@ -332,13 +338,13 @@ pub struct OutputsIn {
 }
 
 /// Dense-curve request.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::CurvesIn)]
 #[serde(deny_unknown_fields)]
 pub struct CurvesIn {
     /// Number of uniformly spaced points over `[t_a, t_b]`, 0..100 000 (0 = none; 1 gives `t_a`).
     #[schema(example = 0)]
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub count: u64,
     /// Quantities to return (default all: s, v, a, j).
     #[serde(default)]

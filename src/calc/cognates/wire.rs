@@ -17,7 +17,9 @@ pub type Point = [f64; 2];
 /// Request of `POST /v1/cognates`: a four-bar with a coupler point, either by dimensions
 /// (`ground`, `crank`, `coupler`, `rocker`, `coupler_point`) or by one drawn configuration
 /// (`joints`), plus an optional snapshot input angle and the optional outputs in `options`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cognates::CognatesRequest)]
 #[serde(deny_unknown_fields)]
 pub struct CognatesRequest {
@@ -55,14 +57,14 @@ pub struct CognatesRequest {
     #[schema(nullable = false, example = 30.0)]
     pub input_angle_deg: Option<f64>,
     /// Reference of `input_angle_deg`: `global` (from +x) or `ground` (from A→B, paper φ).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub angle_reference: AngleReference,
     /// Assembly branch `t1` of the snapshot (1: E left of the directed line D→B). Default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub branch: Option<Sign>,
     /// Optional outputs and knobs.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub options: CognatesOptions,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -77,7 +79,9 @@ impl crate::calc::common::TimeLimited for CognatesRequest {
 }
 
 /// Ground pivots. `A` defaults to `[0, 0]`; give either `B` or `length` (with `angle_deg`).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cognates::GroundSpec)]
 #[serde(deny_unknown_fields)]
 pub struct GroundSpec {
@@ -100,7 +104,7 @@ pub struct GroundSpec {
 }
 
 /// Coupler point P, rigidly attached to the coupler, in exactly one of three forms.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cognates::CouplerPoint)]
 #[serde(try_from = "CouplerPointRaw", untagged)]
 pub enum CouplerPoint {
@@ -113,7 +117,7 @@ pub enum CouplerPoint {
         #[schema(example = 1.56)]
         e: f64,
         /// Coupler side `t2`: 1 when P is left of the directed line D→E. Default 1.
-        #[serde(default)]
+        #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
         side: Sign,
     },
     /// Coupler frame: origin D, x along D→E, y to the left; `k = (u + i·v)/b`.
@@ -133,7 +137,7 @@ pub enum CouplerPoint {
 }
 
 /// Flat form of [`CouplerPoint`] used to decode it with a precise message when forms are mixed.
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, crate::calc::Rules)]
 #[serde(deny_unknown_fields)]
 struct CouplerPointRaw {
     d: Option<f64>,
@@ -181,7 +185,7 @@ impl TryFrom<CouplerPointRaw> for CouplerPoint {
 }
 
 /// One drawn configuration (joints mode).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cognates::JointsSpec)]
 #[serde(deny_unknown_fields)]
 pub struct JointsSpec {
@@ -208,7 +212,9 @@ pub struct JointsSpec {
 }
 
 /// Reference of `input_angle_deg`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cognates::AngleReference)]
 #[serde(rename_all = "snake_case")]
 pub enum AngleReference {
@@ -220,7 +226,9 @@ pub enum AngleReference {
 }
 
 /// Sample spacing on limited-range circuits.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cognates::Spacing)]
 #[serde(rename_all = "snake_case")]
 pub enum Spacing {
@@ -232,7 +240,9 @@ pub enum Spacing {
 }
 
 /// How curves are traced.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cognates::CurveMode)]
 #[serde(rename_all = "snake_case")]
 pub enum CurveMode {
@@ -244,7 +254,9 @@ pub enum CurveMode {
 }
 
 /// A verification method (spec §4.9).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = cognates::VerifyKind)]
 #[serde(rename_all = "snake_case")]
 pub enum VerifyKind {
@@ -257,9 +269,10 @@ pub enum VerifyKind {
 }
 
 /// Optional outputs (off by default, computed only when asked) and accuracy knobs.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cognates::CognatesOptions)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct CognatesOptions {
     /// Return sampled coupler curves of all three mechanisms.
     pub curves: bool,

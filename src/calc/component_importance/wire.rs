@@ -11,7 +11,7 @@ use crate::calc::Range;
 use crate::numerics::SolverReport;
 
 /// Request: one fault graph, one or more operating ages.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::ComponentImportanceRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
@@ -40,13 +40,17 @@ pub struct ComponentImportanceRequest {
     /// Operating ages t at which the importance is evaluated \[h\]; 1–1000 values, each > 0.
     pub times_h: Vec<f64>,
     /// Per-time replacements of the Weibull-derived F_i(t) and RI_i(t) (reproduce paper inputs).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[serde(
+        default,
+        deserialize_with = "crate::calc::rules::null_default",
+        skip_serializing_if = "Vec::is_empty"
+    )]
     pub overrides: Vec<TimeOverride>,
     /// Method options (defaults reproduce the paper).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub options: Options,
     /// Which optional outputs to compute and return.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: Outputs,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -61,7 +65,7 @@ impl crate::calc::common::TimeLimited for ComponentImportanceRequest {
 }
 
 /// One component (node of the fault graph).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::ComponentSpec)]
 #[serde(deny_unknown_fields)]
 pub struct ComponentSpec {
@@ -90,7 +94,7 @@ pub struct ComponentSpec {
 }
 
 /// Weibull parameters.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::Weibull)]
 #[serde(deny_unknown_fields)]
 pub struct Weibull {
@@ -103,7 +107,7 @@ pub struct Weibull {
 }
 
 /// One failure mode of a component (paper Table 5).
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::FailureMode)]
 #[serde(deny_unknown_fields)]
 pub struct FailureMode {
@@ -116,23 +120,33 @@ pub struct FailureMode {
 }
 
 /// Replacements of F_i(t) and RI_i(t) at one time (keys are component ids).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::TimeOverride)]
 #[serde(deny_unknown_fields)]
 pub struct TimeOverride {
     /// The time \[h\]; must be one of `times_h`.
     pub time_h: f64,
     /// Failure probability F_i(t) [–] per id, in [0, 1].
-    #[serde(rename = "F", default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[serde(
+        rename = "F",
+        default,
+        deserialize_with = "crate::calc::rules::null_default",
+        skip_serializing_if = "BTreeMap::is_empty"
+    )]
     pub f: BTreeMap<String, f64>,
     /// Failure-mode risk RI_i(t) [1/h] per id, ≥ 0.
-    #[serde(rename = "RI", default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[serde(
+        rename = "RI",
+        default,
+        deserialize_with = "crate::calc::rules::null_default",
+        skip_serializing_if = "BTreeMap::is_empty"
+    )]
     pub ri: BTreeMap<String, f64>,
 }
 
 /// Constant weights ω_c of the two indices: a pair `[ω_c¹, ω_c²]` (probability, risk) or the
 /// entropy mode `{subjective: [w1, w2], entropy_at_h: t0}` (ω_c = ½(ω_subj + ω_entropy(t0))).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::ConstantWeights)]
 #[serde(untagged)]
 pub enum ConstantWeights {
@@ -149,7 +163,7 @@ impl Default for ConstantWeights {
 }
 
 /// Entropy-based constant weights (spec §3.9).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::EntropyWeights)]
 #[serde(deny_unknown_fields)]
 pub struct EntropyWeights {
@@ -160,7 +174,9 @@ pub struct EntropyWeights {
 }
 
 /// Which simple paths the propagation sum runs over.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = component_importance::PathMethod)]
 #[serde(rename_all = "snake_case")]
 pub enum PathMethod {
@@ -172,7 +188,9 @@ pub enum PathMethod {
 }
 
 /// How hierarchy numbers are assigned.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = component_importance::LevelsMode)]
 #[serde(rename_all = "snake_case")]
 pub enum LevelsMode {
@@ -184,7 +202,9 @@ pub enum LevelsMode {
 }
 
 /// Which edge betweenness is used.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = component_importance::BetweennessMode)]
 #[serde(rename_all = "snake_case")]
 pub enum BetweennessMode {
@@ -196,9 +216,10 @@ pub enum BetweennessMode {
 }
 
 /// Method options. Every field is optional; the defaults reproduce the paper.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::Options)]
 #[serde(deny_unknown_fields)]
+#[rules(legacy_nulls)]
 pub struct Options {
     /// In-degree coefficient Q [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.25.
     #[serde(default = "default_q_in")]
@@ -259,9 +280,10 @@ impl Default for Options {
 }
 
 /// Optional outputs (off by default except the cheap indices).
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::Outputs)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct Outputs {
     /// Return the time-independent structure (B, I, levels, T, Hc, HE): O(n + m) payload.
     pub matrices: bool,

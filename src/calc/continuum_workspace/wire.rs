@@ -11,7 +11,9 @@ use crate::calc::common::{Shard, ShardOut};
 use crate::numerics::SolverReport;
 
 /// What to compute.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::Mode)]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
@@ -24,7 +26,9 @@ pub enum Mode {
 }
 
 /// A named design with ASSUMED geometry (spec 6.2); the response states the geometry.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::PresetName)]
 pub enum PresetName {
     /// Design 1.
@@ -48,7 +52,7 @@ pub enum PresetName {
 }
 
 /// The request.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::ContinuumWorkspaceRequest)]
 #[serde(deny_unknown_fields)]
 pub struct ContinuumWorkspaceRequest {
@@ -106,7 +110,7 @@ pub struct ContinuumWorkspaceRequest {
 
 /// Mechanism design (spec 3.1): either `preset` alone (optionally with `sigma_allow_pa`) or
 /// `actuators` + `rods`.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::DesignRequest)]
 #[serde(deny_unknown_fields)]
 pub struct DesignRequest {
@@ -132,7 +136,7 @@ pub struct DesignRequest {
 }
 
 /// One linear guide.
-#[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::ActuatorRequest)]
 #[serde(deny_unknown_fields)]
 pub struct ActuatorRequest {
@@ -148,7 +152,7 @@ pub struct ActuatorRequest {
 }
 
 /// One rod.
-#[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::RodRequest)]
 #[serde(deny_unknown_fields)]
 pub struct RodRequest {
@@ -187,7 +191,7 @@ pub struct RodRequest {
 }
 
 /// Dead load on the platform.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::LoadRequest)]
 #[serde(deny_unknown_fields)]
 pub struct LoadRequest {
@@ -202,7 +206,7 @@ pub struct LoadRequest {
 }
 
 /// Solver settings (spec 3.2).
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::SolverRequest)]
 #[serde(deny_unknown_fields)]
 pub struct SolverRequest {
@@ -225,7 +229,9 @@ pub struct SolverRequest {
 }
 
 /// Which equilibrium the FK starts from (spec 4.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::StartKind)]
 #[serde(rename_all = "snake_case")]
 pub enum StartKind {
@@ -238,7 +244,7 @@ pub enum StartKind {
 }
 
 /// A solver state for warm starts.
-#[derive(Debug, Clone, Deserialize, Serialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::SolverState)]
 #[serde(deny_unknown_fields)]
 pub struct SolverState {
@@ -247,7 +253,7 @@ pub struct SolverState {
 }
 
 /// FK start.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::StartRequest)]
 #[serde(deny_unknown_fields)]
 pub struct StartRequest {
@@ -283,7 +289,9 @@ pub struct StartRequest {
 }
 
 /// Step control of the continuation from home (spec 4.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::ContinuationKind)]
 #[serde(rename_all = "snake_case")]
 pub enum ContinuationKind {
@@ -298,7 +306,7 @@ pub enum ContinuationKind {
 }
 
 /// Optional FK outputs.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::OutputsRequest)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsRequest {
@@ -317,7 +325,9 @@ pub struct OutputsRequest {
 }
 
 /// Seed of a workspace wave.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::SeedKind)]
 #[serde(rename_all = "snake_case")]
 pub enum SeedKind {
@@ -332,7 +342,7 @@ pub enum SeedKind {
 }
 
 /// Seed of the sweep.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::SeedRequest)]
 #[serde(deny_unknown_fields)]
 pub struct SeedRequest {
@@ -351,7 +361,7 @@ pub struct SeedRequest {
 }
 
 /// Jump limits of one sub-step.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::JumpLimits)]
 #[serde(deny_unknown_fields)]
 pub struct JumpLimits {
@@ -366,7 +376,9 @@ pub struct JumpLimits {
 }
 
 /// Stability test per node.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::StabilityCheckName)]
 #[serde(rename_all = "snake_case")]
 pub enum StabilityCheckName {
@@ -379,7 +391,9 @@ pub enum StabilityCheckName {
 }
 
 /// Rod-crossing limit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::RodCrossing)]
 #[serde(rename_all = "snake_case")]
 pub enum RodCrossing {
@@ -390,7 +404,7 @@ pub enum RodCrossing {
 }
 
 /// Workspace limits.
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::WorkspaceLimits)]
 #[serde(deny_unknown_fields)]
 pub struct WorkspaceLimits {
@@ -409,7 +423,9 @@ pub struct WorkspaceLimits {
 }
 
 /// Area method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = continuum_workspace::AreaMethod)]
 #[serde(rename_all = "snake_case")]
 pub enum AreaMethod {
@@ -420,7 +436,7 @@ pub enum AreaMethod {
 }
 
 /// Workspace sweep settings (spec 4.7).
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::WorkspaceRequest)]
 #[serde(deny_unknown_fields)]
 pub struct WorkspaceRequest {
@@ -491,7 +507,7 @@ pub struct WorkspaceRequest {
 }
 
 /// Assembly-mode search settings (spec 4.6).
-#[derive(Debug, Clone, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = continuum_workspace::AssemblyModesRequest)]
 #[serde(deny_unknown_fields)]
 pub struct AssemblyModesRequest {
@@ -1036,7 +1052,7 @@ pub fn nested_bounds() -> Vec<crate::calc::SchemaBound> {
 }
 
 /// Neighbourhood of the workspace wave: the integer 4 or 8.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, crate::calc::Rules)]
 #[serde(try_from = "u32")]
 pub struct Neighbours(pub u32);
 

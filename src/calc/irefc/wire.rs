@@ -54,7 +54,7 @@ impl Warning {
 }
 
 /// Elastic material of a body.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::Material)]
 #[serde(deny_unknown_fields)]
 pub struct Material {

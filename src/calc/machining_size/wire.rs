@@ -118,9 +118,10 @@ crate::schema_bounds! {
 /// Request of `POST /v1/machining-size/train`: a data set (rows of process factors and the
 /// measured dimension) and XGBoost-style parameters; returns the model, holdout and k-fold
 /// metrics, importances and an optional SHAP summary (spec §2.1).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::TrainRequest)]
 #[serde(deny_unknown_fields)]
+#[rules(legacy_nulls)]
 pub struct TrainRequest {
     /// Column names: 1..200, unique, non-empty.
     #[schema(min_items = 1, max_items = 200)]
@@ -131,13 +132,13 @@ pub struct TrainRequest {
     /// Measured dimension y per row [target unit, e.g. mm]: one per row, not all equal.
     pub target: Vec<f64>,
     /// Boosting parameters (defaults: the paper's Table 2).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub params: TrainParams,
     /// Column dropping and SMOGN.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub preprocessing: PreprocessingIn,
     /// Holdout split and k-fold cross-validation.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub validation: ValidationIn,
     /// Optional outputs: `importance` (default), `shap_summary`, `test_predictions`.
     #[serde(default = "default_outputs")]
@@ -167,9 +168,10 @@ impl TimeLimited for TrainRequest {
 
 /// Boosting parameters; the defaults are the paper's Table 2 (n_estimators 400, max_depth 6,
 /// learning_rate 0.05, colsample_bytree 0.8, reg_alpha 0.05, reg_lambda 0.1).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::TrainParams)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct TrainParams {
     /// Boosting rounds (trees), 1..5000. Default 400.
     pub n_estimators: u32,
@@ -229,7 +231,9 @@ impl Default for TrainParams {
 }
 
 /// Split search of the trees.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = machining_size::TreeMethod)]
 #[serde(rename_all = "snake_case")]
 pub enum TreeMethod {
@@ -241,13 +245,13 @@ pub enum TreeMethod {
 }
 
 /// Preprocessing of the training data (spec §3 step 1).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::PreprocessingIn)]
 #[serde(deny_unknown_fields)]
 pub struct PreprocessingIn {
     /// Remove zero-variance columns before training (paper §3.2). Default true. The model keeps
     /// the original column indices.
-    #[serde(default = "yes")]
+    #[serde(default = "yes", deserialize_with = "crate::calc::rules::null_true")]
     pub drop_constant: bool,
     /// SMOGN resampling of the TRAINING split only (never the test rows). Default none.
     #[serde(default)]
@@ -269,9 +273,10 @@ impl Default for PreprocessingIn {
 }
 
 /// SMOGN options (spec §2.4).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::SmognIn)]
 #[serde(deny_unknown_fields)]
+#[rules(legacy_nulls)]
 pub struct SmognIn {
     /// Relevance control points `[[y, φ], ...]`: at least 2, y strictly increasing
     /// [target unit], φ in [0, 1]. Required (the automatic box-plot relevance fails on
@@ -303,9 +308,10 @@ fn two_percent() -> f64 {
 }
 
 /// Holdout split and cross-validation.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::ValidationIn)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct ValidationIn {
     /// Holdout share, [0, 0.5]. Default 0.2 (the paper's 80/20). The first
     /// ⌊(1 − test_fraction)·n⌋ rows of a seeded permutation train.
@@ -329,7 +335,7 @@ impl Default for ValidationIn {
 }
 
 /// An optional output of `/train`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::TrainOutputKind)]
 #[serde(rename_all = "snake_case")]
 pub enum TrainOutputKind {
@@ -376,7 +382,7 @@ pub struct TrainResponse {
 
 /// Our model document (spec §5): arrays indexed by node id, root 0, leaves have
 /// `left = right = −1`. Prediction = base_score + Σ trees; `x[feature] < threshold` goes left.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::GbdtModel)]
 #[serde(deny_unknown_fields)]
 pub struct GbdtModel {
@@ -400,7 +406,7 @@ pub struct GbdtModel {
 }
 
 /// One tree as parallel arrays indexed by node id (root 0).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::TreeDoc)]
 #[serde(deny_unknown_fields)]
 pub struct TreeDoc {
@@ -414,7 +420,7 @@ pub struct TreeDoc {
     /// Threshold θ per node (finite; `x < θ` goes left; 0 at leaves).
     pub threshold: Vec<f64>,
     /// Direction of a missing value per node (unused in v1: rows are finite).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub default_left: Vec<bool>,
     /// Node value [target unit], |v| ≤ 1e100: the leaf output (already × η) at leaves, the
     /// node's own weight × η at internal nodes.
@@ -422,7 +428,7 @@ pub struct TreeDoc {
     /// Cover (training rows, = hessian sum) per node, ≥ 0.
     pub cover: Vec<f64>,
     /// Loss change Δ of the split per node (0 at leaves) [target unit²].
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub loss_change: Vec<f64>,
 }
 
@@ -661,7 +667,7 @@ pub struct SmognData {
 
 /// Request of `POST /v1/machining-size/predict`: a model (ours, or an XGBoost JSON model) and
 /// rows; optional SHAP values and interaction values (spec §2.2).
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::PredictRequest)]
 #[serde(deny_unknown_fields)]
 pub struct PredictRequest {
@@ -680,14 +686,14 @@ pub struct PredictRequest {
     pub feature_names: Option<Vec<String>>,
     /// SHAP values: `none` (default), `path_dependent` (= XGBoost `pred_contribs`, shap
     /// TreeExplainer without data) or `interventional` (needs `background`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub shap: ShapKind,
     /// Background rows of interventional SHAP, 1..1000; rows × background ≤ 1 000 000.
     #[serde(default)]
     #[schema(nullable = false, min_items = 1, max_items = 1000)]
     pub background: Option<Vec<Vec<f64>>>,
     /// SHAP interaction values (path-dependent; rows ≤ 1000 and rows·d² ≤ 2 000 000).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub interactions: bool,
     /// Wall-clock budget of the request \[ms\], 1..600 000 (capped by the server).
     #[serde(default)]
@@ -728,7 +734,9 @@ pub struct XgboostModel {
 }
 
 /// Kind of SHAP values.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = machining_size::ShapKind)]
 #[serde(rename_all = "snake_case")]
 pub enum ShapKind {
@@ -808,7 +816,7 @@ pub struct ModelSummary {
 
 /// Request of `POST /v1/machining-size/analyze`: the paper's data diagnostics (spec §2.3, §6):
 /// constant columns always; PCA, grey relational grades and a SMOGN preview when asked.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::AnalyzeRequest)]
 #[serde(deny_unknown_fields)]
 pub struct AnalyzeRequest {
@@ -845,9 +853,10 @@ impl TimeLimited for AnalyzeRequest {
 }
 
 /// Grey relational analysis options.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::GraIn)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct GraIn {
     /// Distinguishing coefficient ρ, (0, 1]. Default 0.5.
     pub rho: f64,
@@ -867,7 +876,9 @@ impl Default for GraIn {
 }
 
 /// Normalisation of the GRA series.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = machining_size::GraNormalise)]
 #[serde(rename_all = "snake_case")]
 pub enum GraNormalise {
@@ -879,9 +890,10 @@ pub enum GraNormalise {
 }
 
 /// PCA options.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::PcaIn)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct PcaIn {
     /// Components kept for loadings and the composite score, 1..200; absent → all (more than
     /// the non-constant features → all, with a warning).
@@ -892,9 +904,10 @@ pub struct PcaIn {
 }
 
 /// SMOGN preview options: the SMOGN options plus whether to return the resampled data.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::SmognPreviewIn)]
 #[serde(deny_unknown_fields)]
+#[rules(legacy_nulls)]
 pub struct SmognPreviewIn {
     /// Relevance control points `[[y, φ], ...]`: at least 2, y strictly increasing
     /// [target unit], φ in [0, 1].

@@ -23,7 +23,9 @@ pub type Mat4 = [[f64; 4]; 4];
 /// Request of `POST /v1/spatial-coupling`: the coupling (α, a, β), the input speed, the assembly
 /// mode, and where to evaluate it: single input angles (`theta1_deg`), a uniform `sweep`, or both.
 /// Without either, the default sweep (0°…360°, 721 points) is evaluated.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = spatial_coupling::SpatialCouplingRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
@@ -74,7 +76,7 @@ pub struct SpatialCouplingRequest {
     #[schema(nullable = false, max_items = 100, value_type = Vec<[f64; 3]>)]
     pub body3_points_m: Option<Vec<Vec3>>,
     /// Optional output groups (spec §5); each costs O(1) per point.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: OutputsIn,
     /// Wall-clock limit for this request \[ms\] (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -89,7 +91,9 @@ impl crate::calc::common::TimeLimited for SpatialCouplingRequest {
 }
 
 /// A uniform sweep θ1 = start + k·(end − start)/(n − 1), k = 0…n − 1 (both ends included).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = spatial_coupling::SweepIn)]
 #[serde(deny_unknown_fields)]
 pub struct SweepIn {
@@ -108,9 +112,12 @@ pub struct SweepIn {
 }
 
 /// Output groups (spec §5). The core (θ2, i12, di12/dθ1, ω2, ε2) is always returned.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = spatial_coupling::OutputsIn)]
 #[serde(deny_unknown_fields, default)]
+#[rules(legacy_nulls)]
 pub struct OutputsIn {
     /// Contact point B: position, velocity, speed and the denominator D. Default false.
     pub contact: bool,

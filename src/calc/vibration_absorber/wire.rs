@@ -67,27 +67,27 @@ pub const MAX_HARMONICS: usize = 16;
 
 /// Request of `POST /v1/vibration-absorber`: beam, absorber, actuator, control law, excitation and
 /// the analyses wanted. Every member is optional (spec §2 defaults).
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::VibrationAbsorberRequest)]
 #[serde(deny_unknown_fields)]
 pub struct VibrationAbsorberRequest {
     /// The cantilever.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub beam: BeamIn,
     /// The tuned mass (absorber).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub absorber: AbsorberIn,
     /// The voice-coil actuator between absorber and beam.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub actuator: ActuatorIn,
     /// Configuration and PD law.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub control: ControlIn,
     /// The force on the beam.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub excitation: ExcitationIn,
     /// Optional analyses (none is computed unless asked).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: OutputsIn,
     /// Wall-clock budget of this request \[ms\] (capped by the service).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -97,7 +97,7 @@ pub struct VibrationAbsorberRequest {
 
 /// Uniform Euler–Bernoulli cantilever (spec §2, §3.A). Give `area_m2` and `second_moment_m4`
 /// together, or `section` (rectangle), not both; default section 50 mm × 5 mm.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::BeamIn)]
 #[serde(deny_unknown_fields)]
 pub struct BeamIn {
@@ -137,7 +137,7 @@ pub struct BeamIn {
 }
 
 /// Rectangular cross-section.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::SectionIn)]
 #[serde(deny_unknown_fields)]
 pub struct SectionIn {
@@ -150,7 +150,7 @@ pub struct SectionIn {
 }
 
 /// The absorber: mass, spring and damper between the beam at `position_m` and the mass.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::AbsorberIn)]
 #[serde(deny_unknown_fields)]
 pub struct AbsorberIn {
@@ -182,7 +182,7 @@ pub struct AbsorberIn {
 }
 
 /// Voice-coil actuator: `u = K_c i`, `L_c di/dt = −R i − K_b ṙ + e_c`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::ActuatorIn)]
 #[serde(deny_unknown_fields)]
 pub struct ActuatorIn {
@@ -205,7 +205,9 @@ pub struct ActuatorIn {
 }
 
 /// Configuration of the absorber.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = vibration_absorber::ControlMode)]
 #[serde(rename_all = "snake_case")]
 pub enum ControlMode {
@@ -223,12 +225,12 @@ pub enum ControlMode {
 /// Configuration and PD law. With `active`, the gains come from `kp_v_m` + `kd_v_s_m` when both
 /// are given, else from the tuning (Eq. (7)(8)): `tuning_hz`, or `tuning_mode` (bare-beam `f_k`;
 /// default mode 2).
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::ControlIn)]
 #[serde(deny_unknown_fields)]
 pub struct ControlIn {
     /// Configuration, default `active`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub mode: ControlMode,
     /// Target frequency `f_c` \[Hz\] of the tuning (exclusive with `tuning_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -249,7 +251,9 @@ pub struct ControlIn {
 }
 
 /// Time law of the force.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = vibration_absorber::ExcitationType)]
 #[serde(rename_all = "snake_case")]
 pub enum ExcitationType {
@@ -268,12 +272,16 @@ pub enum ExcitationType {
 /// `resonance_of_mode` (the model's bare-beam `f_k`; default mode 2) and `phase_rad`. Several
 /// harmonics (spec §3.D.4): list them in `harmonics` instead (then `amplitude_n`, `frequency_hz`,
 /// `resonance_of_mode` and `phase_rad` must be absent); `p(t) = Σ_j P_j sin(Ω_j t + φ_j)`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::ExcitationIn)]
 #[serde(deny_unknown_fields)]
 pub struct ExcitationIn {
     /// Time law, default `harmonic`.
-    #[serde(default, rename = "type")]
+    #[serde(
+        default,
+        deserialize_with = "crate::calc::rules::null_default",
+        rename = "type"
+    )]
     pub kind: ExcitationType,
     /// Force abscissa `x_p` \[m\], 0 < x_p ≤ `beam.length_m`, default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -305,7 +313,7 @@ pub struct ExcitationIn {
 
 /// One component `P_j sin(Ω_j t + φ_j)` of a multi-harmonic force. Give exactly one of
 /// `frequency_hz` and `resonance_of_mode`.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::HarmonicIn)]
 #[serde(deny_unknown_fields)]
 pub struct HarmonicIn {
@@ -327,21 +335,21 @@ pub struct HarmonicIn {
 }
 
 /// The optional analyses (spec §5); each is computed only when present / true.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::OutputsIn)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsIn {
     /// Undamped natural frequencies with and without the absorber (Table 2). O(n³).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub natural_frequencies: bool,
     /// Closed-loop eigenvalues, largest real part and stability label. O(N³).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub eigenvalues: bool,
     /// Absorber-only step responses (fixed base): settling time, overshoot, DC gain.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub ava_step: bool,
     /// Return the absorber-only step series too (with `ava_step`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub ava_step_series: bool,
     /// Absorber-only closed-loop FRF `X_a/Ref` on a grid (paper Fig. 6).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -362,7 +370,7 @@ pub struct OutputsIn {
 }
 
 /// Mode-shape sampling.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::ModeShapesIn)]
 #[serde(deny_unknown_fields)]
 pub struct ModeShapesIn {
@@ -382,7 +390,7 @@ pub struct ModeShapesOut {
 }
 
 /// A frequency grid.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::GridIn)]
 #[serde(deny_unknown_fields)]
 pub struct GridIn {
@@ -396,12 +404,12 @@ pub struct GridIn {
     #[schema(example = 400)]
     pub n_points: u32,
     /// Logarithmic spacing (default linear).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub log: bool,
 }
 
 /// Coupled frequency response request.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::FrequencyResponseIn)]
 #[serde(deny_unknown_fields)]
 pub struct FrequencyResponseIn {
@@ -415,7 +423,7 @@ pub struct FrequencyResponseIn {
     #[schema(example = 400)]
     pub n_points: u32,
     /// Logarithmic spacing (default linear).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub log: bool,
     /// Output abscissae `x_o` \[m\], each in [0, `beam.length_m`], at most 64; default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -424,7 +432,7 @@ pub struct FrequencyResponseIn {
 }
 
 /// Time response request.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::TimeResponseIn)]
 #[serde(deny_unknown_fields)]
 pub struct TimeResponseIn {
@@ -442,7 +450,7 @@ pub struct TimeResponseIn {
     pub points_m: Option<Vec<f64>>,
     /// Return the sampled series (the biggest payload): `t_s`, `w_m` per abscissa, and with an
     /// absorber `stroke_m`, with a coil `force_n` and `current_a`, with `active` `voltage_v`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub return_series: bool,
     /// Keep every k-th sample in the series (default 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]

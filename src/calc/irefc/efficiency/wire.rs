@@ -7,7 +7,9 @@ use crate::calc::Range;
 use crate::calc::irefc::wire::{CHI, GeometryOut, R2_MM, RB_MM, Warning, Z2};
 
 /// Loss model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = irefc::efficiency::EfficiencyModel)]
 #[serde(rename_all = "snake_case")]
 pub enum EfficiencyModel {
@@ -34,7 +36,7 @@ impl EfficiencyModel {
 }
 
 /// Optional outputs.
-#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::efficiency::EfficiencyInclude)]
 #[serde(deny_unknown_fields)]
 pub struct EfficiencyInclude {
@@ -43,7 +45,7 @@ pub struct EfficiencyInclude {
 }
 
 /// Request of `POST /v1/irefc-efficiency`. Configuration: carrier input, crown fixed, cam output.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::efficiency::IrefcEfficiencyRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"r2_mm":20,"Z2":26,"chi":1.4,"rb_mm":2,"power_W":1500,"speed_rpm":1500,

@@ -11,7 +11,9 @@ use crate::calc::irefc::wire::{
 use crate::numerics::SolverReport;
 
 /// Single design or the paper's "structured array" sweep.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = irefc::stress::StressMode)]
 #[serde(rename_all = "snake_case")]
 pub enum StressMode {
@@ -22,7 +24,9 @@ pub enum StressMode {
 }
 
 /// Which link carries the output torque.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = irefc::stress::OutputLink)]
 #[serde(rename_all = "snake_case")]
 pub enum OutputLink {
@@ -34,7 +38,9 @@ pub enum OutputLink {
 }
 
 /// How the torque is shared over the elements when an element sits at φ2.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = irefc::stress::LoadSharing)]
 #[serde(rename_all = "snake_case")]
 pub enum LoadSharing {
@@ -57,7 +63,7 @@ impl LoadSharing {
 }
 
 /// Optional outputs; expensive ones are off by default and not computed unless requested.
-#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::StressInclude)]
 #[serde(deny_unknown_fields)]
 pub struct StressInclude {
@@ -72,7 +78,7 @@ pub struct StressInclude {
 }
 
 /// Integer range `from..=to` with step 1.
-#[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::IntRange)]
 #[serde(deny_unknown_fields)]
 pub struct IntRange {
@@ -85,7 +91,7 @@ pub struct IntRange {
 }
 
 /// Real range `from, from + step, … ≤ to` (values computed as from + i·step).
-#[derive(Debug, Clone, Copy, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::StepRange)]
 #[serde(deny_unknown_fields)]
 pub struct StepRange {
@@ -101,7 +107,7 @@ pub struct StepRange {
 }
 
 /// The "structured array": ranges of Z2 and χ, optional lists of rb and r2.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::SweepSpec)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
@@ -117,7 +123,7 @@ pub struct SweepSpec {
 }
 
 /// Request of `POST /v1/irefc-stress`.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::IrefcStressRequest)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"mode":"single","r2_mm":20,"Z2":26,"chi":1.4,"rb_mm":2,"lb_mm":4,"torque_Nm":119.366207,
