@@ -534,9 +534,19 @@ pub fn one_of(
             which.join(", ")
         }
     };
+    // Point at the field to remove (the last one given) or to add (the first one listed).
+    let field = if n == 0 {
+        given[0].0
+    } else {
+        given
+            .iter()
+            .rev()
+            .find(|(_, p)| *p)
+            .map_or(given[0].0, |g| g.0)
+    };
     v.push_code(
         code.unwrap_or(super::INVALID_INPUT),
-        at.pointer(),
+        at.key(field).pointer(),
         format!("give exactly one of {list}, got {got}"),
     );
 }

@@ -76,7 +76,13 @@ pub fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
             let mut pointer = pointer_of(err.path());
             let inner = err.into_inner();
             let message = strip_position(&inner.to_string());
+            // A number beyond f64 is well-formed JSON: a value problem at its pointer, not a 400.
+            let out_of_range = message == "number out of range";
             match inner.classify() {
+                _ if out_of_range => ApiError::invalid_field(
+                    pointer,
+                    "number out of range: not representable as a finite double",
+                ),
                 serde_json::error::Category::Data => {
                     if let Some(field) = missing_field_in(&message) {
                         pointer.push('/');
@@ -277,6 +283,13 @@ mod tests {
         assert_eq!(e.status(), StatusCode::BAD_REQUEST);
         let e = decode::<Outer>(br#"{"items":[]} x"#).unwrap_err();
         assert_eq!(e.status(), StatusCode::BAD_REQUEST);
+    }
+
+    #[test]
+    fn a_number_beyond_f64_is_a_value_problem_at_its_pointer() {
+        let e = decode::<Outer>(br#"{"items":[{"t_b":1e400}]}"#).unwrap_err();
+        assert_eq!(e.status(), StatusCode::UNPROCESSABLE_ENTITY);
+        assert_eq!(e.body().errors[0].pointer, "/items/0/t_b");
     }
 
     #[test]

@@ -185,6 +185,16 @@ pub fn openapi() -> utoipa::openapi::OpenApi {
     serde_json::from_value(openapi::document().clone()).unwrap_or_else(|_| api_parts().0)
 }
 
+/// The OpenAPI document as YAML (`openapi.yaml`, `--print-openapi`): the very document served at
+/// `/openapi.json`, keyword for keyword (a round trip through utoipa's types would drop the
+/// keywords they do not model, such as a `oneOf` beside `properties`).
+///
+/// # Errors
+/// The YAML writer's failure (not expected for a JSON document).
+pub fn openapi_yaml() -> Result<String, serde_norway::Error> {
+    serde_norway::to_string(openapi::document())
+}
+
 /// The whole application. Tests drive it without a socket.
 pub fn app(state: AppState) -> Router {
     let (router, _api) = api_router().0.split_for_parts();
@@ -238,6 +248,9 @@ pub fn respond<T: Serialize>(value: &T) -> Result<Response, ApiError> {
     encode(value).map(json_response)
 }
 
+/// First capacity of an answer's buffer [bytes].
+const ENCODE_CAPACITY: usize = 16 * 1024;
+
 /// The JSON body of a response: checked for non-finite numbers (one allocation-free pass), then
 /// written once into a buffer. Runs inside the compute job, so large answers are encoded on the
 /// bounded compute pool, not on the threads that accept connections.
@@ -247,10 +260,13 @@ pub fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
         tracing::error!(%pointer, "calculation produced a non-finite number");
         return Err(ApiError::internal());
     }
-    serde_json::to_vec(value).map_err(|e| {
+    // Pre-sized: most answers fit, and a large one (tens of KB) doubles a few times at most.
+    let mut body = Vec::with_capacity(ENCODE_CAPACITY);
+    serde_json::to_writer(&mut body, value).map_err(|e| {
         tracing::error!(error = %e, "response serialization failed");
         ApiError::internal()
-    })
+    })?;
+    Ok(body)
 }
 
 /// An `application/json` response from an encoded body.

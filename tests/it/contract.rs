@@ -3,7 +3,9 @@
 //! each problem status the tests provoke) validates against the documented response schema of
 //! that status, with a JSON Schema 2020-12 validator (the `jsonschema` crate). Also: no schema
 //! name is claimed by two Rust types, every bound comes from a table, and the document served at
-//! `/openapi.json` is the one checked here.
+//! `/openapi.json` is the one checked here. And what a generated client relies on: `null` for an
+//! optional field is the same as leaving it out, at every depth; every operation lists the rules
+//! between fields its schema-valid requests can break (`x-cross-field-rules`).
 
 use crate::common;
 
@@ -87,23 +89,9 @@ pub fn violations(doc: &Value, schema: &Value, instance: &Value) -> Vec<String> 
         .collect()
 }
 
-/// Modules whose wire types are still being moved onto the one-source bounds table (schema-name
-/// prefix, and the `api/` folder of their examples). Transitional: the list must end empty.
-pub const PENDING_BOUNDS_TABLE: &[&str] = &[];
-
-/// Whether `name` (a schema name or an `api/` file) belongs to a module of [`PENDING_BOUNDS_TABLE`].
-pub fn pending(name: &str) -> bool {
-    PENDING_BOUNDS_TABLE
-        .iter()
-        .any(|m| name.starts_with(&format!("{m}.")) || name.starts_with(&format!("{m}/")))
-}
-
 #[test]
-fn no_schema_name_is_claimed_twice_and_every_bound_comes_from_a_table() {
-    let problems: Vec<String> = mechcalc::http::openapi::document_problems()
-        .into_iter()
-        .filter(|p| !p.contains("literal") || !pending(p.trim_start()))
-        .collect();
+fn no_schema_name_is_claimed_twice_and_every_rule_comes_from_its_declaration() {
+    let problems: Vec<String> = mechcalc::http::openapi::document_problems();
     assert!(
         problems.is_empty(),
         "OpenAPI problems:\n  {}",
@@ -251,6 +239,243 @@ async fn objects_sent_as_arrays_are_refused() {
                     r.pointers()
                 ));
             }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Status, problem type and pointers of an answer.
+#[derive(Debug)]
+struct Answer {
+    status: u16,
+    pointers: Vec<String>,
+}
+
+async fn post(endpoint: &str, body: &Value) -> Answer {
+    let r = common::post_json(endpoint, body).await;
+    let status = r.status.as_u16();
+    let pointers = if status == 200 {
+        Vec::new()
+    } else {
+        r.pointers()
+    };
+    Answer { status, pointers }
+}
+
+fn resolve<'a>(doc: &'a Value, s: &'a Value) -> &'a Value {
+    let mut s = s;
+    for _ in 0..32 {
+        match s.get("$ref").and_then(Value::as_str) {
+            Some(r) => {
+                s = doc
+                    .pointer(r.trim_start_matches('#'))
+                    .unwrap_or_else(|| panic!("dangling $ref {r}"));
+            }
+            None => return s,
+        }
+    }
+    s
+}
+
+/// The variant of a `oneOf` that `instance` matches (by discriminator, else by validation).
+fn pick_variant<'a>(doc: &'a Value, s: &'a Value, instance: &Value) -> Option<&'a Value> {
+    let variants = s.get("oneOf")?.as_array()?;
+    if let Some(tag) = s
+        .pointer("/discriminator/propertyName")
+        .and_then(Value::as_str)
+    {
+        let v = instance.get(tag)?.as_str()?;
+        let r = s
+            .pointer(&format!("/discriminator/mapping/{v}"))?
+            .as_str()?;
+        return doc.pointer(r.trim_start_matches('#'));
+    }
+    variants
+        .iter()
+        .find(|v| violations(doc, v, instance).is_empty())
+}
+
+/// The wire convention's `time_limit_ms` is accepted at the top level of every operation's
+/// request, documented there with the shared bound [1, 600 000] ms, and enforced: 0 and 600 001
+/// are 422 naming `/time_limit_ms`, the bound's ends are answered like the example itself.
+#[tokio::test]
+async fn every_operation_takes_the_top_level_time_limit() {
+    let doc = doc();
+    let mut failures = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for (file, endpoint, body) in examples() {
+        if !seen.insert(endpoint.clone()) {
+            continue;
+        }
+        let schema = resolve(&doc, &request_schema(&doc, &endpoint)).clone();
+        let prop = resolve(&doc, &schema["properties"]["time_limit_ms"]);
+        if prop["minimum"] != json!(1) || prop["maximum"] != json!(600_000) {
+            failures.push(format!(
+                "{endpoint}: time_limit_ms documented as {prop} (want minimum 1, maximum 600000)"
+            ));
+        }
+        let base = post(&endpoint, &body).await.status;
+        for (ms, want_rejected) in [(0u64, true), (600_001, true), (1, false), (600_000, false)] {
+            let mut b = body.clone();
+            b["time_limit_ms"] = json!(ms);
+            let a = post(&endpoint, &b).await;
+            let named = a.pointers.iter().any(|p| p == "/time_limit_ms");
+            if want_rejected && !(a.status == 422 && named) {
+                failures.push(format!(
+                    "api/{file}: time_limit_ms = {ms} answered {} (pointers {:?}), want 422 at \
+                     /time_limit_ms",
+                    a.status, a.pointers
+                ));
+            }
+            // 1 ms may legitimately run out on a heavy example (a 422 deadline answer); it must
+            // never be rejected as an invalid time_limit_ms.
+            if !want_rejected && (named || (ms == 600_000 && a.status != base)) {
+                failures.push(format!(
+                    "api/{file}: time_limit_ms = {ms} answered {} (pointers {:?}), the example \
+                     alone {base}",
+                    a.status, a.pointers
+                ));
+            }
+        }
+    }
+    let posts = doc["paths"]
+        .as_object()
+        .expect("paths")
+        .iter()
+        .filter(|(_, item)| item.get("post").is_some())
+        .count();
+    assert_eq!(
+        seen.len(),
+        posts,
+        "every POST operation has an api/ example (seen {seen:?})"
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The request with `null` for every optional property the instance leaves out, at every depth
+/// (objects inside lists and inside the chosen `oneOf` alternative too): what a client generated
+/// from the document sends.
+fn with_nulls(doc: &Value, schema: &Value, instance: &Value) -> Value {
+    let s = resolve(doc, schema);
+    // A `oneOf` beside `properties` is a constraint (exactly one of two fields), not alternatives.
+    if s.get("properties").is_none()
+        && let Some(v) = pick_variant(doc, s, instance)
+    {
+        return with_nulls(doc, v, instance);
+    }
+    match instance {
+        Value::Object(obj) => {
+            let mut out = obj.clone();
+            if let Some(props) = s.get("properties").and_then(Value::as_object) {
+                let required: Vec<&str> = s
+                    .get("required")
+                    .and_then(Value::as_array)
+                    .map(|r| r.iter().filter_map(Value::as_str).collect())
+                    .unwrap_or_default();
+                for (name, ps) in props {
+                    match obj.get(name) {
+                        Some(v) => {
+                            out.insert(name.clone(), with_nulls(doc, ps, v));
+                        }
+                        None if !required.contains(&name.as_str()) => {
+                            out.insert(name.clone(), Value::Null);
+                        }
+                        None => {}
+                    }
+                }
+            }
+            Value::Object(out)
+        }
+        Value::Array(items) => match s.get("items") {
+            Some(is) => Value::Array(items.iter().map(|x| with_nulls(doc, is, x)).collect()),
+            None => instance.clone(),
+        },
+        _ => instance.clone(),
+    }
+}
+
+/// The answer fields that hold wall-clock or CPU times (they differ from run to run).
+pub const TIMING_KEYS: &[&str] = &[
+    "elapsed_ms",
+    "elapsed_s",
+    "cpu_ms",
+    "wall_ms",
+    "compute_ms",
+    "compute_us",
+    "timing_ms",
+];
+
+/// An answer without what differs from run to run (wall-clock times).
+fn without_timing(v: &Value) -> Value {
+    match v {
+        Value::Object(m) => Value::Object(
+            m.iter()
+                .filter(|(k, _)| !TIMING_KEYS.contains(&k.as_str()))
+                .map(|(k, x)| (k.clone(), without_timing(x)))
+                .collect(),
+        ),
+        Value::Array(a) => Value::Array(a.iter().map(without_timing).collect()),
+        _ => v.clone(),
+    }
+}
+
+/// A generated client sends `null` for every optional field it does not set: each `api/` example
+/// so completed is accepted and answered exactly like the example itself (timings aside).
+#[tokio::test]
+async fn null_is_absent_for_every_optional_field_at_every_depth() {
+    let doc = doc();
+    let mut failures = Vec::new();
+    for (file, endpoint, body) in examples() {
+        let schema = request_schema(&doc, &endpoint);
+        let nulls = with_nulls(&doc, &schema, &body);
+        assert_ne!(nulls, body, "api/{file}: some optional field is left out");
+        for v in violations(&doc, &schema, &nulls) {
+            failures.push(format!(
+                "api/{file} with nulls: the document refuses it: {v}"
+            ));
+        }
+        let plain = common::post_json(&endpoint, &body).await;
+        let filled = common::post_json(&endpoint, &nulls).await;
+        if filled.status != plain.status {
+            failures.push(format!(
+                "api/{file}: with nulls {} {}, plain {}",
+                filled.status,
+                filled.json(),
+                plain.status
+            ));
+        } else if without_timing(&filled.json()) != without_timing(&plain.json()) {
+            failures.push(format!("api/{file}: the answer changes with nulls"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Every operation lists its rules between fields under `x-cross-field-rules`: each with its own
+/// code (never the generic `INVALID_INPUT`), the fields it relates and one sentence.
+#[test]
+fn every_operation_lists_its_cross_field_rules() {
+    let doc = doc();
+    let mut failures = Vec::new();
+    for (route, item) in doc["paths"].as_object().expect("paths") {
+        let Some(op) = item.get("post") else { continue };
+        let Some(rules) = op.get("x-cross-field-rules").and_then(Value::as_array) else {
+            failures.push(format!("{route}: no x-cross-field-rules"));
+            continue;
+        };
+        let mut codes = std::collections::BTreeSet::new();
+        for r in rules {
+            let code = r["code"].as_str().unwrap_or("");
+            if code.is_empty() || code == "INVALID_INPUT" || !codes.insert(code.to_owned()) {
+                failures.push(format!(
+                    "{route}: rule code `{code}` is empty, generic or repeated"
+                ));
+            }
+            if !r["pointers"].is_array() || r["rule"].as_str().is_none_or(str::is_empty) {
+                failures.push(format!("{route}: rule {code} lacks pointers or a sentence"));
+            }
+        }
+        if !codes.contains("RESPONSE_TOO_LARGE") {
+            failures.push(format!("{route}: RESPONSE_TOO_LARGE is not listed"));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
