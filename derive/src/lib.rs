@@ -452,6 +452,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                 |i| quote!(&self.#i),
                 "",
             )?;
+            let mut one_of_pushes = Vec::new();
             for group in &cr.one_of {
                 let mut entries = Vec::new();
                 let mut wires = Vec::new();
@@ -468,7 +469,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                 }
                 let code = code_tokens(None, cr.code.as_ref());
                 checks.push(quote!(crate::calc::rules::one_of(&[#(#entries),*], #code, __at, __v);));
-                pushes.push(quote!(out.push(&schema, "", crate::calc::rules::Kind::OneOf(&[#(#wires),*]));));
+                one_of_pushes.push(quote!(out.push(&schema, "", crate::calc::rules::Kind::OneOf(&[#(#wires),*]));));
             }
             for f in &specs {
                 checks.push(check_field(f, cr.code.as_ref(), true));
@@ -477,6 +478,8 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                 recursions.push(r);
                 let _ = f.span;
             }
+            // After the fields' own rules, so each alternative carries them.
+            pushes.extend(one_of_pushes);
         }
         Data::Enum(e) => {
             if !cr.one_of.is_empty() {
