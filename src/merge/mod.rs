@@ -137,6 +137,17 @@ impl Sweep {
         }
     }
 
+    /// JSON pointer of the per-item array of a sharded answer.
+    #[must_use]
+    pub const fn items_pointer(self) -> &'static str {
+        match self {
+            Self::IrefcStress => "/records",
+            Self::BusFuelEconomy => "/results",
+            Self::MachiningTrain => "/metrics/cv/folds",
+            Self::ContinuumWorkspace => "/waves",
+        }
+    }
+
     /// What the endpoint splits, for messages.
     #[must_use]
     pub const fn items(self) -> &'static str {
@@ -219,6 +230,16 @@ pub enum MergeError {
         path: &'static str,
         /// What it splits.
         items: &'static str,
+    },
+    /// A shard's answer is an answer of another endpoint.
+    #[error("{name} is not an answer of {path}: it has no {pointer}")]
+    WrongEndpoint {
+        /// The shard.
+        name: String,
+        /// The endpoint.
+        path: &'static str,
+        /// The per-item array it lacks.
+        pointer: &'static str,
     },
     /// A shard's answer is not of the expected shape.
     #[error("{name}: {what}")]
@@ -492,6 +513,13 @@ fn block(sweep: Sweep, f: &ShardFile) -> Result<Block, MergeError> {
             items: sweep.items(),
         });
     };
+    if f.answer.pointer(sweep.items_pointer()).is_none() {
+        return Err(MergeError::WrongEndpoint {
+            name: f.name.clone(),
+            path: sweep.path(),
+            pointer: sweep.items_pointer(),
+        });
+    }
     let field = |k: &str| {
         s.get(k).and_then(Value::as_u64).ok_or_else(|| {
             malformed(format!(
