@@ -651,9 +651,16 @@ fn first_difference(a: &Value, b: &Value, at: &str) -> Option<(String, Value, Va
             .zip(y)
             .enumerate()
             .find_map(|(i, (va, vb))| first_difference(va, vb, &format!("{at}/{i}"))),
-        _ if a.to_string() == b.to_string() => None,
+        // As JSON text: -0.0 and 0.0 differ, as they do in the answers.
+        _ if same_text(a, b) => None,
         _ => Some((at.to_owned(), a.clone(), b.clone())),
     }
+}
+
+/// Whether two values have the same JSON text.
+fn same_text(a: &Value, b: &Value) -> bool {
+    let (x, y) = (a.to_string(), b.to_string());
+    x == y
 }
 
 /// A value as JSON, shortened for a message.
