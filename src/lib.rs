@@ -7,11 +7,14 @@
 //! * [`config`]: flags and environment variables of the binary.
 //! * [`plot`]: SVG pictures of answers (`Accept: image/svg+xml`).
 //! * [`cli`]: `mechcalc run`, one calculation from the command line without a server.
+//! * [`merge`]: the answers of a sweep's shards merged into the unsharded answer
+//!   (`mechcalc merge`).
 
 pub mod calc;
 pub mod cli;
 pub mod config;
 pub mod http;
+pub mod merge;
 pub mod numerics;
 pub mod plot;
 

@@ -27,14 +27,29 @@ struct Cli {
 enum Command {
     /// Run one calculation (or an NDJSON batch) without a server: JSON request in (a file or
     /// standard input), JSON (or `--svg`) out; problem details on stderr and exit code 2 for a
-    /// refused request.
+    /// refused request. `--shard I/N` computes block I of N of a sweep.
     Run(mechcalc::cli::RunArgs),
+    /// Merge the answers of shards 0..N of one sweep (`mechcalc run --shard I/N`) into the
+    /// unsharded answer; missing, duplicated or mismatched shards are refused (exit code 2).
+    Merge(mechcalc::cli::MergeArgs),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    if let Some(Command::Run(args)) = &cli.command {
-        return mechcalc::cli::run(args, cli.config);
+    match &cli.command {
+        Some(Command::Run(args)) => return mechcalc::cli::run(args, cli.config),
+        Some(Command::Merge(args)) => return mechcalc::cli::merge(args),
+        None => {}
+    }
+    if cli.print_openapi {
+        return match mechcalc::http::openapi().to_yaml() {
+            // `mechcalc --print-openapi | head`: a closed pipe ends the output quietly.
+            Ok(y) => mechcalc::cli::write_stdout(y.as_bytes()),
+            Err(e) => {
+                eprintln!("could not render the OpenAPI document: {e}");
+                std::process::ExitCode::FAILURE
+            }
+        };
     }
     match tokio::runtime::Builder::new_multi_thread()
         .enable_all()
@@ -49,18 +64,6 @@ fn main() -> std::process::ExitCode {
 }
 
 async fn serve(cli: Cli) -> std::process::ExitCode {
-    if cli.print_openapi {
-        return match mechcalc::http::openapi().to_yaml() {
-            Ok(y) => {
-                print!("{y}");
-                std::process::ExitCode::SUCCESS
-            }
-            Err(e) => {
-                eprintln!("could not render the OpenAPI document: {e}");
-                std::process::ExitCode::FAILURE
-            }
-        };
-    }
     let config = cli.config;
     let filter = EnvFilter::try_from_env("MECHCALC_LOG").unwrap_or_else(|_| EnvFilter::new("info"));
     if config.log_format == "json" {

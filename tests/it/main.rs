@@ -40,3 +40,4 @@ mod pictures;
 mod progress_stream;
 mod response_size;
 mod sharding;
+mod sweep_cli;

@@ -1,23 +1,21 @@
-//! `shard: {index, count}` on the sweeps: for count ∈ {1, 2, 3, 7} (and, for the continuum
-//! workspace's waves, one more than the waves) the shards' answers, merged by
-//! the rule documented on each answer's `shard` (concatenate the per-item arrays in shard order,
-//! add the counters, recompute the named reductions), equal the unsharded answer exactly — the
-//! per-item numbers compared as JSON text, i.e. bit for bit. Bad shards are 422 with the
-//! field's pointer.
+//! `shard: {index, count}` on the sweeps: for count ∈ {1, 2, 3, 7} and one more than the items
+//! the shards' answers, merged by `mechcalc::merge` (the rule documented on each answer's
+//! `shard`: concatenate the per-item arrays in shard order, add the counters, recompute the
+//! named reductions) and given in reverse order, equal the unsharded answer exactly — every
+//! number compared as JSON text, i.e. bit for bit, timings aside ([`comparable`]). Bad shards
+//! are 422 with the field's pointer.
 
 use crate::common;
 
 use mechcalc::calc::bus_fuel_economy::{self, BusFuelEconomyRequest, BusFuelEconomyResponse};
-use mechcalc::calc::continuum_workspace::wire::{
-    WaveOut, WorkspaceResponse, WorkspaceShardResponse,
-};
+use mechcalc::calc::continuum_workspace::wire::{WorkspaceResponse, WorkspaceShardResponse};
 use mechcalc::calc::continuum_workspace::{
     self, ContinuumWorkspaceRequest, ContinuumWorkspaceResponse,
 };
 use mechcalc::calc::irefc::stress::wire::StressSweepResponse;
 use mechcalc::calc::irefc::{IrefcStressRequest, IrefcStressResponse, run_stress};
-use mechcalc::calc::machining_size::wire::SplitMetrics;
 use mechcalc::calc::machining_size::{self, TrainRequest, TrainResponse};
+use mechcalc::merge::{ShardFile, Sweep, merge};
 use mechcalc::numerics::Budget;
 use serde::Serialize;
 use serde_json::{Value, json};
@@ -30,10 +28,79 @@ fn text<T: Serialize>(v: &T) -> String {
     serde_json::to_string(v).expect("serializable")
 }
 
-fn with_shard(body: &Value, index: u32, count: u32) -> Value {
+pub(crate) fn with_shard(body: &Value, index: u32, count: u32) -> Value {
     let mut b = body.clone();
     b["shard"] = json!({"index": index, "count": count});
     b
+}
+
+/// Members that describe a run rather than the request, and differ between two runs of one
+/// request: wall-clock times everywhere.
+const TIMINGS: [&str; 3] = ["elapsed_ms", "compute_ms", "timing_ms"];
+
+/// The JSON text of an answer of `sweep` without what a merged answer cannot reproduce (the
+/// module docs of `mechcalc::merge`): timings; the IREFC sweep's `meta.threads` (each shard
+/// uses at most as many threads as it has combinations); the continuum workspace's report
+/// counters (every shard repeats the assembly-mode search).
+pub(crate) fn comparable(answer: &Value, sweep: Sweep) -> String {
+    fn strip(v: &mut Value) {
+        match v {
+            Value::Object(m) => {
+                for k in TIMINGS {
+                    m.shift_remove(k);
+                }
+                m.values_mut().for_each(strip);
+            }
+            Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    let mut v = answer.clone();
+    strip(&mut v);
+    let drop: &[(&str, &str)] = match sweep {
+        Sweep::IrefcStress => &[("/meta", "threads")],
+        Sweep::ContinuumWorkspace => &[("/report", "iterations"), ("/report", "evaluations")],
+        _ => &[],
+    };
+    for (parent, key) in drop {
+        let o = v.pointer_mut(parent).and_then(Value::as_object_mut);
+        assert!(
+            o.and_then(|o| o.shift_remove(*key)).is_some(),
+            "{parent}/{key} is in every answer"
+        );
+    }
+    v.to_string()
+}
+
+/// The shards' answers as the merge reads them, in reverse order (any order merges).
+fn files<T: Serialize>(parts: &[T]) -> Vec<ShardFile> {
+    parts
+        .iter()
+        .enumerate()
+        .rev()
+        .map(|(i, p)| ShardFile {
+            name: format!("shard {i}"),
+            answer: serde_json::to_value(p).expect("serializable"),
+        })
+        .collect()
+}
+
+/// Asserts that the library's merge of `parts` equals `whole`, timings aside.
+fn assert_merges<T: Serialize, W: Serialize>(
+    sweep: Sweep,
+    parts: &[T],
+    whole: &W,
+    request: Option<&Value>,
+    count: u32,
+) {
+    let merged = merge(sweep, files(parts), request)
+        .unwrap_or_else(|e| panic!("{sweep:?}, count {count}: {e}"));
+    let whole = serde_json::to_value(whole).expect("serializable");
+    assert_eq!(
+        comparable(&merged, sweep),
+        comparable(&whole, sweep),
+        "{sweep:?}, count {count}: the merged answer"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -41,7 +108,7 @@ fn with_shard(body: &Value, index: u32, count: u32) -> Value {
 // ---------------------------------------------------------------------------------------------
 
 /// 7 × Z2, 6 × χ: 42 combinations, some of them infeasible (undercut at small χ and large Z2).
-fn irefc_body() -> Value {
+pub(crate) fn irefc_body() -> Value {
     json!({"mode": "sweep", "r2_mm": 20, "rb_mm": 2, "torque_Nm": 119.366207, "step_deg": 2,
            "refine": true, "sweep": {"Z2": {"from": 10, "to": 16}, "chi": {"from": 1.05, "to": 1.55, "step": 0.1}}})
 }
@@ -52,25 +119,6 @@ fn irefc(body: &Value) -> StressSweepResponse {
         IrefcStressResponse::Sweep(r) => r,
         IrefcStressResponse::Single(_) => panic!("a sweep request answered as single"),
     }
-}
-
-/// The merge rule of `best`/`worst`: among the shards' picks the largest (worst) or smallest
-/// (best) `sigma_max_MPa`, the lowest index on ties.
-fn pick(parts: &[StressSweepResponse], worst: bool) -> Option<usize> {
-    let mut out: Option<(usize, f64)> = None;
-    for p in parts {
-        let i = if worst { p.worst } else { p.best };
-        let Some(i) = i else { continue };
-        let start = p.shard.as_deref().map_or(0, |s| s.start as usize);
-        let s = p.records[i - start]
-            .sigma_max_mpa
-            .expect("a picked record is valid");
-        let better = out.is_none_or(|(_, o)| if worst { s > o } else { s < o });
-        if better {
-            out = Some((i, s));
-        }
-    }
-    out.map(|o| o.0)
 }
 
 #[test]
@@ -84,11 +132,10 @@ fn irefc_sweep_shards_merge_into_the_whole_sweep() {
         "the sweep mixes valid and invalid"
     );
     assert!(whole.shard.is_none(), "no shard statement without a shard");
-    for count in COUNTS {
+    for count in COUNTS.into_iter().chain([n as u32 + 1]) {
         let parts: Vec<StressSweepResponse> = (0..count)
             .map(|i| irefc(&with_shard(&body, i, count)))
             .collect();
-        let mut records = Vec::new();
         let mut next = 0u64;
         for (i, p) in parts.iter().enumerate() {
             let s = *p
@@ -100,20 +147,10 @@ fn irefc_sweep_shards_merge_into_the_whole_sweep() {
             assert_eq!(s.end - s.start, p.records.len() as u64);
             assert_eq!(p.meta.n_combinations, p.records.len() as u64);
             next = s.end;
-            records.extend(p.records.iter().cloned());
         }
         assert_eq!(next, n as u64, "count {count}: the blocks cover the sweep");
-        assert_eq!(
-            text(&records),
-            text(&whole.records),
-            "count {count}: records"
-        );
-        let sum = |f: fn(&StressSweepResponse) -> u64| parts.iter().map(f).sum::<u64>();
-        assert_eq!(sum(|p| p.n_valid), whole.n_valid);
-        assert_eq!(sum(|p| p.n_invalid), whole.n_invalid);
-        assert_eq!(sum(|p| p.n_not_evaluated), whole.n_not_evaluated);
-        assert_eq!(pick(&parts, true), whole.worst, "count {count}: worst");
-        assert_eq!(pick(&parts, false), whole.best, "count {count}: best");
+        // The picks come from different shards for most counts: the merge compares them.
+        assert_merges(Sweep::IrefcStress, &parts, &whole, None, count);
     }
 }
 
@@ -121,7 +158,7 @@ fn irefc_sweep_shards_merge_into_the_whole_sweep() {
 // Bus: motors × cycles
 // ---------------------------------------------------------------------------------------------
 
-fn bus_body() -> Value {
+pub(crate) fn bus_body() -> Value {
     let motor = |id: &str, eff: f64| {
         json!({"id": id, "model": "constant", "efficiency": eff, "t_peak_nm": 800,
                "p_peak_w": 130000, "n_max_rpm": 5200})
@@ -142,14 +179,11 @@ fn bus_comparison_shards_merge_into_the_whole_comparison() {
     let body = bus_body();
     let whole = bus(&body);
     assert_eq!(whole.results.len(), 9);
-    let comparison = whole.comparison.as_ref().expect("3 motors are compared");
-    let weights = comparison.weights.clone();
-    for count in COUNTS {
+    assert!(whole.comparison.is_some(), "3 motors are compared");
+    for count in COUNTS.into_iter().chain([10]) {
         let parts: Vec<BusFuelEconomyResponse> = (0..count)
             .map(|i| bus(&with_shard(&body, i, count)))
             .collect();
-        let mut results = Vec::new();
-        let mut maps = Vec::new();
         let mut next = 0u64;
         for (i, p) in parts.iter().enumerate() {
             let s = p.shard.expect("a sharded answer says which shard it is");
@@ -160,29 +194,21 @@ fn bus_comparison_shards_merge_into_the_whole_comparison() {
             assert_eq!(s.end - s.start, p.results.len() as u64);
             assert!(p.comparison.is_none(), "a shard cannot compare all motors");
             next = s.end;
-            results.extend(p.results.iter().cloned());
-            maps.extend(p.motor_maps.iter().flatten().cloned());
         }
-        assert_eq!(
-            text(&results),
-            text(&whole.results),
-            "count {count}: results"
-        );
-        assert_eq!(text(&maps), text(&whole.motor_maps), "count {count}: maps");
-        let merged = bus_fuel_economy::merged_comparison(&results, &weights);
-        assert_eq!(
-            text(&merged),
-            text(&whole.comparison),
-            "count {count}: comparison"
-        );
+        assert_merges(Sweep::BusFuelEconomy, &parts, &whole, Some(&body), count);
     }
+    // The comparison needs the request's desirability weights.
+    let parts: Vec<BusFuelEconomyResponse> =
+        (0..2).map(|i| bus(&with_shard(&body, i, 2))).collect();
+    let e = merge(Sweep::BusFuelEconomy, files(&parts), None).expect_err("needs the request");
+    assert!(e.to_string().contains("--request"), "{e}");
 }
 
 // ---------------------------------------------------------------------------------------------
 // Machining size: k-fold cross-validation folds
 // ---------------------------------------------------------------------------------------------
 
-fn train_body() -> Value {
+pub(crate) fn train_body() -> Value {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("api/machining_size/train_synthetic.json");
     let mut b: Value =
@@ -204,11 +230,10 @@ fn machining_cv_fold_shards_merge_into_the_whole_cross_validation() {
     let whole = train(&body);
     let cv = whole.metrics.cv.as_ref().expect("7-fold CV finished");
     assert_eq!((cv.k, cv.folds.len()), (7, 7));
-    for count in COUNTS {
+    for count in COUNTS.into_iter().chain([8]) {
         let parts: Vec<TrainResponse> = (0..count)
             .map(|i| train(&with_shard(&body, i, count)))
             .collect();
-        let mut folds: Vec<SplitMetrics> = Vec::new();
         let mut next = 0u64;
         for (i, p) in parts.iter().enumerate() {
             assert_eq!(
@@ -216,7 +241,6 @@ fn machining_cv_fold_shards_merge_into_the_whole_cross_validation() {
                 text(&whole.model),
                 "every shard trains the same model"
             );
-            assert_eq!(text(&p.metrics.test), text(&whole.metrics.test));
             let c = p.metrics.cv.as_ref().expect("the shard's folds finished");
             let s = c.shard.expect("a sharded answer says which shard it is");
             assert_eq!(
@@ -226,15 +250,10 @@ fn machining_cv_fold_shards_merge_into_the_whole_cross_validation() {
             assert_eq!(c.k, 7);
             assert_eq!(s.end - s.start, c.folds.len() as u64);
             next = s.end;
-            folds.extend(c.folds.iter().cloned());
         }
         assert_eq!(next, 7);
-        let merged = machining_size::output::cv_metrics(7, folds);
-        assert_eq!(
-            text(&merged),
-            text(cv),
-            "count {count}: folds and their statistics"
-        );
+        // The means and sds over the folds, and the trees built in all, are recomputed.
+        assert_merges(Sweep::MachiningTrain, &parts, &whole, None, count);
     }
 }
 
@@ -246,7 +265,7 @@ const CONTINUUM: &str = "/v1/continuum-workspace";
 
 /// Design 1, one wave per stable assembly mode at (-0.22, 0.2425) (a node of the 5 x 5 grid):
 /// the N_grid 4 search finds three stable modes there (tests/it/http_continuum_workspace.rs).
-fn continuum_body() -> Value {
+pub(crate) fn continuum_body() -> Value {
     json!({"mode": "workspace", "design": {"preset": "keops_d1"}, "assembly_modes": {"n_grid": 4},
            "workspace": {"grid": [5, 5], "ranges_m": [[-0.26, -0.18], [0.2025, 0.2825]],
                          "seed": {"kind": "all_stable_modes", "inputs_m": [-0.22, 0.2425]},
@@ -270,31 +289,6 @@ fn continuum_shard(body: &Value) -> WorkspaceShardResponse {
     match continuum(body) {
         ContinuumWorkspaceResponse::WorkspaceShard(r) => *r,
         _ => panic!("a sharded sweep answered in another shape"),
-    }
-}
-
-/// The merge rule of `WorkspaceShardResponse::shard`: waves concatenated in shard order, the
-/// first at the top level and the rest as `other_waves`; `grid` and `preset` from any shard;
-/// warnings the union in order of first appearance; `timing_ms` and `report` (per shard) taken
-/// from `like`, the answer compared with.
-fn merge_waves(parts: &[WorkspaceShardResponse], like: &WorkspaceResponse) -> WorkspaceResponse {
-    let mut waves: Vec<WaveOut> = parts.iter().flat_map(|p| p.waves.clone()).collect();
-    let mut warnings: Vec<String> = Vec::new();
-    for w in parts.iter().flat_map(|p| &p.warnings) {
-        if !warnings.contains(w) {
-            warnings.push(w.clone());
-        }
-    }
-    let first = waves.remove(0);
-    WorkspaceResponse {
-        mode: parts[0].mode,
-        grid: parts[0].grid.clone(),
-        wave: first,
-        other_waves: (!waves.is_empty()).then_some(waves),
-        timing_ms: like.timing_ms,
-        warnings,
-        preset: parts[0].preset.clone(),
-        report: like.report.clone(),
     }
 }
 
@@ -335,10 +329,14 @@ fn continuum_wave_shards_merge_into_the_whole_sweep() {
                 "count {count}: shards beyond the waves are empty"
             );
         }
-        assert_eq!(
-            text(&merge_waves(&parts, &whole)),
-            text(&whole),
-            "count {count}: the merged answer"
+        assert_merges(Sweep::ContinuumWorkspace, &parts, &whole, None, count);
+        // The report counters are the shards' work: at least the unsharded run's.
+        let merged = merge(Sweep::ContinuumWorkspace, files(&parts), None).expect("merges");
+        assert!(
+            merged["report"]["evaluations"].as_u64() >= Some(whole.report.evaluations),
+            "count {count}: {} < {}",
+            merged["report"]["evaluations"],
+            whole.report.evaluations
         );
     }
 }
