@@ -42,7 +42,7 @@ fn main() -> std::process::ExitCode {
         None => {}
     }
     if cli.print_openapi {
-        return match mechcalc::http::openapi().to_yaml() {
+        return match mechcalc::http::openapi_yaml() {
             // `mechcalc --print-openapi | head`: a closed pipe ends the output quietly.
             Ok(y) => mechcalc::cli::write_stdout(y.as_bytes()),
             Err(e) => {
