@@ -588,8 +588,9 @@ pub fn augmented_system(
 }
 
 /// The exact time response (spec §3.D.4): the augmented autonomous system stepped with one
-/// matrix exponential, in the coordinates of its Schur form
-/// ([`schur_response::time_response`]).
+/// matrix exponential in the original coordinates ([`Stepper::run`]). Stepping in the Schur
+/// coordinates ([`schur_response::time_response`]) was measured no faster on the api-like cases
+/// (benches/RESULTS.md, issue 27) and is not used.
 fn time_response(
     model: &Model,
     a: &DMatrix<f64>,
@@ -609,7 +610,7 @@ fn time_response(
         last_from: sys.last_from,
         decimate: t.series.then_some(t.decimate),
     };
-    let series = schur_response::time_response(&stepper, budget)?;
+    let series = stepper.run(budget)?;
     Ok(TimeOutput {
         excitation_hz: excitation_hz.to_vec(),
         listed: sys.listed,

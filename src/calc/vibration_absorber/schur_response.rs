@@ -7,8 +7,8 @@
 //!   quasi-triangular back substitution per frequency (`N²/2` products) instead of a complex LU
 //!   (`N³/3`, plus a copy of the matrix);
 //! * time response: the augmented system is stepped in the coordinates `u = Qᵀ D⁻¹ s` with
-//!   `E = expm(T h)` (quasi-triangular as `T`), the outputs and the next state from one pass over
-//!   the packed columns of `[Ĉ; E]`.
+//!   `E = expm(T h)` (quasi-triangular as `T`), the outputs and the next state from one
+//!   matrix-vector product with `[Ĉ; E]`.
 //!
 //! Neither forms eigenvectors, so both stay exact where `A` is defective or has repeated
 //! eigenvalues (an undamped mode forced at its own frequency, where the exosystem's `±jΩ`
@@ -126,49 +126,28 @@ pub fn time_response(stepper: &Stepper<'_>, budget: &Budget) -> Result<TimeSerie
     }
 }
 
-/// `[Ĉ; E]` packed column by column: column `j` holds the `r` output entries, then the rows
-/// `0..lim_j` of `E` (the rest of the column is zero below `T`'s block diagonal).
-struct Packed {
-    /// Column data, concatenated.
-    data: Vec<f64>,
-    /// Start of each column in `data` and its length `r + lim_j`.
-    cols: Vec<(usize, usize)>,
-}
-
-impl Packed {
-    fn new(e: &DMatrix<f64>, ch: &[DVector<f64>], schur: &BalancedSchur) -> Self {
-        let n = e.nrows();
-        let r = ch.len();
-        let mut lim = vec![0; n];
-        for &(start, size) in &schur.blocks {
-            for l in &mut lim[start..start + size] {
-                *l = start + size;
-            }
-        }
-        let mut data = Vec::with_capacity(n * (n + r));
-        let mut cols = Vec::with_capacity(n);
-        for (j, &l) in lim.iter().enumerate() {
-            let begin = data.len();
-            data.extend(ch.iter().map(|c| c[j]));
-            data.extend(e.column(j).iter().take(l));
-            cols.push((begin, r + l));
-        }
-        Self { data, cols }
-    }
-
-    /// `out[..r] = Ĉ u`, `out[r..] = E u`.
-    fn apply(&self, u: &[f64], out: &mut [f64]) {
-        out.fill(0.0);
-        for (&(begin, len), &uj) in self.cols.iter().zip(u) {
-            if uj == 0.0 {
-                continue;
-            }
-            let col = &self.data[begin..begin + len];
-            for (o, m) in out[..len].iter_mut().zip(col) {
-                *o += m * uj;
-            }
+/// `[Ĉ; E]` as one column-major matrix, so that one matrix-vector product gives the outputs
+/// `y_k = Ĉ u_k` and the next state `u_{k+1} = E u_k` (the products vectorise along the
+/// columns; separate row dot products would be latency-bound). The entries of `E` below `T`'s
+/// block diagonal are zero in exact arithmetic and are set so.
+fn fused(e: &DMatrix<f64>, ch: &[DVector<f64>], schur: &BalancedSchur) -> DMatrix<f64> {
+    let n = e.nrows();
+    let r = ch.len();
+    let mut lim = vec![0; n];
+    for &(start, size) in &schur.blocks {
+        for l in &mut lim[start..start + size] {
+            *l = start + size;
         }
     }
+    DMatrix::from_fn(r + n, n, |i, j| {
+        if i < r {
+            ch[i][j]
+        } else if i - r < lim[j] {
+            e[(i - r, j)]
+        } else {
+            0.0
+        }
+    })
 }
 
 /// `u_{k+1} = E u_k`, `y_k = Ĉ u_k`, re-anchored with `u(t_k) = expm(T t_k) u(0)` as
@@ -186,7 +165,7 @@ fn run_schur(
     let n = t.nrows();
     let ch: Vec<DVector<f64>> = st.rows.iter().map(|c| schur.row_to_schur(c)).collect();
     let nr = ch.len();
-    let packed = Packed::new(&e, &ch, schur);
+    let m = fused(&e, &ch, schur);
     let u0 = schur.to_schur(st.s0);
     let mut ts = TimeSeries {
         max_abs: vec![0.0; nr],
@@ -199,8 +178,8 @@ fn run_schur(
     let mut series: Option<Vec<Vec<f64>>> =
         keep.map(|d| vec![Vec::with_capacity(st.steps / d + 1); nr]);
     let mut times = keep.map(|d| Vec::with_capacity(st.steps / d + 1));
-    let mut u: Vec<f64> = u0.iter().copied().collect();
-    let mut out = vec![0.0; nr + n];
+    let mut u = u0.clone();
+    let mut out = DVector::zeros(nr + n);
     let reanchor = st.steps > REANCHOR_ABOVE;
     let mut sumsq = vec![0.0; nr];
     for k in 0..=st.steps {
@@ -212,9 +191,9 @@ fn run_schur(
                     detail: format!("t = {time} s"),
                 })?;
                 ts.expms += 1;
-                u.copy_from_slice((direct * &u0).as_slice());
+                u = direct * &u0;
             } else {
-                u.copy_from_slice(&out[nr..]);
+                u.copy_from(&out.rows(nr, n));
             }
             if k % 1024 == 0 {
                 if budget.check(ts.expms).is_some() {
@@ -233,10 +212,10 @@ fn run_schur(
                 }
             }
         }
-        packed.apply(&u, &mut out);
+        out.gemv(1.0, &m, &u, 0.0);
         let last = k >= st.last_from;
         let sample = keep.is_some_and(|d| k % d == 0);
-        for (j, &y) in out[..nr].iter().enumerate() {
+        for (j, &y) in out.as_slice()[..nr].iter().enumerate() {
             let ay = y.abs();
             ts.max_abs[j] = ts.max_abs[j].max(ay);
             if last {
