@@ -18,10 +18,14 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use mechcalc::calc::vibration_absorber::compute::build_model;
+use mechcalc::calc::vibration_absorber::compute::{
+    augmented_system, ava_step, build_model, compute, excitation_hz, schur_response,
+};
 use mechcalc::calc::vibration_absorber::input::VibrationAbsorberInput;
 use mechcalc::calc::vibration_absorber::model::Model;
-use mechcalc::calc::vibration_absorber::response::eigen;
+use mechcalc::calc::vibration_absorber::response::{
+    Stepper, eigen, frequency_response, step_metrics,
+};
 use mechcalc::calc::vibration_absorber::{VibrationAbsorberRequest, run};
 use mechcalc::numerics::Budget;
 use mechcalc::numerics::linalg::expm;
@@ -301,7 +305,261 @@ fn print_method_table() {
     println!();
 }
 
+/// Thirteen requests shaped like the `api/` examples (issue 27): the three examples and ten
+/// variations over configuration, forcing, modes, position, gains and outputs.
+fn api_cases() -> Vec<(&'static str, Value)> {
+    let file = |s: &str| serde_json::from_str::<Value>(s).expect("example");
+    let paper = file(include_str!("../api/vibration_absorber/paper_case.json"));
+    let with = |base: &Value, patch: Value| {
+        let mut v = base.clone();
+        for (k, p) in patch.as_object().expect("object") {
+            v[k] = p.clone();
+        }
+        v
+    };
+    let frf = |n: u32, pts: Value| json!({"f_min_hz": 0.5, "f_max_hz": 100.0, "n_points": n, "log": true, "points_m": pts});
+    let time = |t: f64, dt: f64, pts: Value| json!({"t_end_s": t, "dt_s": dt, "points_m": pts});
+    vec![
+        ("paper_case", paper.clone()),
+        (
+            "frequency_sweep",
+            file(include_str!(
+                "../api/vibration_absorber/frequency_sweep.json"
+            )),
+        ),
+        (
+            "two_harmonics",
+            file(include_str!("../api/vibration_absorber/two_harmonics.json")),
+        ),
+        (
+            "paper_passive",
+            with(
+                &paper,
+                json!({"control": {"mode": "passive"},
+            "outputs": {"natural_frequencies": true, "eigenvalues": true, "frequency_response": frf(200, json!([1.0])), "time_response": time(10.0, 1e-3, json!([1.0]))}}),
+            ),
+        ),
+        (
+            "none_at_f1",
+            json!({"control": {"mode": "none"}, "excitation": {"type": "harmonic", "resonance_of_mode": 1},
+            "outputs": {"eigenvalues": true, "time_response": time(10.0, 1e-3, json!([1.0]))}}),
+        ),
+        (
+            "active_t5",
+            s2(
+                3,
+                &json!({"eigenvalues": true, "time_response": time(10.0, 1e-3, json!([1.0, 0.5]))}),
+            ),
+        ),
+        (
+            "shorted_frf",
+            json!({"control": {"mode": "passive_shorted"}, "beam": {"modal_damping_ratio": 0.002},
+            "outputs": {"eigenvalues": true, "frequency_response": frf(400, json!([1.0, 0.5]))}}),
+        ),
+        (
+            "impulse_n5",
+            json!({"beam": {"n_modes": 5, "modal_damping_ratio": 0.005}, "excitation": {"type": "impulse"},
+            "outputs": {"time_response": time(2.0, 1e-4, json!([1.0]))}}),
+        ),
+        (
+            "step_damped",
+            json!({"beam": {"modal_damping_ratio": 0.01}, "excitation": {"type": "step"},
+            "outputs": {"ava_step": true, "time_response": time(5.0, 1e-3, json!([1.0]))}}),
+        ),
+        (
+            "ava_only",
+            with(
+                &paper,
+                json!({"outputs": {"ava_step": true,
+            "ava_frequency_response": {"f_min_hz": 1.0, "f_max_hz": 100.0, "n_points": 400, "log": true}}}),
+            ),
+        ),
+        (
+            "third_span_n4",
+            json!({"beam": {"n_modes": 4, "modal_damping_ratio": 0.001}, "absorber": {"position_m": 0.3333},
+            "control": {"mode": "active", "tuning_mode": 2}, "excitation": {"type": "harmonic", "resonance_of_mode": 2},
+            "outputs": {"frequency_response": frf(300, json!([1.0])), "time_response": time(10.0, 1e-3, json!([1.0]))}}),
+        ),
+        (
+            "explicit_gains",
+            with(
+                &paper,
+                json!({"control": {"mode": "active", "kp_v_m": 500.0, "kd_v_s_m": -3.0},
+            "outputs": {"ava_step": true, "eigenvalues": true, "time_response": time(3.0, 1e-3, json!([1.0]))}}),
+            ),
+        ),
+        (
+            "n10_frf_time",
+            s2(
+                10,
+                &json!({"frequency_response": frf(400, json!([1.0])), "time_response": time(2.0, 1e-3, json!([1.0]))}),
+            ),
+        ),
+    ]
+}
+
+/// The stages issue 27 changed, run by the previous dense implementations (kept in
+/// `response`): eigenvalues by their own Schur iteration, each absorber step response on its own
+/// (heap 4 × 4 matrices, an exponential per bisection step), a complex LU per frequency, the
+/// time response stepped with the dense `Φ` in the original coordinates.
+fn stages_before(input: &VibrationAbsorberInput, budget: &Budget) -> f64 {
+    let (m, freqs, gains) = build_model(input);
+    let (a, b) = (m.a_matrix(), m.b_vector());
+    let o = &input.outputs;
+    let mut acc = 0.0;
+    let eig = (o.eigenvalues || o.frf.is_some()).then(|| eigen(&a).expect("eig"));
+    if o.ava_step {
+        let (fa, fb) = m.dev.fixed_base();
+        let dc = (m.dev.ka > 0.0).then(|| m.dev.kc / (m.dev.ka * m.dev.r));
+        let ec = step_metrics(&fa, &fb, &DVector::from_vec(vec![1.0, 0.0, 0.0]), dc, false);
+        acc += ec.settling.unwrap_or(0.0);
+        if let Some(g) = gains {
+            let c = DVector::from_vec(vec![g.kp, g.kd, 0.0]);
+            let err = step_metrics(&fa, &fb, &c, dc.map(|d| d * g.kp), false);
+            acc += err.settling.unwrap_or(0.0);
+        }
+    }
+    if let Some((grid, points)) = &o.frf {
+        let w: Vec<f64> = grid.frequencies().iter().map(|f| 2.0 * PI * f).collect();
+        let rows: Vec<DVector<f64>> = points.iter().map(|x| m.row_deflection(*x)).collect();
+        let ev = eig
+            .as_ref()
+            .map(|e| e.values.as_slice())
+            .unwrap_or_default();
+        let h = frequency_response(&a, &b, &rows, &w, ev, budget).expect("FRF");
+        acc += h.len() as f64;
+    }
+    if let Some(t) = &o.time {
+        let fe = excitation_hz(input, &freqs);
+        let sys = augmented_system(&m, (&a, &b), input, t, &fe);
+        let st = Stepper {
+            a: &sys.a,
+            s0: &sys.s0,
+            rows: &sys.rows,
+            steps: t.steps,
+            dt: t.dt,
+            last_from: sys.last_from,
+            decimate: t.series.then_some(t.decimate),
+        };
+        acc += st.run(budget).expect("time").max_abs[0];
+    }
+    acc
+}
+
+/// The same stages by the paths `compute` now calls (the time response keeps the dense stepping).
+fn stages_after(input: &VibrationAbsorberInput, budget: &Budget) -> f64 {
+    let (m, freqs, gains) = build_model(input);
+    let (a, b) = (m.a_matrix(), m.b_vector());
+    let o = &input.outputs;
+    let mut acc = 0.0;
+    let dec =
+        (o.eigenvalues || o.frf.is_some()).then(|| schur_response::decompose(&a).expect("eig"));
+    if o.ava_step {
+        let (ec, err) = ava_step::step_pair(&m.dev, gains.as_ref(), false);
+        acc += ec.settling.unwrap_or(0.0) + err.and_then(|e| e.settling).unwrap_or(0.0);
+    }
+    if let Some((grid, points)) = &o.frf {
+        let w: Vec<f64> = grid.frequencies().iter().map(|f| 2.0 * PI * f).collect();
+        let rows: Vec<DVector<f64>> = points.iter().map(|x| m.row_deflection(*x)).collect();
+        let schur = dec.as_ref().and_then(|d| d.1.as_ref()).expect("Schur form");
+        let h = schur_response::frequency_response(schur, &b, &rows, &w, budget).expect("FRF");
+        acc += h.len() as f64;
+    }
+    if let Some(t) = &o.time {
+        let fe = excitation_hz(input, &freqs);
+        let sys = augmented_system(&m, (&a, &b), input, t, &fe);
+        let st = Stepper {
+            a: &sys.a,
+            s0: &sys.s0,
+            rows: &sys.rows,
+            steps: t.steps,
+            dt: t.dt,
+            last_from: sys.last_from,
+            decimate: t.series.then_some(t.decimate),
+        };
+        acc += st.run(budget).expect("time").max_abs[0];
+    }
+    acc
+}
+
+/// Median of `runs` interleaved timings of `f` and `g` [s].
+fn interleaved<A, B>(
+    runs: usize,
+    mut f: impl FnMut() -> A,
+    mut g: impl FnMut() -> B,
+) -> (f64, f64) {
+    let (mut tf, mut tg) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
+    black_box(f());
+    black_box(g());
+    for _ in 0..runs {
+        let t = std::time::Instant::now();
+        black_box(f());
+        tf.push(t.elapsed().as_secs_f64());
+        let t = std::time::Instant::now();
+        black_box(g());
+        tg.push(t.elapsed().as_secs_f64());
+    }
+    let med = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    (med(&mut tf), med(&mut tg))
+}
+
+/// Issue 27: the changed stages before (dense reference paths) and after (fixed-size steps,
+/// one Schur form), interleaved in one session on the 13 api-like cases, and the whole
+/// `compute` after; "compute before" = compute after − stages after + stages before (the rest
+/// of compute did not change).
+fn print_issue27_table() {
+    println!(
+        "\n### Issue 27: compute on 13 api-like cases, changed stages before/after (interleaved medians)\n"
+    );
+    println!(
+        "| case | stages before [ms] | stages after [ms] | ratio | compute after [ms] | compute before (derived) [ms] | ratio |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    let budget = Budget::unlimited();
+    let (mut sb, mut sa, mut ca, mut cb) = (0.0, 0.0, 0.0, 0.0);
+    for (name, v) in api_cases() {
+        let input = VibrationAbsorberInput::try_from(req(&v)).expect("valid");
+        let (before, after) = interleaved(
+            41,
+            || stages_before(&input, &budget),
+            || stages_after(&input, &budget),
+        );
+        let (full, _) = interleaved(41, || compute(&input, &budget).expect("computes"), || ());
+        let derived = full - after + before;
+        sb += before;
+        sa += after;
+        ca += full;
+        cb += derived;
+        println!(
+            "| {name} | {:.3} | {:.3} | {:.1}× | {:.3} | {:.3} | {:.1}× |",
+            before * 1e3,
+            after * 1e3,
+            before / after,
+            full * 1e3,
+            derived * 1e3,
+            derived / full
+        );
+    }
+    println!(
+        "| **all 13** | {:.3} | {:.3} | {:.1}× | {:.3} | {:.3} | {:.1}× |",
+        sb * 1e3,
+        sa * 1e3,
+        sb / sa,
+        ca * 1e3,
+        cb * 1e3,
+        cb / ca
+    );
+    println!();
+}
+
 fn benches(c: &mut Criterion) {
+    print_issue27_table();
+    if std::env::var_os("VA_ISSUE27_ONLY").is_some() {
+        return;
+    }
     print_cost_table();
     print_method_table();
     let budget = Budget::unlimited();

@@ -4,6 +4,11 @@ use std::f64::consts::PI;
 
 use nalgebra::{Complex, DMatrix, DVector};
 
+#[path = "ava_step.rs"]
+pub mod ava_step;
+#[path = "schur_response.rs"]
+pub mod schur_response;
+
 use super::beam::ModeShape;
 use super::error::VibrationAbsorberError as Error;
 use super::input::{
@@ -11,7 +16,7 @@ use super::input::{
 };
 use super::model::{Device, Gains, Model};
 use super::response::{self, Eigen, StepMetrics, Stepper, TimeSeries};
-use crate::calc::common::Warning;
+use crate::numerics::linalg::BalancedSchur;
 use crate::numerics::{Budget, SolverReport, StopReason};
 
 /// Distance of `x_a` to a node of the tuned mode, relative to L, below which the mode is
@@ -54,10 +59,55 @@ pub struct VibrationAbsorberOutput {
     pub time: Option<TimeOutput>,
     /// Mode shapes `(x [m], φ_k(x))`.
     pub mode_shapes: Option<(Vec<f64>, Vec<Vec<f64>>)>,
-    /// Warnings.
-    pub warnings: Vec<Warning>,
+    /// Findings the caller should know about (turned into wire warnings by `output.rs`).
+    pub warnings: Vec<Notice>,
     /// Cost.
     pub report: SolverReport,
+}
+
+/// Something the caller should know about an answer that is nevertheless returned (spec §2
+/// warnings, §7 hazards), with the numbers that describe it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Notice {
+    /// The absorber at `position` \[m\] is within [`NODE_WARN_REL`]·L of `node` \[m\] of the
+    /// tuned mode: it cannot act on that mode.
+    AbsorberAtNode {
+        /// `x_a` \[m\].
+        position: f64,
+        /// The node \[m\].
+        node: f64,
+    },
+    /// `K_p < 0` [V/m]: the actuator must act as a negative spring.
+    NegativeKp {
+        /// `K_p` [V/m].
+        kp: f64,
+    },
+    /// An absorber step response does not settle (undamped or without spring).
+    NoSettling,
+    /// `count` grid frequencies coincide with an undamped eigenvalue (|H| null there).
+    UndampedResonance {
+        /// Null grid points.
+        count: usize,
+    },
+    /// ζ = 0 with active control: the closed loop is marginal; `max_re` \[1/s\] when the
+    /// eigenvalues were computed.
+    MarginalStability {
+        /// max Re λ \[1/s\].
+        max_re: Option<f64>,
+    },
+    /// The coupled system is unstable.
+    Unstable {
+        /// max Re λ \[1/s\].
+        max_re: f64,
+    },
+    /// Excitation near but not at the tuning frequency: beating, not cancellation (spec §4
+    /// item 10).
+    ExcitationOffTuning {
+        /// Excitation frequency \[Hz\].
+        excitation_hz: f64,
+        /// Tuning frequency \[Hz\].
+        tuning_hz: f64,
+    },
 }
 
 /// Time response reductions with their channel layout.
@@ -82,6 +132,18 @@ fn hz(f: FreqRef, freqs: &[f64]) -> f64 {
     match f {
         FreqRef::Hz(x) => x,
         FreqRef::Mode(k) => freqs[k.clamp(1, freqs.len()) - 1],
+    }
+}
+
+/// Frequency of each harmonic component \[Hz\] (empty unless harmonic), references resolved
+/// against the bare-beam frequencies `freqs` \[Hz\].
+#[must_use]
+pub fn excitation_hz(input: &VibrationAbsorberInput, freqs: &[f64]) -> Vec<f64> {
+    match &input.forcing {
+        Forcing::Harmonic { components, .. } => {
+            components.iter().map(|c| hz(c.freq, freqs)).collect()
+        }
+        _ => Vec::new(),
     }
 }
 
@@ -197,24 +259,22 @@ pub fn compute(
     let b = model.b_vector();
     check_state_space(&a, &b)?;
     let need_eig = o.eigenvalues || o.frf.is_some();
-    let eigen = if need_eig {
+    let (eigen, schur) = if need_eig {
         evaluations += 1;
-        Some(response::eigen(&a)?)
+        let (e, s) = schur_response::decompose(&a)?;
+        (Some(e), s)
     } else {
-        None
+        (None, None)
     };
     stability_warning(&model, input.beam.zeta, eigen.as_ref(), &mut warnings);
 
     let ava_step = o
         .ava_step
-        .then(|| ava_steps(&model.dev, gains.as_ref(), o.ava_step_series));
+        .then(|| ava_step::step_pair(&model.dev, gains.as_ref(), o.ava_step_series));
     if let Some((ec, err)) = &ava_step {
         evaluations += ec.expms + err.as_ref().map_or(0, |e| e.expms);
         if ec.settling.is_none() || err.as_ref().is_some_and(|e| e.settling.is_none()) {
-            warnings.push(Warning::new(
-                "NO_SETTLING",
-                "an absorber step response does not settle (undamped or without spring): no settling time",
-            ));
+            warnings.push(Notice::NoSettling);
         }
     }
     let ava_frf = o
@@ -232,6 +292,7 @@ pub fn compute(
             Some(coupled_frf(
                 &model,
                 (&a, &b),
+                schur.as_ref(),
                 grid,
                 points,
                 eig,
@@ -242,12 +303,7 @@ pub fn compute(
         None => None,
     };
 
-    let excitation_hz: Vec<f64> = match &input.forcing {
-        Forcing::Harmonic { components, .. } => {
-            components.iter().map(|c| hz(c.freq, &freqs)).collect()
-        }
-        _ => Vec::new(),
-    };
+    let excitation_hz = excitation_hz(input, &freqs);
     for fe in &excitation_hz {
         tuning_warning(gains.as_ref(), *fe, &mut warnings);
     }
@@ -303,7 +359,7 @@ fn design_warnings(
     freqs: &[f64],
     gains: Option<&Gains>,
     input: &VibrationAbsorberInput,
-    warnings: &mut Vec<Warning>,
+    warnings: &mut Vec<Notice>,
 ) -> Option<Vec<f64>> {
     let has_absorber = model.config != Config::None;
     // Tuned mode and its nodes (where the absorber cannot act on it).
@@ -326,53 +382,45 @@ fn design_warnings(
             .iter()
             .find(|x| (*x - input.absorber.position).abs() <= NODE_WARN_REL * model.length)
     {
-        warnings.push(Warning::at(
-            "ABSORBER_AT_NODE",
-            "/absorber/position_m",
-            format!(
-                "the absorber at {} m is within {NODE_WARN_REL}·L of the node {x:.6} m of the tuned mode: it cannot act on that mode",
-                input.absorber.position
-            ),
-        ));
+        warnings.push(Notice::AbsorberAtNode {
+            position: input.absorber.position,
+            node: *x,
+        });
     }
     if let Some(g) = gains
         && g.kp < 0.0
     {
-        warnings.push(Warning::at(
-            "NEGATIVE_KP",
-            "/control",
-            format!(
-                "K_p = {:.6e} V/m < 0: the actuator must act as a negative spring",
-                g.kp
-            ),
-        ));
+        warnings.push(Notice::NegativeKp { kp: g.kp });
     }
     tuned_nodes
 }
 
-/// The coupled receptance on a grid at each abscissa, with the undamped-resonance warning.
+/// The coupled receptance on a grid at each abscissa, with the undamped-resonance warning: from
+/// the kept Schur form of `A`, or by the dense complex LU per frequency without one.
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the model, its matrices and decomposition, the grid and the caller's collectors"
+)]
 fn coupled_frf(
     model: &Model,
     (a, b): (&DMatrix<f64>, &DVector<f64>),
+    schur: Option<&BalancedSchur>,
     grid: &Grid,
     points: &[f64],
     eig: &[Complex<f64>],
     budget: &Budget,
-    warnings: &mut Vec<Warning>,
+    warnings: &mut Vec<Notice>,
 ) -> Result<Frf, Error> {
     let f = grid.frequencies();
     let w: Vec<f64> = f.iter().map(|f| 2.0 * PI * f).collect();
     let rows: Vec<DVector<f64>> = points.iter().map(|x| model.row_deflection(*x)).collect();
-    let h = response::frequency_response(a, b, &rows, &w, eig, budget)?;
+    let h = match schur {
+        Some(s) => schur_response::frequency_response(s, b, &rows, &w, budget)?,
+        None => response::frequency_response(a, b, &rows, &w, eig, budget)?,
+    };
     let nulls = h.iter().filter(|r| r.iter().any(Option::is_none)).count();
     if nulls > 0 {
-        warnings.push(Warning::at(
-            "UNDAMPED_RESONANCE",
-            "/outputs/frequency_response",
-            format!(
-                "{nulls} grid frequencies coincide with an undamped eigenvalue: |H| is null there"
-            ),
-        ));
+        warnings.push(Notice::UndampedResonance { count: nulls });
     }
     let per_point = (0..points.len())
         .map(|j| h.iter().map(|r| r[j]).collect())
@@ -382,41 +430,29 @@ fn coupled_frf(
 
 /// The marginal-stability warning (ζ = 0 with active control, spec §7 item 1) or, otherwise, an
 /// unstable label.
-fn stability_warning(model: &Model, zeta: f64, eigen: Option<&Eigen>, warnings: &mut Vec<Warning>) {
+fn stability_warning(model: &Model, zeta: f64, eigen: Option<&Eigen>, warnings: &mut Vec<Notice>) {
     if model.config == Config::Active && zeta == 0.0 {
-        let rate = eigen.map_or(String::new(), |e| {
-            format!(" (max Re λ = {:+.3e} 1/s)", e.max_re)
+        warnings.push(Notice::MarginalStability {
+            max_re: eigen.map(|e| e.max_re),
         });
-        warnings.push(Warning::at(
-            "MARGINAL_STABILITY",
-            "/beam/modal_damping_ratio",
-            format!("modal_damping_ratio = 0 with active control: the closed loop is marginal{rate}; any ζ ≥ 1e-4 makes it stable"),
-        ));
     } else if let Some(e) = eigen
         && e.stability == response::Stab::Unstable
     {
-        warnings.push(Warning::new(
-            "UNSTABLE",
-            format!(
-                "the coupled system is unstable: max Re λ = {:+.3e} 1/s",
-                e.max_re
-            ),
-        ));
+        warnings.push(Notice::Unstable { max_re: e.max_re });
     }
 }
 
 /// Excitation near but not at the tuning frequency: beating, not cancellation (spec §4 item 10).
-fn tuning_warning(gains: Option<&Gains>, fe: f64, warnings: &mut Vec<Warning>) {
+fn tuning_warning(gains: Option<&Gains>, fe: f64, warnings: &mut Vec<Notice>) {
     if let Some(g) = gains
         && let Some(fc) = g.tuning_hz
     {
         let rel = (fe - fc).abs() / fc;
         if rel > 1e-9 && rel < 0.02 {
-            warnings.push(Warning::at(
-                "EXCITATION_OFF_TUNING",
-                "/excitation",
-                format!("excitation at {fe:.6} Hz, tuning at {fc:.6} Hz: the response beats instead of being cancelled (tune by mode index to use the model's own frequency)"),
-            ));
+            warnings.push(Notice::ExcitationOffTuning {
+                excitation_hz: fe,
+                tuning_hz: fc,
+            });
         }
     }
 }
@@ -427,28 +463,6 @@ fn nearest_mode(f: f64, freqs: &[f64]) -> usize {
     (0..freqs.len())
         .min_by(|i, j| d(freqs[*i]).total_cmp(&d(freqs[*j])))
         .unwrap_or(0)
-}
-
-/// Fixed-base absorber step responses `G_ec`, `G_err` (spec §3.B).
-fn ava_steps(
-    dev: &Device,
-    gains: Option<&Gains>,
-    series: bool,
-) -> (StepMetrics, Option<StepMetrics>) {
-    let (a, b) = dev.fixed_base();
-    let dc_ec = (dev.ka > 0.0).then(|| dev.kc / (dev.ka * dev.r));
-    let ec = response::step_metrics(
-        &a,
-        &b,
-        &DVector::from_vec(vec![1.0, 0.0, 0.0]),
-        dc_ec,
-        series,
-    );
-    let err = gains.map(|g| {
-        let c = DVector::from_vec(vec![g.kp, g.kd, 0.0]);
-        response::step_metrics(&a, &b, &c, dc_ec.map(|d| d * g.kp), series)
-    });
-    (ec, err)
 }
 
 /// `G_cl(j2πf) = N/(D + N)`, `N = K_c(K_p + K_d s)`; `None` where `D + N` vanishes to rounding.
@@ -473,19 +487,35 @@ fn ava_frequency_response(
     (f, h)
 }
 
-/// The exact time response (spec §3.D.4): augmented autonomous system, one matrix exponential,
-/// `Φᵏ` stepping. A harmonic force adds one 2×2 exosystem block `[[0, Ω_j], [−Ω_j, 0]]` per
-/// component (state `[sin(Ω_j t + φ_j), cos(Ω_j t + φ_j)]`, driving `A` through `P_j B`), a step
-/// one constant state, an impulse only the initial state `P0 B`.
-fn time_response(
+/// The augmented autonomous system of a time response (spec §3.D.4) and what to sample.
+#[derive(Debug, Clone)]
+pub struct AugmentedSystem {
+    /// `A_aug`.
+    pub a: DMatrix<f64>,
+    /// `s_aug(0)`.
+    pub s0: DVector<f64>,
+    /// Output rows: the requested abscissae, then stroke, force, current, voltage as present.
+    pub rows: Vec<DVector<f64>>,
+    /// Row of the stroke, force, current, voltage (if present).
+    pub extra: [Option<usize>; 4],
+    /// First sample of the "last period" window.
+    pub last_from: usize,
+    /// Whether the harmonic components were listed (`excitation.harmonics`).
+    pub listed: bool,
+}
+
+/// The augmented system of the exact time response: a harmonic force adds one 2×2 exosystem
+/// block `[[0, Ω_j], [−Ω_j, 0]]` per component (state `[sin(Ω_j t + φ_j), cos(Ω_j t + φ_j)]`,
+/// driving `A` through `P_j B`), a step one constant state, an impulse only the initial state
+/// `P0 B`.
+#[must_use]
+pub fn augmented_system(
     model: &Model,
-    a: &DMatrix<f64>,
-    b: &DVector<f64>,
+    (a, b): (&DMatrix<f64>, &DVector<f64>),
     input: &VibrationAbsorberInput,
     t: &TimeRequest,
     excitation_hz: &[f64],
-    budget: &Budget,
-) -> Result<TimeOutput, Error> {
+) -> AugmentedSystem {
     let n = a.nrows();
     let p0 = input.amplitude;
     let (extra_states, listed) = match &input.forcing {
@@ -547,22 +577,46 @@ fn time_response(
         .map_or(1.0, |f| 1.0 / f);
     let t_end = t.steps as f64 * t.dt;
     let last_from = ((t_end - window) / t.dt).ceil().max(0.0) as usize;
+    AugmentedSystem {
+        a: aug,
+        s0,
+        rows,
+        extra,
+        last_from: last_from.min(t.steps),
+        listed,
+    }
+}
+
+/// The exact time response (spec §3.D.4): the augmented autonomous system stepped with one
+/// matrix exponential in the original coordinates ([`Stepper::run`]). Stepping in the Schur
+/// coordinates ([`schur_response::time_response`]) was measured no faster on the api-like cases
+/// (benches/RESULTS.md, issue 27) and is not used.
+fn time_response(
+    model: &Model,
+    a: &DMatrix<f64>,
+    b: &DVector<f64>,
+    input: &VibrationAbsorberInput,
+    t: &TimeRequest,
+    excitation_hz: &[f64],
+    budget: &Budget,
+) -> Result<TimeOutput, Error> {
+    let sys = augmented_system(model, (a, b), input, t, excitation_hz);
     let stepper = Stepper {
-        a: &aug,
-        s0: &s0,
-        rows: &rows,
+        a: &sys.a,
+        s0: &sys.s0,
+        rows: &sys.rows,
         steps: t.steps,
         dt: t.dt,
-        last_from: last_from.min(t.steps),
+        last_from: sys.last_from,
         decimate: t.series.then_some(t.decimate),
     };
     let series = stepper.run(budget)?;
     Ok(TimeOutput {
         excitation_hz: excitation_hz.to_vec(),
-        listed,
+        listed: sys.listed,
         n_samples: t.steps + 1,
         points: t.points.clone(),
         series,
-        extra,
+        extra: sys.extra,
     })
 }

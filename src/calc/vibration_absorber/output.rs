@@ -4,7 +4,7 @@ use std::f64::consts::PI;
 
 use nalgebra::Complex;
 
-use super::compute::{TimeOutput, VibrationAbsorberOutput};
+use super::compute::{NODE_WARN_REL, Notice, TimeOutput, VibrationAbsorberOutput};
 use super::input::VibrationAbsorberInput;
 use super::response::{Eigen, Stab, StepMetrics};
 use super::wire::{
@@ -12,7 +12,7 @@ use super::wire::{
     GainsOut, ModeShapesOut, NaturalFrequenciesOut, Stability, StepOut, TimeOut, TimePointOut,
     VibrationAbsorberResponse,
 };
-use crate::calc::common::ResponseSize;
+use crate::calc::common::{ResponseSize, Warning};
 use crate::numerics::Budget;
 
 /// Upper estimate of the answer's size from the validated request (checked before computing):
@@ -56,6 +56,60 @@ pub fn response_size(input: &VibrationAbsorberInput) -> ResponseSize {
         size = size.numbers("/outputs/mode_shapes/n_points", n as u64 * (modes + 1));
     }
     size
+}
+
+impl From<&Notice> for Warning {
+    fn from(n: &Notice) -> Self {
+        match n {
+            Notice::AbsorberAtNode { position, node } => Self::at(
+                "ABSORBER_AT_NODE",
+                "/absorber/position_m",
+                format!(
+                    "the absorber at {position} m is within {NODE_WARN_REL}·L of the node {node:.6} m of the tuned mode: it cannot act on that mode"
+                ),
+            ),
+            Notice::NegativeKp { kp } => Self::at(
+                "NEGATIVE_KP",
+                "/control",
+                format!("K_p = {kp:.6e} V/m < 0: the actuator must act as a negative spring"),
+            ),
+            Notice::NoSettling => Self::new(
+                "NO_SETTLING",
+                "an absorber step response does not settle (undamped or without spring): no settling time",
+            ),
+            Notice::UndampedResonance { count } => Self::at(
+                "UNDAMPED_RESONANCE",
+                "/outputs/frequency_response",
+                format!(
+                    "{count} grid frequencies coincide with an undamped eigenvalue: |H| is null there"
+                ),
+            ),
+            Notice::MarginalStability { max_re } => {
+                let rate = max_re.map_or(String::new(), |m| format!(" (max Re λ = {m:+.3e} 1/s)"));
+                Self::at(
+                    "MARGINAL_STABILITY",
+                    "/beam/modal_damping_ratio",
+                    format!(
+                        "modal_damping_ratio = 0 with active control: the closed loop is marginal{rate}; any ζ ≥ 1e-4 makes it stable"
+                    ),
+                )
+            }
+            Notice::Unstable { max_re } => Self::new(
+                "UNSTABLE",
+                format!("the coupled system is unstable: max Re λ = {max_re:+.3e} 1/s"),
+            ),
+            Notice::ExcitationOffTuning {
+                excitation_hz,
+                tuning_hz,
+            } => Self::at(
+                "EXCITATION_OFF_TUNING",
+                "/excitation",
+                format!(
+                    "excitation at {excitation_hz:.6} Hz, tuning at {tuning_hz:.6} Hz: the response beats instead of being cancelled (tune by mode index to use the model's own frequency)"
+                ),
+            ),
+        }
+    }
 }
 
 /// Magnitude and phase [deg] of optional complex values.
@@ -224,7 +278,7 @@ pub fn respond(
             x_m: x.clone(),
             shapes: s.clone(),
         }),
-        warnings: out.warnings.clone(),
+        warnings: out.warnings.iter().map(Warning::from).collect(),
         report,
     }
 }
