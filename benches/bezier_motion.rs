@@ -39,9 +39,9 @@ use mechcalc::calc::bezier_motion::optimize::{
 use mechcalc::calc::bezier_motion::plant::{
     EndDerivatives, EndStateMethod, Plant, end_state, gl_rule, response_gl, response_matrix,
 };
-use nalgebra::{DMatrix, DVector};
 use mechcalc::calc::bezier_motion::{BezierInput, BezierMotionRequest, compute, run};
 use mechcalc::numerics::Budget;
+use nalgebra::{DMatrix, DVector};
 use serde_json::{Value, json};
 use support::{Timing, time_for};
 
@@ -348,7 +348,11 @@ fn print_issue27_tables() {
     println!("| quantity | method | median µs | worst µs | error |");
     println!("|---|---|---|---|---|");
     // Over-damped end states against GL with twice the rule's panels and 10 more nodes.
-    for (xi, wnt, m, p) in [(20.0, 500.0, 4, 9), (5.0, 3000.0, 6, 19), (60.0, 300.0, 2, 3)] {
+    for (xi, wnt, m, p) in [
+        (20.0, 500.0, 4, 9),
+        (5.0, 3000.0, 6, 19),
+        (60.0, 300.0, 2, 3),
+    ] {
         let plant = Plant::new(1.0, wnt * wnt, 2.0 * xi * wnt, 1.0);
         let gamma: Vec<f64> = (1..=p).map(|j| f64::from(j) / f64::from(p + 1)).collect();
         let law = BezierLaw::new(m as usize, 1.0, &gamma, 1.0);
@@ -474,7 +478,11 @@ fn print_issue27_tables() {
             let terms = objective_terms(Objective::MinAccelL2, black_box(&shape), &[]);
             solve_terms(&terms, std::slice::from_ref(&rows)).expect("pd")
         });
-        let what = format!("γ*, {} (cond(Hq) {})", case["name"].as_str().unwrap_or("?"), case["cond_Hq"].as_str().unwrap_or("?"));
+        let what = format!(
+            "γ*, {} (cond(Hq) {})",
+            case["name"].as_str().unwrap_or("?"),
+            case["cond_Hq"].as_str().unwrap_or("?")
+        );
         println!(
             "| {what} | float Gram products, one solve (before) | {:.2} | {:.2} | {:.1e} of max|γ*| |",
             t_old.median_us(),

@@ -52,7 +52,10 @@ pub fn prepare(req: &mut Value) {
 /// Bezier law; bottom: their motor accelerations overlaid.
 fn render_shapers(req: &Value, answer: &Value, sc: &Value) -> Result<String, PlotError> {
     let t_end = req["motion"]["T_s"].as_f64().unwrap_or(1.0);
-    let phi = numbers(&answer["law"]["S_rad"]).last().copied().unwrap_or(0.0);
+    let phi = numbers(&answer["law"]["S_rad"])
+        .last()
+        .copied()
+        .unwrap_or(0.0);
     let baseline = if sc["baseline"].as_str() == Some("cycloidal") {
         Baseline::Cycloidal
     } else {

@@ -750,11 +750,22 @@ fn shaper_rows_match_an_independent_integration() {
                 let umax = (0..=samples)
                     .map(|k| u(t * f64::from(k) / f64::from(samples)).abs())
                     .fold(0.0_f64, f64::max);
-                assert!(umax <= row.peak_accel_rad_s2 * (1.0 + 1e-12), "{name}: sampled {umax} > peak");
-                assert!(umax >= row.peak_accel_rad_s2 * (1.0 - 1e-8), "{name}: sampled {umax} < peak");
+                assert!(
+                    umax <= row.peak_accel_rad_s2 * (1.0 + 1e-12),
+                    "{name}: sampled {umax} > peak"
+                );
+                assert!(
+                    umax >= row.peak_accel_rad_s2 * (1.0 - 1e-8),
+                    "{name}: sampled {umax} < peak"
+                );
             }
             // The Bezier row is the module's own residual and sweep.
-            rel(sc.bezier.e_t_j.max(1e-300), r.residual.e_t_j.max(1e-300), 0.0, "bezier E");
+            rel(
+                sc.bezier.e_t_j.max(1e-300),
+                r.residual.e_t_j.max(1e-300),
+                0.0,
+                "bezier E",
+            );
             let bs = sc.bezier.sensitivity.as_ref().expect("bezier sweep");
             let ms = r.sensitivity.as_ref().expect("module sweep");
             for (a, b) in bs.iter().zip(ms) {
@@ -776,9 +787,16 @@ fn shaper_zv_and_zvd_cancel_at_the_design_stiffness() {
                 &json!({"shaper_comparison": {"baseline": baseline, "shapers": ["none", "zv", "zvd"]}}),
             );
             let sc = solve(&body).shaper_comparison.expect("comparison");
-            let e: Vec<f64> = sc.rows.iter().map(|r| r.as_ref().expect("row").e_t_j).collect();
+            let e: Vec<f64> = sc
+                .rows
+                .iter()
+                .map(|r| r.as_ref().expect("row").e_t_j)
+                .collect();
             assert!(e[0] > 0.0);
-            assert!(e[1] <= 1e-12 * e[0] && e[2] <= 1e-12 * e[0], "{baseline}: {e:?}");
+            assert!(
+                e[1] <= 1e-12 * e[0] && e[2] <= 1e-12 * e[0],
+                "{baseline}: {e:?}"
+            );
         }
     }
 }
@@ -810,7 +828,10 @@ fn shaper_ei_is_flatter_than_zv_over_20_percent() {
                     .fold(0.0_f64, f64::max)
             };
             let (zv, ei) = (worst(0), worst(1));
-            assert!(ei < zv, "{baseline}: worst E over ±20 %: EI {ei:e} ≥ ZV {zv:e}");
+            assert!(
+                ei < zv,
+                "{baseline}: worst E over ±20 %: EI {ei:e} ≥ ZV {zv:e}"
+            );
         }
     }
 }
@@ -826,8 +847,12 @@ fn shaper_comparison_limits() {
     });
     let r = solve(&body);
     assert!(r.shaper_comparison.is_none());
-    assert!(r.warnings.iter().any(|w| w.code == "SHAPER_COMPARISON_NOT_OSCILLATORY"
-        && w.pointer.as_deref() == Some("/outputs/shaper_comparison")));
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w.code == "SHAPER_COMPARISON_NOT_OSCILLATORY"
+                && w.pointer.as_deref() == Some("/outputs/shaper_comparison"))
+    );
     // The paper drive's Td = 0.1186 s: a 0.1 s move leaves no room for ZVD/EI (Td ≥ T), ZV fits.
     let mut body = paper("optimize", &json!({"T_s": 0.1}));
     body["outputs"] = json!({"shaper_comparison": {"shapers": ["zv", "zvd", "ei"]}});

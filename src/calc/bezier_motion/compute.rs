@@ -7,9 +7,7 @@ use super::input::{BezierInput, Mode};
 use super::kinematics::{Kinematics, kinematics, polygon_against_motion, reverses};
 use super::law::BezierLaw;
 use super::optimize::{LawShape, Objective, objective_terms, residual_rows, solve_terms};
-use super::plant::{
-    EndDerivatives, Plant, RHO_MAX_GL, ResponseMatrix, end_state, response_matrix,
-};
+use super::plant::{EndDerivatives, Plant, RHO_MAX_GL, ResponseMatrix, end_state, response_matrix};
 use super::shaper::{Comparison, LawRow, Shaper, ShaperSkip, compare};
 use crate::numerics::Budget;
 
@@ -395,8 +393,7 @@ fn shaper_comparison(
     }
     let finite = rows.iter().flatten().all(|r| {
         r.energy.is_finite()
-            && r
-                .sensitivity
+            && r.sensitivity
                 .as_ref()
                 .is_none_or(|s| s.iter().all(|(_, e)| e.is_finite()))
     });

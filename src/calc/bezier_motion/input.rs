@@ -1,6 +1,7 @@
 //! Validation of a [`BezierMotionRequest`] into a [`BezierInput`] (spec §2), collecting every
 //! offending field with its JSON pointer.
 
+use super::compute::BezierWarning;
 use super::history::HistorySpec;
 use super::optimize::Objective;
 use super::plant::Plant;
@@ -11,7 +12,6 @@ use super::wire::{
     PHI, RATIO, ROBUST_REL, STIFFNESS, STIFFNESS_FACTOR, WINDOW_AFTER,
 };
 use super::wire::{BaselineIn, EI_TOLERANCE, MAX_SHAPERS, ShaperIn};
-use super::compute::BezierWarning;
 use crate::calc::common::time_limit;
 use crate::calc::{CalcFailure, Validator};
 

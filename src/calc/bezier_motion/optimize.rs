@@ -173,7 +173,11 @@ fn int_differences(s: &[i128], order: usize) -> Vec<i128> {
 
 /// The objective terms of `objective` (spec §3.7).
 #[must_use]
-pub fn objective_terms(objective: Objective, shape: &LawShape, gamma_ref: &[f64]) -> ObjectiveTerms {
+pub fn objective_terms(
+    objective: Objective,
+    shape: &LawShape,
+    gamma_ref: &[f64],
+) -> ObjectiveTerms {
     let order = match objective {
         Objective::MinDeviation => {
             return ObjectiveTerms {

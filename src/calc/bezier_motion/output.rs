@@ -3,11 +3,11 @@
 use std::f64::consts::TAU;
 
 use super::compute::{BezierOutput, BezierWarning, FactorResult, GAMMA_WARN, Residual};
-use super::shaper::{Baseline, Comparison, Shaper};
 use super::history::History;
 use super::input::{BezierInput, Mode};
 use super::optimize::Objective;
 use super::plant::{EndStateMethod, Plant};
+use super::shaper::{Baseline, Comparison, Shaper};
 use super::wire::{
     self, BaselineIn, BezierMotionResponse, BezierRowOut, EndState, FactorEnergyOut, HistoryOut,
     ImpulseOut, KinematicsOut, LawOut, MethodOut, ObjectiveIn, OptimizerOut, ReferenceOut,
