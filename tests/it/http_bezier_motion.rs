@@ -279,3 +279,39 @@ async fn robust_setting_in_simulate_is_ignored_with_a_warning() {
     b["optimize"] = json!({"robust_stiffness_rel": 0.6});
     rejected(&b, "invalid-input", &["/optimize/robust_stiffness_rel"]).await;
 }
+
+/// Issue 31: the shaper comparison's own 422s (empty list, a repeated shaper, `ei_tolerance`
+/// outside [0, 0.5], an unknown shaper name) name their pointers; the api example's answer
+/// carries one row per requested shaper and the Bezier row.
+#[tokio::test]
+async fn shaper_comparison_rules_and_answer() {
+    let base = example("shaper_comparison_paper");
+    let r = post_json(PATH, &base).await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let b = r.json();
+    let rows = b["shaper_comparison"]["rows"].as_array().expect("rows");
+    let names: Vec<&str> = rows.iter().filter_map(|r| r["shaper"].as_str()).collect();
+    assert_eq!(names, ["none", "zv", "zvd", "ei"]);
+    assert!(b["shaper_comparison"]["bezier"]["E_T_J"].is_number());
+
+    let mut v = base.clone();
+    v["outputs"]["shaper_comparison"]["shapers"] = json!([]);
+    post_json(PATH, &v)
+        .await
+        .assert_422_at(&["/outputs/shaper_comparison/shapers"]);
+    let mut v = base.clone();
+    v["outputs"]["shaper_comparison"]["shapers"] = json!(["zv", "ei", "zv"]);
+    post_json(PATH, &v)
+        .await
+        .assert_422_at(&["/outputs/shaper_comparison/shapers/2"]);
+    for bad in [-0.01, 0.6] {
+        let mut v = base.clone();
+        v["outputs"]["shaper_comparison"]["ei_tolerance"] = json!(bad);
+        post_json(PATH, &v)
+            .await
+            .assert_422_at(&["/outputs/shaper_comparison/ei_tolerance"]);
+    }
+    let mut v = base.clone();
+    v["outputs"]["shaper_comparison"]["shapers"] = json!(["mzv"]);
+    assert_eq!(post_json(PATH, &v).await.status, 422);
+}

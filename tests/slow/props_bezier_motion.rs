@@ -354,7 +354,8 @@ proptest! {
         let Some(h) = c.h() else { return Ok(()); };
         let shape = c.shape();
         let rows = residual_rows(&c.plant, &h, &shape);
-        let (hq, f) = objective_terms(obj, &shape, &c.gamma);
+        let terms = objective_terms(obj, &shape, &c.gamma);
+        let (hq, f) = (terms.hq, terms.f);
         let sol = solve(&hq, &f, std::slice::from_ref(&rows)).expect("Hq is positive definite");
         let law = BezierLaw::new(c.m, c.phi, &sol.gamma, c.t);
         let e_opt = c.plant.energy(h.apply(&law.a));

@@ -6,15 +6,62 @@ use super::history::{History, RHO_MAX_HISTORY, history};
 use super::input::{BezierInput, Mode};
 use super::kinematics::{Kinematics, kinematics, polygon_against_motion, reverses};
 use super::law::BezierLaw;
-use super::optimize::{LawShape, Objective, objective_terms, residual_rows, solve};
-use super::plant::{Plant, RHO_MAX_GL, ResponseMatrix, response_matrix};
-use crate::calc::common::Warning;
+use super::optimize::{LawShape, Objective, objective_terms, residual_rows, solve_terms};
+use super::plant::{EndDerivatives, Plant, RHO_MAX_GL, ResponseMatrix, end_state, response_matrix};
+use super::shaper::{Comparison, LawRow, Shaper, ShaperSkip, compare};
 use crate::numerics::Budget;
 
 /// `E_floor = ½ J_eq (FLOOR_ULPS · ε · s_x)²` (spec §3.6).
 pub const FLOOR_ULPS: f64 = 64.0;
 /// Warn when `max |γ| / |Phi|` exceeds this (spec §3.7).
 pub const GAMMA_WARN: f64 = 10.0;
+
+/// A warning about the request or its answer, in domain terms (`output.rs` words it for the wire
+/// with the spec's code).
+#[derive(Debug, Clone, PartialEq)]
+pub enum BezierWarning {
+    /// `robust_stiffness_rel` was given in `simulate` mode and is ignored.
+    RobustIgnored,
+    /// Only `rank` of `n_constraints` zero-vibration conditions can be met with `p` free ordinates.
+    LeastSquaresCompromise {
+        /// Numerical rank of the constraints.
+        rank: usize,
+        /// Constraint rows.
+        n_constraints: usize,
+        /// Free ordinates.
+        p: usize,
+    },
+    /// `max |γ| / |Phi|` exceeds [`GAMMA_WARN`].
+    FragilePolygon {
+        /// `max |γ| / |Phi|`.
+        gamma_over_phi: f64,
+    },
+    /// The motor velocity changes sign during the move.
+    MotionReversal,
+    /// The velocity polygon has an ordinate against the motion; the curve does not reverse.
+    VelocityPolygonNegative,
+    /// ξ ≥ 1: the joint does not oscillate.
+    NotOscillatory {
+        /// Damping ratio.
+        xi: f64,
+    },
+    /// A shaper comparison was asked for a drive with ξ ≥ 1 (no damped period): omitted.
+    ShaperNotOscillatory {
+        /// Damping ratio.
+        xi: f64,
+    },
+    /// A shaper lasts the whole move or longer: its row is empty.
+    ShaperTooLong {
+        /// Index of the shaper in the request.
+        index: usize,
+        /// The shaper.
+        shaper: Shaper,
+        /// Its last impulse time \[s\].
+        t_last: f64,
+        /// The move time \[s\].
+        t: f64,
+    },
+}
 
 /// Residual vibration of one law on one plant (spec §3.6).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,7 +82,12 @@ impl Residual {
     /// The residual of the law with acceleration ordinates `a` on `plant`, given its `H`.
     #[must_use]
     pub fn of(plant: &Plant, h: &ResponseMatrix, a: &[f64], t: f64) -> Self {
-        let x = h.apply(a);
+        Self::from_state(plant, h.apply(a), a, t)
+    }
+
+    /// The residual of the law with acceleration ordinates `a` whose end state is `x`.
+    #[must_use]
+    pub fn from_state(plant: &Plant, x: [f64; 2], a: &[f64], t: f64) -> Self {
         let energy = plant.energy(x);
         let q = plant.omega_d().map(|wd| {
             let s = wd / plant.z;
@@ -104,8 +156,10 @@ pub struct BezierOutput {
     pub sensitivity: Option<Vec<FactorResult>>,
     /// Time history.
     pub history: Option<History>,
-    /// Warnings.
-    pub warnings: Vec<Warning>,
+    /// The shaper comparison.
+    pub shapers: Option<Comparison>,
+    /// Warnings (domain terms; `output.rs` words them).
+    pub warnings: Vec<BezierWarning>,
     /// Response matrices built.
     pub matrices: u64,
 }
@@ -120,17 +174,27 @@ fn matrix_for(
     t: f64,
     pointer: String,
 ) -> Result<ResponseMatrix, BezierMotionError> {
+    admissible(plant)?;
+    response_matrix(plant, n, t).ok_or_else(|| too_large(plant, t, pointer))
+}
+
+/// Refuses a drive whose natural frequency is 0, not finite or whose ξ is NaN.
+fn admissible(plant: &Plant) -> Result<(), BezierMotionError> {
     if !(plant.wn > 0.0 && plant.wn.is_finite()) || plant.xi.is_nan() {
         return Err(BezierMotionError::NonFinite {
             what: "natural frequency of the drive with the scaled stiffness k·f",
         });
     }
-    response_matrix(plant, n, t).ok_or_else(|| BezierMotionError::RhoTooLarge {
+    Ok(())
+}
+
+fn too_large(plant: &Plant, t: f64, pointer: String) -> BezierMotionError {
+    BezierMotionError::RhoTooLarge {
         rho_max: t * plant.pole_magnitudes().1,
         limit: RHO_MAX_GL,
         xi: plant.xi,
         pointer,
-    })
+    }
 }
 
 /// Control points, optimizer report and robust results of [`optimize`].
@@ -145,7 +209,7 @@ fn optimize(
     plant: Plant,
     (h, shape, n): (&ResponseMatrix, &LawShape, usize),
     matrices: &mut u64,
-    warnings: &mut Vec<Warning>,
+    warnings: &mut Vec<BezierWarning>,
 ) -> Result<Optimized, BezierMotionError> {
     let mut rows = vec![residual_rows(&plant, h, shape)];
     let mut robust_plants = Vec::new();
@@ -158,8 +222,8 @@ fn optimize(
             robust_plants.push((f, pf, hf));
         }
     }
-    let (hq, f) = objective_terms(input.objective, shape, &input.gamma);
-    let sol = solve(&hq, &f, &rows).map_err(|_| BezierMotionError::ObjectiveSingular {
+    let terms = objective_terms(input.objective, shape, &input.gamma);
+    let sol = solve_terms(&terms, &rows).map_err(|_| BezierMotionError::ObjectiveSingular {
         objective: match input.objective {
             Objective::MinDeviation => "min_deviation",
             Objective::MinAccelL2 => "min_accel_l2",
@@ -189,14 +253,11 @@ fn optimize(
         out
     });
     if sol.rank < sol.n_constraints {
-        warnings.push(Warning::new(
-            "LEAST_SQUARES_COMPROMISE",
-            format!(
-                "only {} of {} zero-vibration conditions can be met (p = {}): the law \
-                 is the least-squares compromise, not exactly vibration-free",
-                sol.rank, sol.n_constraints, input.p
-            ),
-        ));
+        warnings.push(BezierWarning::LeastSquaresCompromise {
+            rank: sol.rank,
+            n_constraints: sol.n_constraints,
+            p: input.p,
+        });
     }
     Ok((
         sol.gamma.clone(),
@@ -254,7 +315,7 @@ pub fn compute(input: &BezierInput, budget: &Budget) -> Result<BezierOutput, Bez
         None => None,
         Some(factors) => Some(sensitivity(
             &plant,
-            (n, input.t),
+            input.t,
             &law,
             factors,
             budget,
@@ -269,6 +330,15 @@ pub fn compute(input: &BezierInput, budget: &Budget) -> Result<BezierOutput, Bez
             },
         )?),
     };
+    let shapers = match &input.shapers {
+        None => None,
+        Some(_) => shaper_comparison(
+            input,
+            &law,
+            (&residual, kin.as_ref(), sensitivity.as_deref()),
+            &mut warnings,
+        )?,
+    };
     Ok(BezierOutput {
         law,
         gamma,
@@ -279,22 +349,93 @@ pub fn compute(input: &BezierInput, budget: &Budget) -> Result<BezierOutput, Bez
         kinematics: kin,
         sensitivity,
         history,
+        shapers,
         warnings,
         matrices,
     })
+}
+
+/// The shaper comparison of `input.shapers` beside `law` (its residual, peaks and sweep reused);
+/// `None` with a warning for ξ ≥ 1.
+fn shaper_comparison(
+    input: &BezierInput,
+    law: &BezierLaw,
+    (residual, kin, sweep): (&Residual, Option<&Kinematics>, Option<&[FactorResult]>),
+    warnings: &mut Vec<BezierWarning>,
+) -> Result<Option<Comparison>, BezierMotionError> {
+    let Some(spec) = &input.shapers else {
+        return Ok(None);
+    };
+    let plant = &input.plant;
+    let (td, rows, skips) = match compare(
+        plant,
+        spec,
+        (input.phi, input.t),
+        input.sensitivity.as_deref(),
+    ) {
+        Ok(r) => r,
+        Err(ShaperSkip::NotOscillatory { xi }) => {
+            warnings.push(BezierWarning::ShaperNotOscillatory { xi });
+            return Ok(None);
+        }
+        Err(ShaperSkip::TooLong { .. }) => return Ok(None),
+    };
+    for s in skips {
+        if let ShaperSkip::TooLong { shaper, t_last, t } = s {
+            let index = spec.shapers.iter().position(|x| *x == shaper).unwrap_or(0);
+            warnings.push(BezierWarning::ShaperTooLong {
+                index,
+                shaper,
+                t_last,
+                t,
+            });
+        }
+    }
+    let finite = rows.iter().flatten().all(|r| {
+        r.energy.is_finite()
+            && r.sensitivity
+                .as_ref()
+                .is_none_or(|s| s.iter().all(|(_, e)| e.is_finite()))
+    });
+    if !finite {
+        return Err(BezierMotionError::NonFinite {
+            what: "residual energy of a shaped move",
+        });
+    }
+    let own;
+    let k = match kin {
+        Some(k) => k,
+        None => {
+            own = kinematics(law);
+            &own
+        }
+    };
+    Ok(Some(Comparison {
+        spec: spec.clone(),
+        td,
+        rows,
+        law: LawRow {
+            energy: residual.energy,
+            peak_accel: k.peak_accel.0,
+            peak_vel: k.peak_velocity.0,
+            sensitivity: sweep.map(|s| s.iter().map(|f| (f.factor, f.residual.energy)).collect()),
+        },
+    }))
 }
 
 /// The residual of `law` with the joint stiffness scaled by each of `factors` (the sensitivity
 /// sweep), counting the matrices built in `matrices` and checking the budget before each one.
 fn sensitivity(
     plant: &Plant,
-    (n, t): (usize, f64),
+    t: f64,
     law: &BezierLaw,
     factors: &[f64],
     budget: &Budget,
     matrices: &mut u64,
 ) -> Result<Vec<FactorResult>, BezierMotionError> {
     let mut out = Vec::with_capacity(factors.len());
+    // The law's end derivatives are computed once; each factor then costs O(N) on the IBP path.
+    let ends = EndDerivatives::new(&law.a);
     for (i, &f) in factors.iter().enumerate() {
         if budget.check(*matrices).is_some() {
             return Err(BezierMotionError::Deadline {
@@ -302,17 +443,19 @@ fn sensitivity(
             });
         }
         let pf = plant.with_stiffness_factor(f);
-        let hf = matrix_for(
-            &pf,
-            n,
-            t,
-            format!("/outputs/sensitivity/stiffness_factors/{i}"),
-        )?;
+        admissible(&pf)?;
+        let x = end_state(&pf, &ends, t).ok_or_else(|| {
+            too_large(
+                &pf,
+                t,
+                format!("/outputs/sensitivity/stiffness_factors/{i}"),
+            )
+        })?;
         *matrices += 1;
         out.push(FactorResult {
             factor: f,
             plant: pf,
-            residual: Residual::of(&pf, &hf, &law.a, t),
+            residual: Residual::from_state(&pf, x, &law.a, t),
         });
         budget.progress((i + 1) as f64 / factors.len() as f64, None);
     }
@@ -326,41 +469,23 @@ fn law_warnings(
     plant: &Plant,
     law: &BezierLaw,
     (gamma, kin): (&[f64], Option<&Kinematics>),
-    warnings: &mut Vec<Warning>,
+    warnings: &mut Vec<BezierWarning>,
 ) {
     let gmax = gamma.iter().fold(0.0_f64, |m, g| m.max(g.abs())) / input.phi.abs();
     if gmax > GAMMA_WARN {
-        warnings.push(Warning::new(
-            "FRAGILE_POLYGON",
-            format!(
-                "max |γ|/|Phi| = {gmax:.4e} > {GAMMA_WARN}: a strongly oscillating control polygon \
-                 (numerically fragile even though the curve is smooth)"
-            ),
-        ));
+        warnings.push(BezierWarning::FragilePolygon {
+            gamma_over_phi: gmax,
+        });
     }
     if polygon_against_motion(law) {
         // The peaks' own check when they were computed (the same samples and refinements).
         if kin.map_or_else(|| reverses(law), |k| k.motion_reversal) {
-            warnings.push(Warning::new(
-                "MOTION_REVERSAL",
-                "the motor velocity changes sign during the move (the law reverses)",
-            ));
+            warnings.push(BezierWarning::MotionReversal);
         } else {
-            warnings.push(Warning::new(
-                "VELOCITY_POLYGON_NEGATIVE",
-                "the velocity control polygon has an ordinate against the direction of motion; \
-                 the curve itself does not reverse",
-            ));
+            warnings.push(BezierWarning::VelocityPolygonNegative);
         }
     }
     if plant.xi >= 1.0 {
-        warnings.push(Warning::new(
-            "NOT_OSCILLATORY",
-            format!(
-                "ξ = {:.6} ≥ 1: the joint does not oscillate; ωd, η, Q and amplitude outputs are \
-                 omitted",
-                plant.xi
-            ),
-        ));
+        warnings.push(BezierWarning::NotOscillatory { xi: plant.xi });
     }
 }

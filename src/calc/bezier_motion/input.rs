@@ -1,15 +1,18 @@
 //! Validation of a [`BezierMotionRequest`] into a [`BezierInput`] (spec §2), collecting every
 //! offending field with its JSON pointer.
 
+use super::compute::BezierWarning;
 use super::history::HistorySpec;
 use super::optimize::Objective;
 use super::plant::Plant;
+use super::shaper::{Baseline, Shaper, ShaperSpec};
 use super::wire::{
     self, BezierMotionRequest, DAMPING, FREE_P, GAMMA, GAMMA_OVER_PHI_MAX, HISTORY_SAMPLES,
     INERTIA, J_EQ, MAX_ACCEL_DEGREE, MAX_FACTORS, MAX_INERTIAS, MOTION_TIME, ORDER_M, ObjectiveIn,
     PHI, RATIO, ROBUST_REL, STIFFNESS, STIFFNESS_FACTOR, WINDOW_AFTER,
 };
-use crate::calc::common::{Warning, time_limit};
+use super::wire::{BaselineIn, EI_TOLERANCE, MAX_SHAPERS, ShaperIn};
+use crate::calc::common::time_limit;
 use crate::calc::{CalcFailure, Validator};
 
 /// What a request computes (the request's `mode`).
@@ -57,8 +60,10 @@ pub struct BezierInput {
     pub history: Option<HistorySpec>,
     /// Stiffness factors of the sensitivity sweep.
     pub sensitivity: Option<Vec<f64>>,
+    /// The shaper comparison, when asked for.
+    pub shapers: Option<ShaperSpec>,
     /// Warnings raised during validation.
-    pub warnings: Vec<Warning>,
+    pub warnings: Vec<BezierWarning>,
 }
 
 /// `usize` of a validated small integer.
@@ -189,11 +194,7 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
                 ) =>
             {
                 if req.mode == wire::Mode::Simulate {
-                    warnings.push(Warning::at(
-                        "ROBUST_IGNORED",
-                        "/optimize/robust_stiffness_rel",
-                        "robust_stiffness_rel applies to mode = optimize; ignored in simulate",
-                    ));
+                    warnings.push(BezierWarning::RobustIgnored);
                     None
                 } else {
                     Some(d)
@@ -251,6 +252,46 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
             .then(|| f.clone())
         });
 
+        let shapers = req.outputs.shaper_comparison.as_ref().and_then(|sc| {
+            let pointer = "/outputs/shaper_comparison/shapers";
+            let n = sc.shapers.len();
+            let mut ok = v.ensure((1..=MAX_SHAPERS).contains(&n), pointer, || {
+                format!("must hold 1..={MAX_SHAPERS} shapers, got {n}")
+            });
+            for (i, s) in sc.shapers.iter().enumerate() {
+                if sc.shapers[..i].contains(s) {
+                    v.push(
+                        format!("{pointer}/{i}"),
+                        format!("shapers[{i}] repeats an earlier entry; list each shaper once"),
+                    );
+                    ok = false;
+                }
+            }
+            let ok_v = v.range(
+                "/outputs/shaper_comparison/ei_tolerance",
+                "ei_tolerance",
+                sc.ei_tolerance,
+                EI_TOLERANCE,
+            );
+            (ok && ok_v).then(|| ShaperSpec {
+                baseline: match sc.baseline {
+                    BaselineIn::Trapezoid => Baseline::Trapezoid,
+                    BaselineIn::Cycloidal => Baseline::Cycloidal,
+                },
+                shapers: sc
+                    .shapers
+                    .iter()
+                    .map(|s| match s {
+                        ShaperIn::None => Shaper::None,
+                        ShaperIn::Zv => Shaper::Zv,
+                        ShaperIn::Zvd => Shaper::Zvd,
+                        ShaperIn::Ei => Shaper::Ei,
+                    })
+                    .collect(),
+                ei_tolerance: sc.ei_tolerance,
+            })
+        });
+
         v.finish()?;
         match (j_eq, phi, gamma) {
             (Some(j_eq), Some(phi), Some(gamma)) if ok_k && ok_c && ok_z && ok_t && ok_n => {
@@ -267,6 +308,7 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
                     kinematics: req.outputs.kinematic_peaks,
                     history,
                     sensitivity,
+                    shapers,
                     warnings,
                 })
             }

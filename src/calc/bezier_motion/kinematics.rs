@@ -4,11 +4,12 @@
 //!
 //! The dense sampling only chooses the bracket: up to degree [`POWER_BASIS_MAX`] it runs on the
 //! power-basis form about the nearer end (Horner, a few flops per sample, relative round-off
-//! ≤ ~2^N ε), above it by de Casteljau; the chosen sample and every refinement step
+//! ≤ ~2^N ε), above it by the O(N) nested Bernstein form about the nearer end (de Casteljau costs
+//! O(N²) per sample); the chosen sample and every refinement step
 //! are evaluated by de Casteljau, so the returned values are de Casteljau's. One sampling of φ'
 //! serves both the peak |φ'| and the least velocity.
 
-use super::law::{BezierLaw, de_casteljau, de_casteljau_slope};
+use super::law::{BezierLaw, binomial, de_casteljau, de_casteljau_slope};
 
 /// Refinement stops below this width in λ (spec §3.9).
 const LAMBDA_TOL: f64 = 1e-12;
@@ -83,13 +84,36 @@ fn scan(c: &[f64], xs: &[f64], signed: Option<f64>) -> (usize, usize) {
 
 /// Hands `visit(k, f(xs[k]))` for every sample in index order, `f` the Bezier polynomial with
 /// ordinates `c`: up to degree [`POWER_BASIS_MAX`] evaluated on the power basis about the nearer
-/// end, eight points at a time, above it by de Casteljau (see the module docs).
+/// end, eight points at a time, above it by the O(n) nested Bernstein form (see the module docs).
 fn for_each_sample(c: &[f64], xs: &[f64], mut visit: impl FnMut(usize, f64)) {
     let last = xs.len().saturating_sub(1);
     let n = c.len().saturating_sub(1);
-    if c.is_empty() || n > POWER_BASIS_MAX {
+    if c.is_empty() {
+        for k in 0..xs.len() {
+            visit(k, 0.0);
+        }
+        return;
+    }
+    if n > POWER_BASIS_MAX {
+        // The nested Bernstein form about the nearer end, O(n) per sample:
+        // f = (1−λ)^n Σ C(n,i) c_i s^i with s = λ/(1−λ) ≤ 1 for λ ≤ ½ (mirrored above), whose
+        // terms are bounded by the Bernstein terms themselves (round-off ~n ε of Σ|c_i| B_i,
+        // de Casteljau's own order), where de Casteljau costs O(n²) per sample.
+        let scaled = |rev: bool| -> Vec<f64> {
+            (0..=n)
+                .map(|i| binomial(n, i) * if rev { c[n - i] } else { c[i] })
+                .collect()
+        };
+        let (fwd, bwd) = (scaled(false), scaled(true));
+        let nn = i32::try_from(n).unwrap_or(i32::MAX);
         for (k, &x) in xs.iter().enumerate() {
-            visit(k, de_casteljau(c, x));
+            let (s, base, a) = if x <= 0.5 {
+                (x / (1.0 - x), 1.0 - x, &fwd)
+            } else {
+                ((1.0 - x) / x, x, &bwd)
+            };
+            let acc = a.iter().rev().fold(0.0, |acc, &ai| acc * s + ai);
+            visit(k, acc * base.powi(nn));
         }
         return;
     }

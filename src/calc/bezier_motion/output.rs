@@ -2,16 +2,18 @@
 
 use std::f64::consts::TAU;
 
-use super::compute::{BezierOutput, FactorResult, Residual};
+use super::compute::{BezierOutput, BezierWarning, FactorResult, GAMMA_WARN, Residual};
 use super::history::History;
 use super::input::{BezierInput, Mode};
 use super::optimize::Objective;
 use super::plant::{EndStateMethod, Plant};
+use super::shaper::{Baseline, Comparison, Shaper};
 use super::wire::{
-    self, BezierMotionResponse, EndState, HistoryOut, KinematicsOut, LawOut, MethodOut,
-    ObjectiveIn, OptimizerOut, ReferenceOut, ResidualOut, SensitivityRow, SystemOut,
+    self, BaselineIn, BezierMotionResponse, BezierRowOut, EndState, FactorEnergyOut, HistoryOut,
+    ImpulseOut, KinematicsOut, LawOut, MethodOut, ObjectiveIn, OptimizerOut, ReferenceOut,
+    ResidualOut, SensitivityRow, ShaperComparisonOut, ShaperIn, ShaperRowOut, SystemOut,
 };
-use crate::calc::common::ResponseSize;
+use crate::calc::common::{ResponseSize, Warning};
 use crate::numerics::{Budget, SolverReport, StopReason};
 
 /// Upper estimate of the answer's size from the validated request (checked before computing):
@@ -30,6 +32,16 @@ pub fn response_size(input: &BezierInput) -> ResponseSize {
         size = size.bytes(
             "/outputs/sensitivity/stiffness_factors",
             f.len() as u64 * (5 * 25 + 100),
+        );
+    }
+    if let Some(s) = &input.shapers {
+        // Per row: 5 numbers and 3 impulses with their names; per factor and row (and the law's
+        // row): 2 numbers and their names.
+        let rows = s.shapers.len() as u64;
+        let factors = input.sensitivity.as_ref().map_or(0, Vec::len) as u64;
+        size = size.bytes(
+            "/outputs/shaper_comparison",
+            512 + rows * 600 + (rows + 1) * factors * (2 * 25 + 30),
         );
     }
     size
@@ -121,7 +133,8 @@ pub fn respond(input: &BezierInput, out: &BezierOutput, budget: &Budget) -> Bezi
             .as_ref()
             .filter(|h| !h.t.is_empty())
             .map(|h| history_out(h, input.t)),
-        warnings: out.warnings.clone(),
+        shaper_comparison: out.shapers.as_ref().map(comparison_out),
+        warnings: out.warnings.iter().map(warning_out).collect(),
         report: SolverReport {
             stop_reason: StopReason::Completed,
             iterations: out.matrices,
@@ -161,6 +174,11 @@ fn method_out(out: &BezierOutput) -> MethodOut {
             EndState::GaussLegendre,
             Some(panels as u64),
             Some(nodes as u64),
+        ),
+        EndStateMethod::Modal { panels, nodes } => (
+            EndState::ModalClosedForm,
+            (panels > 0).then_some(panels as u64),
+            (nodes > 0).then_some(nodes as u64),
         ),
     };
     MethodOut {
@@ -221,5 +239,137 @@ fn history_out(h: &History, t_end: f64) -> HistoryOut {
         peak_ddbeta_after_rad_s2: peak(&h.ddbeta, false),
         substeps_per_sample: h.substeps as u64,
         nodes_per_substep: h.nodes as u64,
+    }
+}
+
+/// The wire form of a domain warning: the spec's code, a message naming the quantity and value,
+/// and the request field it is about.
+#[must_use]
+pub fn warning_out(w: &BezierWarning) -> Warning {
+    match *w {
+        BezierWarning::RobustIgnored => Warning::at(
+            "ROBUST_IGNORED",
+            "/optimize/robust_stiffness_rel",
+            "robust_stiffness_rel applies to mode = optimize; ignored in simulate",
+        ),
+        BezierWarning::LeastSquaresCompromise {
+            rank,
+            n_constraints,
+            p,
+        } => Warning::new(
+            "LEAST_SQUARES_COMPROMISE",
+            format!(
+                "only {rank} of {n_constraints} zero-vibration conditions can be met (p = {p}): \
+                 the law is the least-squares compromise, not exactly vibration-free"
+            ),
+        ),
+        BezierWarning::FragilePolygon { gamma_over_phi } => Warning::new(
+            "FRAGILE_POLYGON",
+            format!(
+                "max |γ|/|Phi| = {gamma_over_phi:.4e} > {GAMMA_WARN}: a strongly oscillating \
+                 control polygon (numerically fragile even though the curve is smooth)"
+            ),
+        ),
+        BezierWarning::MotionReversal => Warning::new(
+            "MOTION_REVERSAL",
+            "the motor velocity changes sign during the move (the law reverses)",
+        ),
+        BezierWarning::VelocityPolygonNegative => Warning::new(
+            "VELOCITY_POLYGON_NEGATIVE",
+            "the velocity control polygon has an ordinate against the direction of motion; the \
+             curve itself does not reverse",
+        ),
+        BezierWarning::NotOscillatory { xi } => Warning::new(
+            "NOT_OSCILLATORY",
+            format!(
+                "ξ = {xi:.6} ≥ 1: the joint does not oscillate; ωd, η, Q and amplitude outputs are \
+                 omitted"
+            ),
+        ),
+        BezierWarning::ShaperNotOscillatory { xi } => Warning::at(
+            "SHAPER_COMPARISON_NOT_OSCILLATORY",
+            "/outputs/shaper_comparison",
+            format!(
+                "ξ = {xi:.6} ≥ 1: the drive has no damped period to design input shapers for; the \
+                 shaper comparison is omitted"
+            ),
+        ),
+        BezierWarning::ShaperTooLong {
+            index,
+            shaper,
+            t_last,
+            t,
+        } => Warning::at(
+            "SHAPER_TOO_LONG",
+            format!("/outputs/shaper_comparison/shapers/{index}"),
+            format!(
+                "the {} shaper's last impulse is at {t_last:.6e} s ≥ T = {t:.6e} s: no time is left \
+                 for the baseline move (T0 ≤ 0); its row is null",
+                shaper_name(shaper)
+            ),
+        ),
+    }
+}
+
+/// The request's name of a shaper.
+fn shaper_name(s: Shaper) -> &'static str {
+    match s {
+        Shaper::None => "none",
+        Shaper::Zv => "zv",
+        Shaper::Zvd => "zvd",
+        Shaper::Ei => "ei",
+    }
+}
+
+fn factor_energies(s: Option<&Vec<(f64, f64)>>) -> Option<Vec<FactorEnergyOut>> {
+    s.map(|v| {
+        v.iter()
+            .map(|&(factor, e_t_j)| FactorEnergyOut { factor, e_t_j })
+            .collect()
+    })
+}
+
+fn comparison_out(c: &Comparison) -> ShaperComparisonOut {
+    ShaperComparisonOut {
+        baseline: match c.spec.baseline {
+            Baseline::Trapezoid => BaselineIn::Trapezoid,
+            Baseline::Cycloidal => BaselineIn::Cycloidal,
+        },
+        ei_tolerance: c.spec.ei_tolerance,
+        damped_period_s: c.td,
+        rows: c
+            .rows
+            .iter()
+            .map(|r| {
+                r.as_ref().map(|r| ShaperRowOut {
+                    shaper: match r.shaper {
+                        Shaper::None => ShaperIn::None,
+                        Shaper::Zv => ShaperIn::Zv,
+                        Shaper::Zvd => ShaperIn::Zvd,
+                        Shaper::Ei => ShaperIn::Ei,
+                    },
+                    baseline_time_s: r.motion.t0,
+                    e_t_j: r.energy,
+                    peak_accel_rad_s2: r.peak_accel,
+                    peak_vel_rad_s: r.peak_vel,
+                    impulses: r
+                        .motion
+                        .impulses
+                        .iter()
+                        .map(|i| ImpulseOut {
+                            t_s: i.t,
+                            amplitude: i.amplitude,
+                        })
+                        .collect(),
+                    sensitivity: factor_energies(r.sensitivity.as_ref()),
+                })
+            })
+            .collect(),
+        bezier: BezierRowOut {
+            e_t_j: c.law.energy,
+            peak_accel_rad_s2: c.law.peak_accel,
+            peak_vel_rad_s: c.law.peak_vel,
+            sensitivity: factor_energies(c.law.sensitivity.as_ref()),
+        },
     }
 }

@@ -2,7 +2,7 @@
 //! matrix `e^{Ac t}` for every ξ ≥ 0, and the response matrix `H` with `x(T) = H·A` (integration
 //! by parts when `r = 2N/rho_min ≤ 1`, composite Gauss–Legendre otherwise).
 
-use super::law::{bernstein_all, binomial};
+use super::law::{bernstein_all, bernstein_horner, binomial};
 use crate::numerics::quadrature::gauss_legendre;
 
 /// Below this `|qd·t²|` the transition matrix uses its power series (spec §3.4): no 0/0 at ξ = 1.
@@ -155,6 +155,16 @@ impl Plant {
 pub enum EndStateMethod {
     /// Integration by parts, closed form (spec §3.5a).
     ClosedFormIbp,
+    /// Over-damped drive (ξ ≥ [`MODAL_XI`]) with r > 1: the two real modes separately, the fast one
+    /// by integration by parts, the slow one by integration by parts when `2N ≤ T·|p_slow|`, else by
+    /// Gauss–Legendre with the §3.5b rule on its own `T·|p_slow|` (`panels`, `nodes`; 0 when
+    /// unused).
+    Modal {
+        /// Gauss–Legendre panels of the slow mode (0: integration by parts).
+        panels: usize,
+        /// Nodes per panel of the slow mode (0: integration by parts).
+        nodes: usize,
+    },
     /// Composite Gauss–Legendre on the Duhamel integral (spec §3.5b).
     GaussLegendre {
         /// Equal panels on [0, 1].
@@ -192,8 +202,23 @@ pub fn ibp_ratio(plant: &Plant, n: usize, t: f64) -> f64 {
     2.0 * n as f64 / (t * plant.pole_magnitudes().0)
 }
 
-/// The production choice of spec §3.5: IBP for r ≤ 1, else Gauss–Legendre with the node rule.
-/// `None` when the Gauss–Legendre path would need `rho_max > RHO_MAX_GL`.
+/// Least damping ratio of the modal path: from ξ = 1.25 the fast pole is at least 4× the slow
+/// one, so the two modes' contributions never cancel to more than a factor ~2.
+pub const MODAL_XI: f64 = 1.25;
+
+/// Whether the end state takes the modal path: r > 1, ξ ≥ [`MODAL_XI`], and Gauss–Legendre would
+/// need more than two panels (below that it costs no more than the modal sums).
+#[must_use]
+pub fn modal_path(plant: &Plant, n: usize, t: f64) -> bool {
+    ibp_ratio(plant, n, t) > 1.0
+        && plant.xi >= MODAL_XI
+        && t * plant.pole_magnitudes().1 > 2.0 * RHO_PER_PANEL
+}
+
+/// The production choice of spec §3.5: IBP for r ≤ 1, else Gauss–Legendre with the node rule
+/// (the modal closed form for strongly over-damped drives, [`modal_path`]). `None` when the
+/// Gauss–Legendre path would need `rho_max > RHO_MAX_GL` (the spec's admission limit, kept on the
+/// modal path too).
 #[must_use]
 pub fn response_matrix(plant: &Plant, n: usize, t: f64) -> Option<ResponseMatrix> {
     let ratio = ibp_ratio(plant, n, t);
@@ -204,8 +229,178 @@ pub fn response_matrix(plant: &Plant, n: usize, t: f64) -> Option<ResponseMatrix
     if rho_max > RHO_MAX_GL {
         return None;
     }
+    if modal_path(plant, n, t) {
+        return Some(response_modal(plant, n, t));
+    }
     let (panels, nodes) = gl_rule(n, rho_max);
     Some(response_gl(plant, n, t, panels, nodes))
+}
+
+/// `H` of an over-damped drive from its two real modes: with `ea = e^{−|p_slow| t}`,
+/// `eb = e^{−|p_fast| t}` and `r = ωn √(ξ²−1)`, the second column of `e^{Ac t}` is
+/// `(ea·[1, −|p_slow|] − eb·[1, −|p_fast|]) / (2r)`, so
+/// `H[:, i] = −zT/(2r) · (I_slow(i)·[1, −|p_slow|] − I_fast(i)·[1, −|p_fast|])` with
+/// `I(ρ, i) = ∫₀¹ e^{−ρ(1−λ)} B(N, i, λ) dλ`, each by [`mode_integrals`].
+#[must_use]
+pub fn response_modal(plant: &Plant, n: usize, t: f64) -> ResponseMatrix {
+    let (slow, fast) = plant.pole_magnitudes();
+    let r = plant.wn * (plant.xi - 1.0).sqrt() * (plant.xi + 1.0).sqrt();
+    let (is, rule) = mode_integrals(n, t * slow);
+    let (ifast, _) = mode_integrals(n, t * fast);
+    let scale = -plant.z * t / (2.0 * r);
+    let psi = is
+        .iter()
+        .zip(&ifast)
+        .map(|(a, b)| scale * (a - b))
+        .collect();
+    let dpsi = is
+        .iter()
+        .zip(&ifast)
+        .map(|(a, b)| scale * (fast * b - slow * a))
+        .collect();
+    let (panels, nodes) = rule.unwrap_or((0, 0));
+    ResponseMatrix {
+        psi,
+        dpsi,
+        method: EndStateMethod::Modal { panels, nodes },
+        ratio: ibp_ratio(plant, n, t),
+    }
+}
+
+/// `I(ρ, i) = ∫₀¹ e^{−ρ(1−λ)} B(N, i, λ) dλ`, i = 0..N, of one real mode: by integration by parts
+/// `Σ_k (−1/ρ)^{k+1} [e^{−ρ} u^(k)(0) − u^(k)(1)]` when `2N ≤ ρ` (the terms fall like (N/ρ)^k, as
+/// in spec §3.5a), else by composite Gauss–Legendre with the §3.5b rule on ρ (returned).
+#[must_use]
+pub fn mode_integrals(n: usize, rho: f64) -> (Vec<f64>, Option<(usize, usize)>) {
+    let mut out = vec![0.0; n + 1];
+    if 2.0 * n as f64 <= rho {
+        let minv = -1.0 / rho;
+        let mut g = (-rho).exp();
+        let mut h = 1.0;
+        let mut falling = 1.0;
+        for k in 0..=n {
+            g *= minv;
+            h *= minv;
+            if k > 0 {
+                falling *= (n + 1 - k) as f64;
+            }
+            for jx in 0..=k {
+                let sign = if (k - jx) % 2 == 0 { 1.0 } else { -1.0 };
+                let coef = falling * sign * binomial(k, jx);
+                out[jx] += coef * g;
+                out[n - k + jx] -= coef * h;
+            }
+        }
+        return (out, None);
+    }
+    let (panels, nodes) = gl_rule(n, rho);
+    let (x, wq) = gauss_legendre(nodes);
+    let pf = panels as f64;
+    let mut b = vec![0.0; n + 1];
+    for p in 0..panels {
+        for (xl, wl) in x.iter().zip(&wq) {
+            let lam = (p as f64 + xl) / pf;
+            bernstein_all(n, lam, &mut b);
+            let w = wl / pf * (-rho * (1.0 - lam)).exp();
+            for (o, bi) in out.iter_mut().zip(&b) {
+                *o += w * bi;
+            }
+        }
+    }
+    (out, Some((panels, nodes)))
+}
+
+/// The λ-derivatives `u^(k)(0)` and `u^(k)(1)`, k = 0..N, of the acceleration law with ordinates
+/// `A_0..A_N` (spec §3.5a): `N!/(N−k)! Δ^k A_0` and `N!/(N−k)! Δ^k A_{N−k}`. They depend on the law
+/// only, so a stiffness sweep computes them once and each factor's end state in O(N).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EndDerivatives {
+    /// The acceleration ordinates.
+    pub a: Vec<f64>,
+    /// `u^(k)(0)`.
+    pub at0: Vec<f64>,
+    /// `u^(k)(1)`.
+    pub at1: Vec<f64>,
+}
+
+impl EndDerivatives {
+    /// The end derivatives of the law with acceleration ordinates `a`.
+    #[must_use]
+    pub fn new(a: &[f64]) -> Self {
+        let n = a.len().saturating_sub(1);
+        let mut d = a.to_vec();
+        let (mut at0, mut at1) = (Vec::with_capacity(n + 1), Vec::with_capacity(n + 1));
+        let mut falling = 1.0;
+        for k in 0..=n {
+            if k > 0 {
+                falling *= (n + 1 - k) as f64;
+                for i in 0..d.len() - 1 {
+                    d[i] = d[i + 1] - d[i];
+                }
+                d.pop();
+            }
+            at0.push(falling * d.first().copied().unwrap_or(0.0));
+            at1.push(falling * d.last().copied().unwrap_or(0.0));
+        }
+        Self {
+            a: a.to_vec(),
+            at0,
+            at1,
+        }
+    }
+}
+
+/// `x(T)` of one law on `plant` without forming `H` (the stiffness sweep): on the IBP path spec
+/// §3.5a applied to the law's [`EndDerivatives`] (O(N)), otherwise the Duhamel integral of the
+/// production rule applied to `u(λ)` itself (O(N) per node) or, on the modal path, `H` and its
+/// product. `None` where [`response_matrix`] is `None`.
+#[must_use]
+pub fn end_state(plant: &Plant, law: &EndDerivatives, t: f64) -> Option<[f64; 2]> {
+    let n = law.a.len().saturating_sub(1);
+    let ratio = ibp_ratio(plant, n, t);
+    if ratio <= 1.0 {
+        let w = plant.wn * t;
+        let minv = [[-2.0 * plant.xi / w, -t / (w * w)], [1.0 / t, 0.0]];
+        let mul = |v: [f64; 2]| {
+            [
+                minv[0][0] * v[0] + minv[0][1] * v[1],
+                minv[1][0] * v[0] + minv[1][1] * v[1],
+            ]
+        };
+        let mut g = plant.column2(t);
+        let mut h = [0.0, 1.0];
+        let mut x = [0.0, 0.0];
+        for (d0, d1) in law.at0.iter().zip(&law.at1) {
+            g = mul(g);
+            h = mul(h);
+            x[0] += g[0] * d0 - h[0] * d1;
+            x[1] += g[1] * d0 - h[1] * d1;
+        }
+        let scale = -plant.z * t;
+        return Some([scale * x[0], scale * x[1]]);
+    }
+    let rho_max = t * plant.pole_magnitudes().1;
+    if rho_max > RHO_MAX_GL {
+        return None;
+    }
+    if modal_path(plant, n, t) {
+        return Some(response_modal(plant, n, t).apply(&law.a));
+    }
+    let (panels, nodes) = gl_rule(n, rho_max);
+    let (x, wq) = gauss_legendre(nodes);
+    let pf = panels as f64;
+    let scale = -plant.z * t;
+    let mut out = [0.0, 0.0];
+    for p in 0..panels {
+        for (xl, wl) in x.iter().zip(&wq) {
+            let lam = (p as f64 + xl) / pf;
+            let col = plant.column2(t * (1.0 - lam));
+            let w = scale * wl / pf * bernstein_horner(&law.a, lam);
+            out[0] += w * col[0];
+            out[1] += w * col[1];
+        }
+    }
+    Some(out)
 }
 
 /// The node rule of spec §3.5b: `P = max(1, ceil(rho_max/24))`,

@@ -45,6 +45,10 @@ pub const STIFFNESS_FACTOR: Range = Range::FINITE.gt(0.0).max(100.0);
 pub const MAX_FACTORS: usize = 201;
 /// Most inertias in `inertias_kgm2`.
 pub const MAX_INERTIAS: usize = 16;
+/// EI shaper's tolerable residual vibration `V` (amplitudes `(1±V)/4`, `(1−V)/2` stay ≥ 0).
+pub const EI_TOLERANCE: Range = Range::closed(0.0, 0.5);
+/// Most shapers in `shaper_comparison.shapers` (each of the four at most once).
+pub const MAX_SHAPERS: usize = 4;
 
 /// Request of `POST /v1/bezier-motion-law`.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
@@ -222,6 +226,76 @@ pub struct OutputsIn {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub sensitivity: Option<SensitivityIn>,
+    /// The returned law beside input shapers (ZV, ZVD, EI) applied to a baseline move on the
+    /// same drive and the same total move time T (off by default; only for ξ < 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub shaper_comparison: Option<ShaperComparisonIn>,
+}
+
+/// Baseline move of the shaper comparison.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(as = bezier_motion::Baseline)]
+#[serde(rename_all = "snake_case")]
+pub enum BaselineIn {
+    /// Equal thirds: `φ'' = +a0`, 0, `−a0`, `a0 = 4.5·Phi/T0²`.
+    #[default]
+    Trapezoid,
+    /// `φ'' = (2π·Phi/T0²)·sin(2πt/T0)` on [0, T0].
+    Cycloidal,
+}
+
+/// An input shaper (impulse train designed for the nominal drive: `Td = 2π/ωd`,
+/// `K = exp(−ξπ/√(1−ξ²))`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(as = bezier_motion::Shaper)]
+#[serde(rename_all = "snake_case")]
+pub enum ShaperIn {
+    /// The unshaped baseline: `[1]` at `[0]`.
+    None,
+    /// Zero vibration: `[1, K]/(1+K)` at `[0, Td/2]`.
+    Zv,
+    /// Zero vibration and derivative: `[1, 2K, K²]/(1+K)²` at `[0, Td/2, Td]`.
+    Zvd,
+    /// Extra-insensitive: `[(1+V)/4, (1−V)/2, (1+V)/4]` at `[0, Td/2, Td]`.
+    Ei,
+}
+
+fn all_shapers() -> Vec<ShaperIn> {
+    vec![ShaperIn::None, ShaperIn::Zv, ShaperIn::Zvd, ShaperIn::Ei]
+}
+
+fn default_ei_tolerance() -> f64 {
+    0.05
+}
+
+/// The shaper comparison: each shaper convolved with the baseline, whose duration is
+/// `T0 = T − (last impulse time)`, so every shaped move ends at T like the Bezier law.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[schema(as = bezier_motion::ShaperComparisonIn)]
+#[serde(deny_unknown_fields)]
+pub struct ShaperComparisonIn {
+    /// Baseline move. Default `trapezoid`.
+    #[serde(default)]
+    pub baseline: BaselineIn,
+    /// Shapers to compare, each at most once (1..4 items). Default all four.
+    #[serde(default = "all_shapers")]
+    #[schema(min_items = 1, max_items = 4, example = json!(["none", "zv", "zvd", "ei"]))]
+    pub shapers: Vec<ShaperIn>,
+    /// EI's tolerable residual vibration `V` (fraction of the unshaped one). Default 0.05.
+    #[serde(default = "default_ei_tolerance")]
+    #[schema(example = 0.05)]
+    pub ei_tolerance: f64,
+}
+
+impl Default for ShaperComparisonIn {
+    fn default() -> Self {
+        Self {
+            baseline: BaselineIn::default(),
+            shapers: all_shapers(),
+            ei_tolerance: default_ei_tolerance(),
+        }
+    }
 }
 
 impl Default for OutputsIn {
@@ -230,6 +304,7 @@ impl Default for OutputsIn {
             kinematic_peaks: true,
             time_history: None,
             sensitivity: None,
+            shaper_comparison: None,
         }
     }
 }
@@ -305,6 +380,11 @@ pub struct BezierMotionResponse {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub time_history: Option<HistoryOut>,
+    /// The law beside input shapers (when `outputs.shaper_comparison` is given and ξ < 1; for
+    /// ξ ≥ 1 omitted with the warning `SHAPER_COMPARISON_NOT_OSCILLATORY`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub shaper_comparison: Option<ShaperComparisonOut>,
     /// Warnings (may be empty).
     pub warnings: Vec<Warning>,
     /// Cost: `iterations` = response matrices built, `evaluations` = those plus history
@@ -348,6 +428,9 @@ pub enum EndState {
     ClosedFormIbp,
     /// Composite Gauss–Legendre on the Duhamel integral (r > 1).
     GaussLegendre,
+    /// Strongly over-damped drive (ξ ≥ 1.25, r > 1): the two real modes in closed form (the
+    /// slow one by Gauss–Legendre when `2N > T·|p_slow|`: `panels`, `nodes` are then its rule).
+    ModalClosedForm,
 }
 
 /// How the end state was computed (spec §3.5).
@@ -358,10 +441,10 @@ pub struct MethodOut {
     pub end_state: EndState,
     /// `r = 2N / rho_min` (IBP when ≤ 1).
     pub ibp_ratio: f64,
-    /// Gauss–Legendre panels (absent for IBP).
+    /// Gauss–Legendre panels (absent for IBP; on the modal path the slow mode's, when used).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub panels: Option<u64>,
-    /// Gauss–Legendre nodes per panel (absent for IBP).
+    /// Gauss–Legendre nodes per panel (absent for IBP; on the modal path the slow mode's).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nodes: Option<u64>,
 }
@@ -541,6 +624,85 @@ pub struct HistoryOut {
     pub nodes_per_substep: u64,
 }
 
+/// The shaper comparison (`outputs.shaper_comparison`).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bezier_motion::ShaperComparisonOut)]
+pub struct ShaperComparisonOut {
+    /// Baseline move.
+    pub baseline: BaselineIn,
+    /// EI's tolerance `V`.
+    pub ei_tolerance: f64,
+    /// Damped period `Td = 2π/ωd` the shapers are designed for \[s\].
+    pub damped_period_s: f64,
+    /// One row per requested shaper, in request order; `null` where the shaper lasts the whole
+    /// move or longer (`T0 ≤ 0`, warning `SHAPER_TOO_LONG`).
+    pub rows: Vec<Option<ShaperRowOut>>,
+    /// The returned Bezier law on the same drive.
+    pub bezier: BezierRowOut,
+}
+
+/// One shaped move.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bezier_motion::ShaperRow)]
+pub struct ShaperRowOut {
+    /// The shaper.
+    pub shaper: ShaperIn,
+    /// Baseline duration `T0 = T − (last impulse time)` \[s\].
+    pub baseline_time_s: f64,
+    /// Residual vibration energy at T, `½ J_eq (ψ'(T)² + ωn² ψ(T)²)` \[J\] (spec §3.3).
+    #[serde(rename = "E_T_J")]
+    pub e_t_j: f64,
+    /// Peak motor acceleration `max |u|` [rad/s²].
+    pub peak_accel_rad_s2: f64,
+    /// Peak motor speed `max |∫u|` [rad/s].
+    pub peak_vel_rad_s: f64,
+    /// The shaper's impulses.
+    pub impulses: Vec<ImpulseOut>,
+    /// Residual energy on the drive with stiffness `k·f`, the shaper designed for the nominal k
+    /// (when `outputs.sensitivity` is given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub sensitivity: Option<Vec<FactorEnergyOut>>,
+}
+
+/// The Bezier law's row of the shaper comparison.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+#[schema(as = bezier_motion::BezierRow)]
+pub struct BezierRowOut {
+    /// Residual vibration energy at T \[J\] (as `residual.E_T_J`).
+    #[serde(rename = "E_T_J")]
+    pub e_t_j: f64,
+    /// Peak motor acceleration `max |φ''|` [rad/s²].
+    pub peak_accel_rad_s2: f64,
+    /// Peak motor speed `max |φ'|` [rad/s].
+    pub peak_vel_rad_s: f64,
+    /// Residual energy for stiffness `k·f` (when `outputs.sensitivity` is given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub sensitivity: Option<Vec<FactorEnergyOut>>,
+}
+
+/// One impulse of a shaper.
+#[derive(Debug, Clone, Copy, Serialize, ToSchema)]
+#[schema(as = bezier_motion::Impulse)]
+pub struct ImpulseOut {
+    /// Time \[s\].
+    pub t_s: f64,
+    /// Amplitude (a shaper's amplitudes sum to 1).
+    pub amplitude: f64,
+}
+
+/// Residual energy for one stiffness factor.
+#[derive(Debug, Clone, Copy, Serialize, ToSchema)]
+#[schema(as = bezier_motion::FactorEnergy)]
+pub struct FactorEnergyOut {
+    /// Factor f on k.
+    pub factor: f64,
+    /// Residual energy E(T) \[J\].
+    #[serde(rename = "E_T_J")]
+    pub e_t_j: f64,
+}
+
 // The documented bounds: the validator (input.rs) checks the same constants.
 crate::schema_bounds! {
     BezierMotionRequest {
@@ -571,5 +733,8 @@ crate::schema_bounds! {
     },
     SensitivityIn {
         stiffness_factors @items: STIFFNESS_FACTOR,
+    },
+    ShaperComparisonIn {
+        ei_tolerance: EI_TOLERANCE,
     },
 }
