@@ -8,6 +8,7 @@
 //! * `--batch`: the input is NDJSON (one request per line); the output is NDJSON in input order
 //!   (an answer, or the problem details of that line). Lines run concurrently on the compute pool.
 //! * `--svg`: the answer as an SVG picture instead of JSON (`Accept: image/svg+xml`).
+//! * `--report OUT.html`: write the calculation report (`Accept: text/html`) to `OUT.html`.
 //!
 //! Exit codes: 0 every answer succeeded; 2 a request was refused (4xx: invalid, infeasible,
 //! too large); 1 the service failed (5xx) or the input could not be read.
@@ -39,6 +40,9 @@ pub struct RunArgs {
     /// Write the answer as an SVG picture instead of JSON.
     #[arg(long, conflicts_with = "batch")]
     pub svg: bool,
+    /// Write the calculation report (self-contained HTML, `Accept: text/html`) to this file.
+    #[arg(long, value_name = "OUT.html", conflicts_with_all = ["batch", "svg"])]
+    pub report: Option<std::path::PathBuf>,
     /// Pretty-print JSON answers.
     #[arg(long)]
     pub pretty: bool,
@@ -78,18 +82,21 @@ pub struct Answer {
 
 /// Run one request through the application in process.
 pub async fn call(state: &AppState, path: &str, body: Vec<u8>, svg: bool) -> Answer {
+    let accept = if svg {
+        "image/svg+xml"
+    } else {
+        "application/json"
+    };
+    call_accept(state, path, body, accept).await
+}
+
+/// Run one request through the application in process, asking for the media type `accept`.
+pub async fn call_accept(state: &AppState, path: &str, body: Vec<u8>, accept: &str) -> Answer {
     let req = Request::builder()
         .method("POST")
         .uri(path)
         .header(header::CONTENT_TYPE, "application/json")
-        .header(
-            header::ACCEPT,
-            if svg {
-                "image/svg+xml"
-            } else {
-                "application/json"
-            },
-        )
+        .header(header::ACCEPT, accept)
         .body(Body::from(body));
     let Ok(req) = req else {
         return internal("could not build the request");
@@ -185,6 +192,8 @@ pub fn run(args: &RunArgs, config: ServiceConfig) -> ExitCode {
     let code = rt.block_on(async {
         if args.batch {
             batch(&state, &path, &input, args.pretty).await
+        } else if let Some(out) = &args.report {
+            report(&state, &path, input, out).await
         } else {
             single(&state, &path, input, args.svg, args.pretty).await
         }
@@ -208,6 +217,23 @@ async fn single(state: &AppState, path: &str, input: Vec<u8>, svg: bool, pp: boo
     let _ = out.write_all(&body);
     let _ = out.write_all(b"\n");
     code
+}
+
+/// `--report OUT.html`: the report to the file; a refused request's problem details to stderr.
+async fn report(state: &AppState, path: &str, input: Vec<u8>, out: &std::path::Path) -> u8 {
+    let a = call_accept(state, path, input, crate::export::HTML).await;
+    let code = exit_for(a.status);
+    if code != 0 {
+        let mut err = std::io::stderr().lock();
+        let _ = err.write_all(&a.body);
+        let _ = err.write_all(b"\n");
+        return code;
+    }
+    if let Err(e) = std::fs::write(out, &a.body) {
+        eprintln!("cannot write {}: {e}", out.display());
+        return 1;
+    }
+    0
 }
 
 async fn batch(state: &AppState, path: &str, input: &[u8], pp: bool) -> u8 {

@@ -6,11 +6,13 @@
 //!   socket).
 //! * [`config`]: flags and environment variables of the binary.
 //! * [`plot`]: SVG pictures of answers (`Accept: image/svg+xml`).
+//! * [`export`]: calculation reports (HTML), tables (CSV) and drawings (DXF) of answers.
 //! * [`cli`]: `mechcalc run`, one calculation from the command line without a server.
 
 pub mod calc;
 pub mod cli;
 pub mod config;
+pub mod export;
 pub mod http;
 pub mod numerics;
 pub mod plot;
