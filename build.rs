@@ -48,7 +48,8 @@ fn module_docs(root: &Path) {
         .filter(|e| e.path().join("mod.rs").is_file())
         .collect();
     modules.sort_by_key(std::fs::DirEntry::file_name);
-    let mut out = String::from("/// (module, its `//!` documentation) of every calculation module.\n");
+    let mut out =
+        String::from("/// (module, its `//!` documentation) of every calculation module.\n");
     out.push_str("pub const MODULE_DOCS: &[(&str, &str)] = &[\n");
     for m in modules {
         let path = m.path().join("mod.rs");

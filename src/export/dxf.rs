@@ -190,7 +190,9 @@ pub fn render(route: &str, request: &Value, answer: &Value) -> Result<Vec<u8>, D
         "/v1/cognates" => cognates(answer),
         "/v1/continuum-workspace" => workspace(answer),
         "/v1/spatial-coupling" => coupling(answer),
-        _ => Err(DxfError::Nothing(format!("{route} has no geometry to draw"))),
+        _ => Err(DxfError::Nothing(format!(
+            "{route} has no geometry to draw"
+        ))),
     }
 }
 
@@ -206,41 +208,48 @@ fn xy(v: &Value) -> Option<[f64; 2]> {
 /// chord's midpoint lies within `tol` of the curve's midpoint (and its quarter points too).
 #[must_use]
 pub fn adaptive_closed(f: &dyn Fn(f64) -> [f64; 2], n0: usize, tol: f64) -> Vec<[f64; 2]> {
-    fn dev(f: &dyn Fn(f64) -> [f64; 2], t0: f64, t1: f64, a: [f64; 2], b: [f64; 2]) -> f64 {
-        [0.25, 0.5, 0.75]
-            .iter()
-            .map(|s| {
-                let p = f(t0 + s * (t1 - t0));
-                let q = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
-                (p[0] - q[0]).hypot(p[1] - q[1])
-            })
-            .fold(0.0, f64::max)
-    }
-    fn split(
-        f: &dyn Fn(f64) -> [f64; 2],
-        t0: f64,
-        t1: f64,
-        a: [f64; 2],
-        b: [f64; 2],
+    /// One curve and its tolerance; `split` bisects one parameter interval.
+    struct Curve<'a> {
+        f: &'a dyn Fn(f64) -> [f64; 2],
         tol: f64,
-        depth: u32,
-        out: &mut Vec<[f64; 2]>,
-    ) {
-        if depth < MAX_BISECTIONS && dev(f, t0, t1, a, b) > tol {
-            let tm = 0.5 * (t0 + t1);
-            let m = f(tm);
-            split(f, t0, tm, a, m, tol, depth + 1, out);
-            split(f, tm, t1, m, b, tol, depth + 1, out);
-        } else {
-            out.push(a);
+    }
+    impl Curve<'_> {
+        /// Largest distance of the curve's quarter points from the chord's.
+        fn deviation(&self, t0: f64, t1: f64, a: [f64; 2], b: [f64; 2]) -> f64 {
+            [0.25, 0.5, 0.75]
+                .iter()
+                .map(|s| {
+                    let p = (self.f)(t0 + s * (t1 - t0));
+                    let q = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
+                    (p[0] - q[0]).hypot(p[1] - q[1])
+                })
+                .fold(0.0, f64::max)
+        }
+
+        fn split(
+            &self,
+            (t0, t1): (f64, f64),
+            (a, b): ([f64; 2], [f64; 2]),
+            depth: u32,
+            out: &mut Vec<[f64; 2]>,
+        ) {
+            if depth < MAX_BISECTIONS && self.deviation(t0, t1, a, b) > self.tol {
+                let tm = 0.5 * (t0 + t1);
+                let m = (self.f)(tm);
+                self.split((t0, tm), (a, m), depth + 1, out);
+                self.split((tm, t1), (m, b), depth + 1, out);
+            } else {
+                out.push(a);
+            }
         }
     }
+    let curve = Curve { f, tol };
     let n0 = n0.max(8);
     let step = std::f64::consts::TAU / n0 as f64;
     let mut out = Vec::new();
     for i in 0..n0 {
         let (t0, t1) = (step * i as f64, step * (i + 1) as f64);
-        split(f, t0, t1, f(t0), f(t1), tol, 0, &mut out);
+        curve.split((t0, t1), (f(t0), f(t1)), 0, &mut out);
     }
     out
 }
@@ -278,7 +287,11 @@ fn irefc(request: &Value, answer: &Value) -> Result<Vec<u8>, DxfError> {
         s.layer(name, color);
     }
     let n0 = 16 * z2 as usize;
-    let cam = adaptive_closed(&|t| g.profile_point(Wheel::Cam, t).contact, n0, CHORD_TOLERANCE_MM);
+    let cam = adaptive_closed(
+        &|t| g.profile_point(Wheel::Cam, t).contact,
+        n0,
+        CHORD_TOLERANCE_MM,
+    );
     s.polyline("CAM_PROFILE", &cam, true);
     // The crown's own frame turned by π and moved to its centre at (2e, 0): the pitch points of
     // both wheels then coincide at (−r1, 0) and the element at φ2 = 0 is the same in both frames.
@@ -362,7 +375,12 @@ fn cognates(answer: &Value) -> Result<Vec<u8>, DxfError> {
                 s.point("GROUND_PIVOTS", q);
             }
         }
-        for c in m.get("curves").and_then(Value::as_array).into_iter().flatten() {
+        for c in m
+            .get("curves")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+        {
             let pts: Vec<[f64; 2]> = c
                 .get("points")
                 .and_then(Value::as_array)
@@ -437,10 +455,7 @@ pub fn cell_outline(ok: &[bool], n1: usize, n2: usize) -> Vec<Vec<usize>> {
         used[start] = true;
         let (a, mut cur) = edges[start];
         let mut chain = vec![a, cur];
-        while let Some(&e) = at
-            .get(&cur)
-            .and_then(|es| es.iter().find(|&&e| !used[e]))
-        {
+        while let Some(&e) = at.get(&cur).and_then(|es| es.iter().find(|&&e| !used[e])) {
             used[e] = true;
             let (x, y) = edges[e];
             cur = if x == cur { y } else { x };
@@ -466,7 +481,12 @@ fn workspace(answer: &Value) -> Result<Vec<u8>, DxfError> {
     let mut waves: Vec<&Value> = Vec::new();
     waves.extend(answer.get("nodes"));
     for key in ["other_waves", "waves"] {
-        for w in answer.get(key).and_then(Value::as_array).into_iter().flatten() {
+        for w in answer
+            .get(key)
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+        {
             waves.extend(w.get("nodes"));
         }
     }

@@ -107,12 +107,7 @@ pub fn csv(
         answer,
         schemas: &schemas,
     };
-    let known = || {
-        defs.iter()
-            .map(|d| d.name)
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
+    let known = || defs.iter().map(|d| d.name).collect::<Vec<_>>().join(", ");
     let grid = match name {
         Some(n) => {
             let def = defs
@@ -131,16 +126,13 @@ pub fn csv(
                 ))
             })?
         }
-        None => defs
-            .iter()
-            .find_map(|d| (d.build)(&ctx))
-            .ok_or_else(|| {
-                TableError::Absent(format!(
-                    "the answer carries none of the tables of {route} ({}); the request \
+        None => defs.iter().find_map(|d| (d.build)(&ctx)).ok_or_else(|| {
+            TableError::Absent(format!(
+                "the answer carries none of the tables of {route} ({}); the request \
                      options named in the OpenAPI document turn them on",
-                    known()
-                ))
-            })?,
+                known()
+            ))
+        })?,
     };
     table::to_csv(&grid).map_err(|e| TableError::Write(e.to_string()))
 }

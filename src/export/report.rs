@@ -103,24 +103,25 @@ figure{margin:1em 0}figure svg{max-width:100%;height:auto;border:1px solid #ddd}
 #[must_use]
 pub fn render(r: &ReportInput<'_>) -> String {
     let schemas = Schemas::of(r.doc, r.route);
-    let op = r
-        .doc
-        .pointer(&format!("/paths/{}/post", r.route.replace('~', "~0").replace('/', "~1")));
+    let op = r.doc.pointer(&format!(
+        "/paths/{}/post",
+        r.route.replace('~', "~0").replace('/', "~1")
+    ));
     let summary = op
         .and_then(|o| o.get("summary"))
         .and_then(Value::as_str)
         .unwrap_or(r.route);
     let mut h = String::with_capacity(64 * 1024);
-    let _ = write!(
+    let _ = writeln!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
          <meta name=\"viewport\" content=\"width=device-width,initial-scale=1\">\
-         <title>mechcalc report: {}</title><style>{STYLE}</style></head><body>\n",
+         <title>mechcalc report: {}</title><style>{STYLE}</style></head><body>",
         escape(r.route)
     );
-    let _ = write!(
+    let _ = writeln!(
         h,
-        "<h1>Calculation report: {}</h1><p class=\"sub\"><code>POST {}</code> · mechcalc {} · {}</p>\n",
+        "<h1>Calculation report: {}</h1><p class=\"sub\"><code>POST {}</code> · mechcalc {} · {}</p>",
         escape(summary),
         escape(r.route),
         escape(env!("CARGO_PKG_VERSION")),
@@ -139,10 +140,10 @@ pub fn render(r: &ReportInput<'_>) -> String {
     h.push_str("</code>, or <code>mechcalc run ");
     h.push_str(&escape(r.route));
     h.push_str(" request.json</code>; the answer of the same version and commit is identical (deterministic calculations; fields measuring time differ).</p>\n");
-    let _ = write!(
+    let _ = writeln!(
         h,
         "<script type=\"application/json\" id=\"request\">{}</script>\n\
-         <script type=\"application/json\" id=\"answer\">{}</script>\n</body></html>\n",
+         <script type=\"application/json\" id=\"answer\">{}</script>\n</body></html>",
         script_json(r.request_bytes),
         script_json(r.answer_bytes)
     );
@@ -152,7 +153,12 @@ pub fn render(r: &ReportInput<'_>) -> String {
 fn provenance(h: &mut String, r: &ReportInput<'_>) {
     h.push_str("<h2 id=\"provenance\">Provenance</h2>\n<table>");
     let mut row = |k: &str, v: &str| {
-        let _ = write!(h, "<tr><th>{}</th><td class=\"v\">{}</td></tr>", escape(k), escape(v));
+        let _ = write!(
+            h,
+            "<tr><th>{}</th><td class=\"v\">{}</td></tr>",
+            escape(k),
+            escape(v)
+        );
     };
     row("service", "mechcalc");
     row("version", env!("CARGO_PKG_VERSION"));
@@ -175,7 +181,7 @@ fn doc_html(h: &mut String, text: &str) {
     let mut para = String::new();
     let flush = |h: &mut String, para: &mut String| {
         if !para.trim().is_empty() {
-            let _ = write!(h, "<p>{}</p>\n", inline(para.trim()));
+            let _ = writeln!(h, "<p>{}</p>", inline(para.trim()));
         }
         para.clear();
     };
@@ -187,7 +193,11 @@ fn doc_html(h: &mut String, text: &str) {
                 h.push_str("</ul>\n");
                 in_list = false;
             }
-            let _ = write!(h, "<h3>{}</h3>\n", inline(head.trim_start_matches('#').trim()));
+            let _ = writeln!(
+                h,
+                "<h3>{}</h3>",
+                inline(head.trim_start_matches('#').trim())
+            );
         } else if let Some(item) = t.strip_prefix("* ").or_else(|| t.strip_prefix("- ")) {
             flush(h, &mut para);
             if !in_list {
@@ -230,13 +240,16 @@ fn inline(s: &str) -> String {
 
 fn method(h: &mut String, r: &ReportInput<'_>, op: Option<&Value>) {
     h.push_str("<h2 id=\"method\">Method and references</h2>\n");
-    if let Some(d) = op.and_then(|o| o.get("description")).and_then(Value::as_str) {
+    if let Some(d) = op
+        .and_then(|o| o.get("description"))
+        .and_then(Value::as_str)
+    {
         doc_html(h, d);
     }
     if let Some(m) = super::module_of(r.route)
         && let Some((_, doc)) = super::MODULE_DOCS.iter().find(|(n, _)| *n == m)
     {
-        let _ = write!(h, "<h3>Module <code>{}</code></h3>\n", escape(m));
+        let _ = writeln!(h, "<h3>Module <code>{}</code></h3>", escape(m));
         doc_html(h, doc);
     }
 }
@@ -284,13 +297,19 @@ fn leaves(v: &Value, path: &mut Vec<String>, out: &mut Vec<Leaf>) {
         }
         Value::Array(a) if a.iter().all(|x| !x.is_object() && !x.is_array()) => {
             let value = if a.len() <= SHOWN_ARRAY {
-                format!("[{}]", a.iter().map(show_scalar).collect::<Vec<_>>().join(", "))
+                format!(
+                    "[{}]",
+                    a.iter().map(show_scalar).collect::<Vec<_>>().join(", ")
+                )
             } else {
                 let nums: Vec<f64> = a.iter().filter_map(Value::as_f64).collect();
                 let lo = nums.iter().copied().fold(f64::INFINITY, f64::min);
                 let hi = nums.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 if nums.len() == a.len() {
-                    format!("{} values from {lo} to {hi} (min … max; all in the embedded JSON)", a.len())
+                    format!(
+                        "{} values from {lo} to {hi} (min … max; all in the embedded JSON)",
+                        a.len()
+                    )
                 } else {
                     format!("{} values (all in the embedded JSON)", a.len())
                 }
@@ -311,7 +330,10 @@ fn leaves(v: &Value, path: &mut Vec<String>, out: &mut Vec<Leaf>) {
         Value::Array(a) => out.push(Leaf {
             pointer: pointer(),
             schema: schema(path),
-            value: format!("{} entries (all in the embedded JSON and the CSV tables)", a.len()),
+            value: format!(
+                "{} entries (all in the embedded JSON and the CSV tables)",
+                a.len()
+            ),
         }),
         scalar => out.push(Leaf {
             pointer: pointer(),
@@ -336,9 +358,9 @@ fn field_table<'d>(h: &mut String, rows: &[Leaf], doc: impl Fn(&[&str]) -> Optio
     for l in rows.iter().take(MAX_ROWS) {
         let p: Vec<&str> = l.schema.iter().map(String::as_str).collect();
         let d = doc(&p).unwrap_or("");
-        let _ = write!(
+        let _ = writeln!(
             h,
-            "<tr><td><code>{}</code></td><td class=\"v\">{}</td><td>{}</td><td>{}</td></tr>\n",
+            "<tr><td><code>{}</code></td><td class=\"v\">{}</td><td>{}</td><td>{}</td></tr>",
             escape(&l.pointer),
             escape(&l.value),
             escape(unit_of(d).unwrap_or("")),
@@ -346,9 +368,9 @@ fn field_table<'d>(h: &mut String, rows: &[Leaf], doc: impl Fn(&[&str]) -> Optio
         );
     }
     if rows.len() > MAX_ROWS {
-        let _ = write!(
+        let _ = writeln!(
             h,
-            "<tr><td colspan=\"4\">… {} more fields in the embedded JSON</td></tr>\n",
+            "<tr><td colspan=\"4\">… {} more fields in the embedded JSON</td></tr>",
             rows.len() - MAX_ROWS
         );
     }
@@ -377,8 +399,9 @@ fn is_check(pointer: &str) -> bool {
 fn results(h: &mut String, r: &ReportInput<'_>, schemas: &Schemas<'_>) {
     let mut rows = Vec::new();
     leaves(r.answer, &mut Vec::new(), &mut rows);
-    let (warnings, rest): (Vec<Leaf>, Vec<Leaf>) =
-        rows.into_iter().partition(|l| l.pointer.starts_with("/warnings"));
+    let (warnings, rest): (Vec<Leaf>, Vec<Leaf>) = rows
+        .into_iter()
+        .partition(|l| l.pointer.starts_with("/warnings"));
     let (solver, rest): (Vec<Leaf>, Vec<Leaf>) = rest.into_iter().partition(|l| {
         l.pointer.starts_with("/report/")
             || l.pointer.starts_with("/meta/solver/")
@@ -408,9 +431,9 @@ fn results(h: &mut String, r: &ReportInput<'_>, schemas: &Schemas<'_>) {
             h.push_str("<table><tr><th>code</th><th>message</th><th>field</th></tr>\n");
             for x in w {
                 let s = |k: &str| x.get(k).map(show_scalar).unwrap_or_default();
-                let _ = write!(
+                let _ = writeln!(
                     h,
-                    "<tr class=\"warn\"><td><code>{}</code></td><td>{}</td><td><code>{}</code></td></tr>\n",
+                    "<tr class=\"warn\"><td><code>{}</code></td><td>{}</td><td><code>{}</code></td></tr>",
                     escape(&s("code")),
                     escape(&s("message")),
                     escape(&s("pointer"))
@@ -433,15 +456,16 @@ fn picture(h: &mut String, r: &ReportInput<'_>) {
     h.push_str("<h2 id=\"picture\">Picture</h2>\n");
     match crate::plot::render(r.route, r.request, r.answer) {
         Some(Ok(svg)) => {
-            let body = svg
-                .find("<svg")
-                .map_or(svg.as_str(), |i| &svg[i..]);
-            let _ = write!(h, "<figure>{body}<figcaption>The answer's picture (as <code>Accept: image/svg+xml</code> draws it).</figcaption></figure>\n");
+            let body = svg.find("<svg").map_or(svg.as_str(), |i| &svg[i..]);
+            let _ = writeln!(
+                h,
+                "<figure>{body}<figcaption>The answer's picture (as <code>Accept: image/svg+xml</code> draws it).</figcaption></figure>"
+            );
         }
         Some(Err(e)) => {
-            let _ = write!(
+            let _ = writeln!(
                 h,
-                "<p>No picture of this answer: {}. The picture endpoint (<code>Accept: image/svg+xml</code>) turns on the outputs it needs.</p>\n",
+                "<p>No picture of this answer: {}. The picture endpoint (<code>Accept: image/svg+xml</code>) turns on the outputs it needs.</p>",
                 escape(&e.to_string())
             );
         }

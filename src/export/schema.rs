@@ -17,12 +17,13 @@ impl<'a> Schemas<'a> {
     /// The schemas of `POST route` in `doc` (absent parts stay `None`: lookups then find nothing).
     #[must_use]
     pub fn of(doc: &'a Value, route: &str) -> Self {
-        let op = doc.get("paths").and_then(|p| p.get(route)).map(|p| &p["post"]);
+        let op = doc
+            .get("paths")
+            .and_then(|p| p.get(route))
+            .map(|p| &p["post"]);
         Self {
             doc,
-            request: op.and_then(|o| {
-                o.pointer("/requestBody/content/application~1json/schema")
-            }),
+            request: op.and_then(|o| o.pointer("/requestBody/content/application~1json/schema")),
             answer: op.and_then(|o| o.pointer("/responses/200/content/application~1json/schema")),
         }
     }
@@ -99,13 +100,11 @@ fn field<'a>(doc: &'a Value, s: &'a Value, path: &[&str]) -> Option<&'a Value> {
 /// The description at `path` (on the property itself, or on the schema it refers to).
 fn description<'a>(doc: &'a Value, root: &'a Value, path: &[&str]) -> Option<&'a str> {
     let f = field(doc, root, path)?;
-    f.get("description")
-        .and_then(Value::as_str)
-        .or_else(|| {
-            alternatives(doc, f)
-                .into_iter()
-                .find_map(|a| a.get("description").and_then(Value::as_str))
-        })
+    f.get("description").and_then(Value::as_str).or_else(|| {
+        alternatives(doc, f)
+            .into_iter()
+            .find_map(|a| a.get("description").and_then(Value::as_str))
+    })
 }
 
 #[cfg(test)]

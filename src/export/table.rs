@@ -264,13 +264,13 @@ pub const TABLES: &[(&str, &[TableDef])] = &[
                 name: "frf",
                 doc: "one row per frequency: magnitude and phase at every output abscissa \
                       (`outputs.frequency_response`)",
-                build: |c| with_points(c, &["frequency_response"]),
+                build: |c| with_points(c, &["frequency_response"], "frequencies_hz"),
             },
             TableDef {
                 name: "time_response",
                 doc: "one row per time sample: deflection at every output abscissa, stroke, \
                       force, current, voltage (`outputs.time_response.return_series`)",
-                build: |c| with_points(c, &["time_response"]),
+                build: |c| with_points(c, &["time_response"], "t_s"),
             },
             TableDef {
                 name: "eigenvalues",
@@ -326,13 +326,21 @@ fn join<'a>(base: &[&'a str], more: &[&'a str]) -> Vec<&'a str> {
 /// Every array of scalars directly in the object at `base` that is as long as the first one: one
 /// column each (scalar fields and other lengths are not rows of this table).
 fn columns(c: &Ctx<'_>, base: &[&str]) -> Option<Grid> {
+    columns_along(c, base, None)
+}
+
+/// As [`columns`], the row count set by the array `anchor` (which must be present) when given.
+fn columns_along(c: &Ctx<'_>, base: &[&str], anchor: Option<&str>) -> Option<Grid> {
     let obj = at(c.answer, base)?.as_object()?;
     let keys: Vec<&str> = obj
         .iter()
         .filter(|(_, v)| scalars(v).is_some())
         .map(|(k, _)| k.as_str())
         .collect();
-    let n = obj.get(*keys.first()?).and_then(scalars)?.len();
+    let n = obj
+        .get(anchor.or(keys.first().copied())?)
+        .and_then(scalars)?
+        .len();
     let keys: Vec<&str> = keys
         .into_iter()
         .filter(|k| obj.get(*k).and_then(scalars).is_some_and(|a| a.len() == n))
@@ -376,7 +384,12 @@ fn parallel(c: &Ctx<'_>, base: &[&str], keys: &[&str], index: Option<&str>) -> O
 /// Flattened scalar leaves of one record: `(name, schema path, value)`. Nested objects give dotted
 /// names; an array of up to three numbers gives `name.0 …`; an array of strings gives one cell
 /// with the strings separated by spaces; other arrays are tables of their own.
-fn flatten(v: &Value, name: &str, path: &mut Vec<String>, out: &mut Vec<(String, Vec<String>, Value)>) {
+fn flatten(
+    v: &Value,
+    name: &str,
+    path: &mut Vec<String>,
+    out: &mut Vec<(String, Vec<String>, Value)>,
+) {
     match v {
         Value::Object(m) => {
             for (k, x) in m {
@@ -458,10 +471,10 @@ fn records_of<'a>(
     Some(g)
 }
 
-/// The arrays at `base` (as [`columns`]) and, for each entry of `base.points`, its arrays of the
+/// The arrays at `base` as long as `anchor` (as [`columns_along`]) and, for each entry of `base.points`, its arrays of the
 /// same length, named `key@x=<x_m>`.
-fn with_points(c: &Ctx<'_>, base: &[&str]) -> Option<Grid> {
-    let mut g = columns(c, base)?;
+fn with_points(c: &Ctx<'_>, base: &[&str], anchor: &str) -> Option<Grid> {
+    let mut g = columns_along(c, base, Some(anchor))?;
     let n = g.rows.len();
     let points = at(c.answer, base)?.get("points").and_then(Value::as_array);
     for p in points.into_iter().flatten() {
@@ -492,7 +505,10 @@ fn cognate_curves(c: &Ctx<'_>) -> Option<Grid> {
         columns: vec![
             lead("mechanism", None),
             lead("circuit", None),
-            c.column("input_deg", &["mechanisms", "*", "curves", "*", "input_deg"]),
+            c.column(
+                "input_deg",
+                &["mechanisms", "*", "curves", "*", "input_deg"],
+            ),
             c.column("branch", &["mechanisms", "*", "curves", "*", "branch"]),
             c.column("x", &["mechanisms", "*", "curves", "*", "points"]),
             c.column("y", &["mechanisms", "*", "curves", "*", "points"]),
@@ -543,7 +559,10 @@ fn ranking(c: &Ctx<'_>) -> Option<Grid> {
     }
     for r in results {
         for (i, name) in names.iter().enumerate() {
-            let mut row = vec![r.get("time_h").cloned().unwrap_or(Value::Null), name.clone()];
+            let mut row = vec![
+                r.get("time_h").cloned().unwrap_or(Value::Null),
+                name.clone(),
+            ];
             row.extend(
                 per_component
                     .iter()
@@ -615,8 +634,10 @@ fn wave_nodes(c: &Ctx<'_>, g: &mut Grid, wave: usize, nodes: &Value, base: &[&st
         g.columns.push(lead("wave", None));
         g.columns.push(lead("i", None));
         g.columns.push(lead("j", None));
-        g.columns.push(c.column("lambda1_m", &["grid", "lambda1_m"]));
-        g.columns.push(c.column("lambda2_m", &["grid", "lambda2_m"]));
+        g.columns
+            .push(c.column("lambda1_m", &["grid", "lambda1_m"]));
+        g.columns
+            .push(c.column("lambda2_m", &["grid", "lambda2_m"]));
         for (k, v) in obj {
             let first = v.as_array().and_then(|a| a.first());
             let path = join(base, &[k.as_str()]);
@@ -660,7 +681,14 @@ fn workspace_nodes(c: &Ctx<'_>) -> Option<Grid> {
         any |= wave_nodes(c, &mut g, 0, n, &["nodes"]).is_some();
     }
     for key in ["other_waves", "waves"] {
-        for (w, wave) in c.answer.get(key).and_then(Value::as_array).into_iter().flatten().enumerate() {
+        for (w, wave) in c
+            .answer
+            .get(key)
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .enumerate()
+        {
             if let Some(n) = wave.get("nodes") {
                 let index = if key == "other_waves" { w + 1 } else { w };
                 any |= wave_nodes(c, &mut g, index, n, &[key, "*", "nodes"]).is_some();
@@ -673,17 +701,25 @@ fn workspace_nodes(c: &Ctx<'_>) -> Option<Grid> {
 fn predictions(c: &Ctx<'_>) -> Option<Grid> {
     let preds = scalars(c.answer.get("predictions")?)?;
     let shap = c.answer.pointer("/shap/values").and_then(Value::as_array);
-    let names: Vec<String> = ["/model/xgboost_json/learner/feature_names", "/model/feature_names"]
-        .iter()
-        .find_map(|p| c.request.pointer(p).and_then(Value::as_array))
-        .map(|a| a.iter().filter_map(Value::as_str).map(str::to_owned).collect())
-        .unwrap_or_default();
-    let width = shap.and_then(|s| s.first()).and_then(Value::as_array).map_or(0, Vec::len);
+    let names: Vec<String> = [
+        "/model/xgboost_json/learner/feature_names",
+        "/model/feature_names",
+    ]
+    .iter()
+    .find_map(|p| c.request.pointer(p).and_then(Value::as_array))
+    .map(|a| {
+        a.iter()
+            .filter_map(Value::as_str)
+            .map(str::to_owned)
+            .collect()
+    })
+    .unwrap_or_default();
+    let width = shap
+        .and_then(|s| s.first())
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
     let mut g = Grid {
-        columns: vec![
-            lead("row", None),
-            c.column("prediction", &["predictions"]),
-        ],
+        columns: vec![lead("row", None), c.column("prediction", &["predictions"])],
         rows: Vec::new(),
     };
     for f in 0..width {
@@ -697,7 +733,12 @@ fn predictions(c: &Ctx<'_>) -> Option<Grid> {
         let mut row = vec![Value::from(i), p.clone()];
         let values = shap.and_then(|s| s.get(i)).and_then(Value::as_array);
         for f in 0..width {
-            row.push(values.and_then(|v| v.get(f)).cloned().unwrap_or(Value::Null));
+            row.push(
+                values
+                    .and_then(|v| v.get(f))
+                    .cloned()
+                    .unwrap_or(Value::Null),
+            );
         }
         g.rows.push(row);
     }

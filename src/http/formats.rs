@@ -133,10 +133,16 @@ pub async fn formats(req: Request, next: Next) -> Response {
         && format == Format::Csv
         && !export::table::tables(&route).iter().any(|t| t.name == name)
     {
-        let known: Vec<&str> = export::table::tables(&route).iter().map(|t| t.name).collect();
+        let known: Vec<&str> = export::table::tables(&route)
+            .iter()
+            .map(|t| t.name)
+            .collect();
         return not_acceptable(
             "UNKNOWN_TABLE",
-            format!("{route} has no table `{name}`; its tables: {}", known.join(", ")),
+            format!(
+                "{route} has no table `{name}`; its tables: {}",
+                known.join(", ")
+            ),
         );
     }
     let request_id = req
@@ -154,7 +160,9 @@ pub async fn formats(req: Request, next: Next) -> Response {
     };
     let Ok(mut request) = serde_json::from_slice::<Value>(&bytes) else {
         // Not JSON: let the handler give its usual 400.
-        return next.run(Request::from_parts(parts, Body::from(bytes))).await;
+        return next
+            .run(Request::from_parts(parts, Body::from(bytes)))
+            .await;
     };
     let run_body = if format == Format::Dxf {
         export::dxf::prepare(&route, &mut request);
@@ -176,7 +184,15 @@ pub async fn formats(req: Request, next: Next) -> Response {
     let made = {
         let route = route.clone();
         tokio::task::spawn_blocking(move || {
-            make(format, &route, &bytes, &request, &answer_bytes, table.as_deref(), request_id)
+            make(
+                format,
+                &route,
+                &bytes,
+                &request,
+                &answer_bytes,
+                table.as_deref(),
+                request_id,
+            )
         })
         .await
     };
@@ -185,28 +201,35 @@ pub async fn formats(req: Request, next: Next) -> Response {
         Err(_) => return ApiError::internal().into_response(),
     };
     match made {
-        Ok(out) => {
-            let mut r = out.into_response();
-            let h = r.headers_mut();
-            h.insert(
-                header::CONTENT_TYPE,
-                HeaderValue::from_static(format.content_type()),
-            );
-            let name = route.trim_start_matches("/v1/").replace('/', "-");
-            let disposition = if format == Format::Html { "inline" } else { "attachment" };
-            if let Ok(v) = HeaderValue::from_str(&format!(
-                "{disposition}; filename=\"{name}.{}\"",
-                format.extension()
-            )) {
-                h.insert(header::CONTENT_DISPOSITION, v);
-            }
-            if let Some(t) = rparts.headers.get("server-timing") {
-                h.insert("server-timing", t.clone());
-            }
-            r
-        }
+        Ok(out) => respond(format, &route, out, rparts.headers.get("server-timing")),
         Err(resp) => resp,
     }
+}
+
+/// The response carrying `out`: its media type, a file name, the calculation's Server-Timing.
+fn respond(format: Format, route: &str, out: Vec<u8>, timing: Option<&HeaderValue>) -> Response {
+    let mut r = out.into_response();
+    let h = r.headers_mut();
+    h.insert(
+        header::CONTENT_TYPE,
+        HeaderValue::from_static(format.content_type()),
+    );
+    let name = route.trim_start_matches("/v1/").replace('/', "-");
+    let disposition = if format == Format::Html {
+        "inline"
+    } else {
+        "attachment"
+    };
+    if let Ok(v) = HeaderValue::from_str(&format!(
+        "{disposition}; filename=\"{name}.{}\"",
+        format.extension()
+    )) {
+        h.insert(header::CONTENT_DISPOSITION, v);
+    }
+    if let Some(t) = timing {
+        h.insert("server-timing", t.clone());
+    }
+    r
 }
 
 /// The bytes of `format` from the exact request, the request as run and the JSON answer.
