@@ -37,7 +37,7 @@ BASE, ARTIFACTS = sys.argv[1], sys.argv[2]
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 os.makedirs(ARTIFACTS, exist_ok=True)
 FAILURES = []
-TIMING = re.compile(r"(elapsed_ms|compute_ms|compute_us|timing_ms|threads)")
+TIMING = re.compile(r"(elapsed_ms|compute_ms|compute_us|timing_ms|cpu_ms|wall_ms|threads)")
 UNITS = {"/v1/irefc-stress": 4, "/v1/irefc-efficiency": 4, "/v1/cognates": 0,
          "/v1/continuum-workspace": 6, "/v1/spatial-coupling": 6}
 

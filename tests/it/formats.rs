@@ -64,6 +64,8 @@ fn is_timing(name: &str) -> bool {
         "compute_ms",
         "compute_us",
         "timing_ms",
+        "cpu_ms",
+        "wall_ms",
         "threads",
     ]
     .iter()
