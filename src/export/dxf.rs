@@ -158,15 +158,17 @@ impl Sheet {
         if pts.len() < 2 {
             return;
         }
-        let mut p = LwPolyline::default();
-        p.vertices = pts
-            .iter()
-            .map(|q| LwPolylineVertex {
-                x: q[0],
-                y: q[1],
-                ..Default::default()
-            })
-            .collect();
+        let mut p = LwPolyline {
+            vertices: pts
+                .iter()
+                .map(|q| LwPolylineVertex {
+                    x: q[0],
+                    y: q[1],
+                    ..Default::default()
+                })
+                .collect(),
+            ..Default::default()
+        };
         p.set_is_closed(closed);
         self.add(layer, EntityType::LwPolyline(p));
     }

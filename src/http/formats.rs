@@ -202,7 +202,7 @@ pub async fn formats(req: Request, next: Next) -> Response {
     };
     match made {
         Ok(out) => respond(format, &route, out, rparts.headers.get("server-timing")),
-        Err(resp) => resp,
+        Err(resp) => *resp,
     }
 }
 
@@ -241,9 +241,9 @@ fn make(
     answer_bytes: &[u8],
     table: Option<&str>,
     request_id: Option<String>,
-) -> Result<Vec<u8>, Response> {
+) -> Result<Vec<u8>, Box<Response>> {
     let Ok(answer) = serde_json::from_slice::<Value>(answer_bytes) else {
-        return Err(ApiError::internal().into_response());
+        return Err(Box::new(ApiError::internal().into_response()));
     };
     let doc = super::openapi::document();
     match format {
@@ -261,25 +261,31 @@ fn make(
             })
             .into_bytes())
         }
-        Format::Csv => export::csv(route, request, &answer, doc, table).map_err(|e| match e {
-            export::TableError::Unknown { .. } => not_acceptable("UNKNOWN_TABLE", e.to_string()),
-            export::TableError::Absent(why) => not_acceptable(
-                "NOTHING_TO_TABULATE",
-                format!("{route}: no table of this answer ({why}); ask for application/json"),
-            ),
-            export::TableError::Write(_) => {
-                tracing::error!(error = %e, "table could not be written");
-                ApiError::internal().into_response()
-            }
+        Format::Csv => export::csv(route, request, &answer, doc, table).map_err(|e| {
+            Box::new(match e {
+                export::TableError::Unknown { .. } => {
+                    not_acceptable("UNKNOWN_TABLE", e.to_string())
+                }
+                export::TableError::Absent(why) => not_acceptable(
+                    "NOTHING_TO_TABULATE",
+                    format!("{route}: no table of this answer ({why}); ask for application/json"),
+                ),
+                export::TableError::Write(_) => {
+                    tracing::error!(error = %e, "table could not be written");
+                    ApiError::internal().into_response()
+                }
+            })
         }),
-        Format::Dxf => export::dxf::render(route, request, &answer).map_err(|e| match e {
-            export::dxf::DxfError::Nothing(why) => {
-                ApiError::nothing_to_draw(route, &why).into_response()
-            }
-            export::dxf::DxfError::Write(_) => {
-                tracing::error!(error = %e, "drawing could not be written");
-                ApiError::internal().into_response()
-            }
+        Format::Dxf => export::dxf::render(route, request, &answer).map_err(|e| {
+            Box::new(match e {
+                export::dxf::DxfError::Nothing(why) => {
+                    ApiError::nothing_to_draw(route, &why).into_response()
+                }
+                export::dxf::DxfError::Write(_) => {
+                    tracing::error!(error = %e, "drawing could not be written");
+                    ApiError::internal().into_response()
+                }
+            })
         }),
     }
 }
