@@ -18,6 +18,7 @@
 //!
 //! `mechcalc merge <endpoint> SHARD_FILE...`: the shards' answers merged into the unsharded
 //! answer ([`crate::merge`]).
+//! * `--report OUT.html`: write the calculation report (`Accept: text/html`) to `OUT.html`.
 //!
 //! Exit codes: 0 every answer succeeded; 2 a request was refused (4xx: invalid, infeasible,
 //! too large; a request or endpoint that cannot be sharded; shards that do not merge); 1 the
@@ -52,6 +53,9 @@ pub struct RunArgs {
     /// Write the answer as an SVG picture instead of JSON.
     #[arg(long, conflicts_with = "batch")]
     pub svg: bool,
+    /// Write the calculation report (self-contained HTML, `Accept: text/html`) to this file.
+    #[arg(long, value_name = "OUT.html", conflicts_with_all = ["batch", "svg"])]
+    pub report: Option<std::path::PathBuf>,
     /// Pretty-print JSON answers.
     #[arg(long)]
     pub pretty: bool,
@@ -144,18 +148,21 @@ pub struct Answer {
 
 /// Run one request through the application in process.
 pub async fn call(state: &AppState, path: &str, body: Vec<u8>, svg: bool) -> Answer {
+    let accept = if svg {
+        "image/svg+xml"
+    } else {
+        "application/json"
+    };
+    call_accept(state, path, body, accept).await
+}
+
+/// Run one request through the application in process, asking for the media type `accept`.
+pub async fn call_accept(state: &AppState, path: &str, body: Vec<u8>, accept: &str) -> Answer {
     let req = Request::builder()
         .method("POST")
         .uri(path)
         .header(header::CONTENT_TYPE, "application/json")
-        .header(
-            header::ACCEPT,
-            if svg {
-                "image/svg+xml"
-            } else {
-                "application/json"
-            },
-        )
+        .header(header::ACCEPT, accept)
         .body(Body::from(body));
     let Ok(req) = req else {
         return internal("could not build the request");
@@ -263,6 +270,8 @@ pub fn run(args: &RunArgs, config: ServiceConfig) -> ExitCode {
     let code = rt.block_on(async {
         if args.batch {
             batch(&state, &path, &input, args.pretty).await
+        } else if let Some(out) = &args.report {
+            report(&state, &path, input, out).await
         } else {
             let out = args.out.as_deref();
             single(
@@ -455,6 +464,23 @@ pub fn merge(args: &MergeArgs) -> ExitCode {
         },
         None => write_stdout(&body),
     }
+}
+
+/// `--report OUT.html`: the report to the file; a refused request's problem details to stderr.
+async fn report(state: &AppState, path: &str, input: Vec<u8>, out: &std::path::Path) -> u8 {
+    let a = call_accept(state, path, input, crate::export::HTML).await;
+    let code = exit_for(a.status);
+    if code != 0 {
+        let mut err = std::io::stderr().lock();
+        let _ = err.write_all(&a.body);
+        let _ = err.write_all(b"\n");
+        return code;
+    }
+    if let Err(e) = std::fs::write(out, &a.body) {
+        eprintln!("cannot write {}: {e}", out.display());
+        return 1;
+    }
+    0
 }
 
 async fn batch(state: &AppState, path: &str, input: &[u8], pp: bool) -> u8 {

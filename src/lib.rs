@@ -6,6 +6,7 @@
 //!   socket).
 //! * [`config`]: flags and environment variables of the binary.
 //! * [`plot`]: SVG pictures of answers (`Accept: image/svg+xml`).
+//! * [`export`]: calculation reports (HTML), tables (CSV) and drawings (DXF) of answers.
 //! * [`cli`]: `mechcalc run`, one calculation from the command line without a server.
 //! * [`merge`]: the answers of a sweep's shards merged into the unsharded answer
 //!   (`mechcalc merge`).
@@ -13,6 +14,7 @@
 pub mod calc;
 pub mod cli;
 pub mod config;
+pub mod export;
 pub mod http;
 pub mod merge;
 pub mod numerics;

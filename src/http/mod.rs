@@ -12,6 +12,7 @@ pub mod cam_law_fit;
 pub mod cognates;
 pub mod component_importance;
 pub mod continuum_workspace;
+pub mod formats;
 pub mod irefc;
 pub mod json;
 pub mod layers;
@@ -214,6 +215,7 @@ pub fn app(state: AppState) -> Router {
         .layer(DefaultBodyLimit::max(body_limit))
         .layer(CatchPanicLayer::custom(panic_response))
         .layer(middleware::from_fn(picture::picture))
+        .layer(middleware::from_fn(formats::formats))
         .layer(middleware::from_fn(stream::event_stream))
         .layer(middleware::from_fn(layers::log_request));
     for (name, value) in layers::hardening_headers() {

@@ -614,6 +614,7 @@ fn document_alternative_media_types(doc: &mut Value) {
             );
         }
     }
+    crate::export::document_formats(doc);
 }
 
 /// utoipa writes `u32` as `format: int32, minimum: 0`, and validators read `int32` as at most

@@ -72,7 +72,11 @@ pub fn render(_req: &Value, answer: &Value) -> Result<String, PlotError> {
         .as_object()
         .ok_or(PlotError::Missing("time_response"))?;
     let curves = frf_series(frf);
-    let t = numbers(&time["t_s"]);
+    // Without `return_series` the answer has the time response's peaks but no samples to draw.
+    let t = numbers(
+        time.get("t_s")
+            .ok_or(PlotError::Missing("time_response.t_s"))?,
+    );
     let mut tseries: Vec<(String, Vec<(f64, f64)>)> = time["points"]
         .as_array()
         .into_iter()

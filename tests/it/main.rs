@@ -10,6 +10,7 @@ use support::http as common;
 mod api_examples;
 mod cli;
 mod contract;
+mod formats;
 mod http_bezier_motion;
 mod http_bus_fuel_economy;
 mod http_cam_law;
