@@ -5,7 +5,8 @@
 //!   hashed on arrival (SHA-256) and compared with every key's hash in constant time. Tokens are
 //!   never logged and never reach a metric; the key id is in the request's log line, a label of
 //!   the request metrics, and names the client for fair queueing ([`crate::http::pool`]).
-//! * **Reload**: SIGHUP reads the file again. A file that fails to parse is refused as a whole
+//! * **Reload**: SIGHUP reads the file again, and so does a change of the file's modification
+//!   time or size (looked at every 10 s: a Kubernetes Secret volume changes with no signal). A file that fails to parse is refused as a whole
 //!   (logged with its line number) and the keys in force stay. A key whose id and rate are
 //!   unchanged keeps its token bucket across a reload.
 //! * **Public routes**: `/healthz`, the page at `/`, the API docs and `/openapi.json` answer
@@ -305,27 +306,62 @@ impl KeyRing {
     }
 }
 
-/// Reread the keys file on every SIGHUP for the life of the process (a no-op without keys).
+/// How often the keys file's modification time and size are looked at (a Kubernetes Secret
+/// volume is updated in place and sends no signal).
+const KEYS_POLL: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// Modification time and size of a file, to notice a change.
+fn stamp(path: &Path) -> Option<(std::time::SystemTime, u64)> {
+    let m = std::fs::metadata(path).ok()?;
+    Some((m.modified().ok()?, m.len()))
+}
+
+/// Reread the keys file on every SIGHUP, and when its modification time or size changes, for
+/// the life of the process (a no-op without keys).
 pub fn reload_on_sighup(ring: Option<Arc<KeyRing>>) {
     let Some(ring) = ring else { return };
-    #[cfg(unix)]
     tokio::spawn(async move {
-        let Ok(mut hup) = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::hangup())
-        else {
-            tracing::error!("cannot listen for SIGHUP; the API keys file will not be reread");
-            return;
-        };
-        while hup.recv().await.is_some() {
+        #[cfg(unix)]
+        let mut hup =
+            match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::hangup()) {
+                Ok(s) => Some(s),
+                Err(e) => {
+                    tracing::error!(error = %e, "cannot listen for SIGHUP; the keys file is polled only");
+                    None
+                }
+            };
+        let mut last = stamp(&ring.path);
+        let mut tick = tokio::time::interval(KEYS_POLL);
+        loop {
+            #[cfg(unix)]
+            let hangup = async {
+                match hup.as_mut() {
+                    Some(h) => h.recv().await,
+                    None => std::future::pending().await,
+                }
+            };
+            #[cfg(not(unix))]
+            let hangup = std::future::pending::<Option<()>>();
+            let cause = tokio::select! {
+                _ = hangup => "SIGHUP",
+                _ = tick.tick() => {
+                    if stamp(&ring.path) == last {
+                        continue;
+                    }
+                    "the file changed"
+                }
+            };
+            last = stamp(&ring.path);
             match ring.reload() {
                 Ok(n) => {
                     metrics::counter!("mechcalc_api_key_reloads_total", "result" => "ok")
                         .increment(1);
-                    tracing::info!(keys = n, "SIGHUP: API keys reloaded");
+                    tracing::info!(keys = n, cause, "API keys reloaded");
                 }
                 Err(e) => {
                     metrics::counter!("mechcalc_api_key_reloads_total", "result" => "error")
                         .increment(1);
-                    tracing::error!(error = %e, "SIGHUP: API keys file refused; the keys in force stay");
+                    tracing::error!(error = %e, cause, "API keys file refused; the keys in force stay");
                 }
             }
         }
