@@ -322,14 +322,13 @@ pub fn reload_on_sighup(ring: Option<Arc<KeyRing>>) {
     let Some(ring) = ring else { return };
     tokio::spawn(async move {
         #[cfg(unix)]
-        let mut hup =
-            match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::hangup()) {
-                Ok(s) => Some(s),
-                Err(e) => {
-                    tracing::error!(error = %e, "cannot listen for SIGHUP; the keys file is polled only");
-                    None
-                }
-            };
+        let mut hup = match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::hangup()) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                tracing::error!(error = %e, "cannot listen for SIGHUP; the keys file is polled only");
+                None
+            }
+        };
         let mut last = stamp(&ring.path);
         let mut tick = tokio::time::interval(KEYS_POLL);
         loop {

@@ -6,9 +6,9 @@
 //!   backlog: jobs ahead × the recent mean job time / slots. A request whose expected wait already
 //!   exceeds its time budget is refused at once instead of after waiting for nothing.
 //! * **Fair queue.** Waiting heavy jobs sit in one queue per client (API key id, or remote
-//!   address without keys) and a freed slot goes to the clients in round-robin order, so a client
-//!   with one job waits about one job per other busy client, never behind another client's whole
-//!   backlog. A client may have at most `client_queue_depth` jobs waiting (beyond: 429
+//!   address without keys) and a freed slot goes to the waiting client that started a job least
+//!   recently (round-robin when all wait), so a client with one job waits about one running job
+//!   per other busy client, never behind another client's whole backlog. A client may have at most `client_queue_depth` jobs waiting (beyond: 429
 //!   `CLIENT_QUEUE_FULL`, its own backlog, other clients unaffected); when the whole queue is full,
 //!   a client with a shorter queue takes the place of the newest job of the longest one (which
 //!   gets 503), so the room is shared too.
@@ -143,8 +143,13 @@ struct Inner {
 struct Fair {
     free: usize,
     queues: HashMap<Arc<str>, VecDeque<Waiter>>,
-    /// Clients with a waiting job, in the order they are served next.
+    /// Clients with a waiting job, in the order they queued (ties of `served`).
     rotation: VecDeque<Arc<str>>,
+    /// When each client last started a job (a sequence number; absent = never): the waiting
+    /// client served least recently goes first, so a client whose job took a free slot directly
+    /// does not also take the next freed one ahead of a client that has waited.
+    served: HashMap<Arc<str>, u64>,
+    serve_seq: u64,
     waiting: usize,
     next_ticket: u64,
 }
@@ -171,18 +176,38 @@ impl Fair {
             .sum::<usize>()
     }
 
-    /// The next waiting job in round-robin order, removed from its queue.
+    /// Record that `client` starts a job now.
+    fn mark_served(&mut self, client: &Arc<str>) {
+        self.serve_seq += 1;
+        self.served.insert(Arc::clone(client), self.serve_seq);
+        // Forget clients that have nothing waiting once the table grows (a forgotten client
+        // counts as never served: at most one early start for it).
+        if self.served.len() > 4096 {
+            let queues = &self.queues;
+            self.served.retain(|c, _| queues.contains_key(c));
+        }
+    }
+
+    /// The next waiting job: the oldest of the waiting client served least recently (queue order
+    /// among equals), removed from its queue. With every client waiting this is round-robin.
     fn pop_next(&mut self) -> Option<Waiter> {
-        let client = self.rotation.pop_front()?;
+        let pos = self
+            .rotation
+            .iter()
+            .enumerate()
+            .min_by_key(|(i, c)| (self.served.get(*c).copied().unwrap_or(0), *i))
+            .map(|(i, _)| i)?;
+        let client = self.rotation.remove(pos)?;
         let queue = self.queues.get_mut(&client)?;
         let w = queue.pop_front();
         if queue.is_empty() {
             self.queues.remove(&client);
         } else {
-            self.rotation.push_back(client);
+            self.rotation.push_back(Arc::clone(&client));
         }
         if w.is_some() {
             self.waiting -= 1;
+            self.mark_served(&client);
         }
         w
     }
@@ -465,6 +490,7 @@ impl ComputePool {
             }
             if fair.free > 0 {
                 fair.free -= 1;
+                fair.mark_served(&client);
                 return Ok(Slot {
                     pool: Some(Arc::clone(&self.inner)),
                 });
@@ -890,8 +916,9 @@ mod tests {
         }
         let order = order.lock().expect("order").clone();
         let b_at = order.iter().position(|c| c == "b").expect("b served");
-        // Round-robin: b is served after at most one of a's waiting jobs.
-        assert!(b_at <= 1, "b served at position {b_at} of {order:?}");
+        // a's first job took the free slot: b, never served, takes the next one, then a and b
+        // would alternate.
+        assert_eq!(b_at, 0, "b served at position {b_at} of {order:?}");
         assert_eq!(pool.waiting(), 0);
         assert_eq!(pool.available_slots(), 1);
     }

@@ -343,3 +343,51 @@ fn help_prints_units_in_plain_brackets() {
     assert!(help.contains("[ms]") && help.contains("[bytes]"), "{help}");
     assert!(help.contains("--api-keys-file") && help.contains("--client-queue-depth"));
 }
+
+/// A log sink for one test.
+#[derive(Clone, Default)]
+struct Captured(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+
+impl std::io::Write for Captured {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        if let Ok(mut v) = self.0.lock() {
+            v.extend_from_slice(b);
+        }
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// What building the state with `config` logs.
+fn start_log(config: ServiceConfig) -> String {
+    let sink = Captured::default();
+    let writer = sink.clone();
+    let subscriber = tracing_subscriber::fmt()
+        .with_ansi(false)
+        .with_writer(move || writer.clone())
+        .finish();
+    tracing::subscriber::with_default(subscriber, || {
+        let _ = AppState::try_new(config);
+    });
+    let bytes = sink.0.lock().map(|v| v.clone()).unwrap_or_default();
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+#[test]
+fn a_non_loopback_bind_without_keys_warns_at_start() {
+    let open = |bind: &str| ServiceConfig {
+        bind: bind.parse().expect("address"),
+        ..common::config()
+    };
+    let log = start_log(open("0.0.0.0:8080"));
+    assert!(log.contains("WARN") && log.contains("no API keys"), "{log}");
+    assert!(!start_log(open("127.0.0.1:8080")).contains("no API keys"));
+    let keys = keys_file(&[("k", "tok-warn", None)]);
+    let log = start_log(ServiceConfig {
+        api_keys_file: Some(keys),
+        ..open("0.0.0.0:8080")
+    });
+    assert!(!log.contains("no API keys"), "{log}");
+}
