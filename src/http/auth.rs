@@ -292,15 +292,15 @@ impl KeyRing {
         let key = found
             .and_then(|i| keys.keys.get(i))
             .ok_or(Refusal::Unknown)?;
-        if let (Some(bucket), Some(n)) = (&key.bucket, key.per_minute) {
-            if let Err(not_until) = bucket.check() {
-                let wait = not_until.wait_time_from(DefaultClock::default().now());
-                return Err(Refusal::Limited {
-                    id: Arc::clone(&key.id),
-                    retry_after_s: wait.as_secs() + u64::from(wait.subsec_nanos() > 0),
-                    per_minute: n.get(),
-                });
-            }
+        if let (Some(bucket), Some(n)) = (&key.bucket, key.per_minute)
+            && let Err(not_until) = bucket.check()
+        {
+            let wait = not_until.wait_time_from(DefaultClock::default().now());
+            return Err(Refusal::Limited {
+                id: Arc::clone(&key.id),
+                retry_after_s: wait.as_secs() + u64::from(wait.subsec_nanos() > 0),
+                per_minute: n.get(),
+            });
         }
         Ok(Arc::clone(&key.id))
     }

@@ -3,7 +3,7 @@
 //! id as a metrics label with no token anywhere, reload, a keys file that cannot be read, the
 //! document's bearer scheme with 401 and 429 on every operation, and `--help` units.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use axum::body::Body;
@@ -31,7 +31,7 @@ fn keys_file(lines: &[(&str, &str, Option<u32>)]) -> PathBuf {
     path
 }
 
-fn write_keys(path: &PathBuf, lines: &[(&str, &str, Option<u32>)]) {
+fn write_keys(path: &Path, lines: &[(&str, &str, Option<u32>)]) {
     let mut text = String::from("# test keys\n");
     for (id, token, rate) in lines {
         text.push_str(&format!("{id} {}", token_hash_hex(token)));
@@ -43,9 +43,9 @@ fn write_keys(path: &PathBuf, lines: &[(&str, &str, Option<u32>)]) {
     std::fs::write(path, text).expect("keys file written");
 }
 
-fn state_with(path: &PathBuf) -> AppState {
+fn state_with(path: &Path) -> AppState {
     AppState::new(ServiceConfig {
-        api_keys_file: Some(path.clone()),
+        api_keys_file: Some(path.to_path_buf()),
         ..common::config()
     })
 }
@@ -274,7 +274,7 @@ async fn a_keys_file_that_cannot_be_read_closes_the_service() {
     let path = std::env::temp_dir().join("mechcalc-keys-that-do-not-exist.txt");
     assert!(
         AppState::try_new(ServiceConfig {
-            api_keys_file: Some(path.clone()),
+            api_keys_file: Some(path.to_path_buf()),
             ..common::config()
         })
         .is_err()

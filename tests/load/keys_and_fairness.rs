@@ -4,7 +4,7 @@
 //! runs it for 60 s).
 
 use std::net::SocketAddr;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -27,7 +27,7 @@ fn keys_file(name: &str, keys: &[(&str, &str, Option<u32>)]) -> PathBuf {
     path
 }
 
-fn write_keys(path: &PathBuf, keys: &[(&str, &str, Option<u32>)]) {
+fn write_keys(path: &Path, keys: &[(&str, &str, Option<u32>)]) {
     let text: String = keys
         .iter()
         .map(|(id, token, rate)| {
@@ -67,6 +67,10 @@ async fn call(
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+#[expect(
+    clippy::too_many_lines,
+    reason = "one scenario against one server, read top to bottom"
+)]
 async fn api_keys_rates_and_reload_over_a_socket() {
     let _serial = SERIAL.lock().await;
     let keys = keys_file(
@@ -413,6 +417,10 @@ async fn cheap_requests_on_64_connections_are_never_shed_during_a_sweep_flood() 
 /// `benches/RESULTS.md`.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 #[ignore = "the soak runs from .ci/soak (MECHCALC_SOAK_SECONDS)"]
+#[expect(
+    clippy::too_many_lines,
+    reason = "one scenario against one server, read top to bottom"
+)]
 async fn soak_mixed_load_from_several_keys() {
     let _serial = SERIAL.lock().await;
     let secs: u64 = std::env::var("MECHCALC_SOAK_SECONDS")
@@ -497,7 +505,7 @@ async fn soak_mixed_load_from_several_keys() {
                 n += 1;
                 sent.fetch_add(1, Ordering::Relaxed);
                 // ci: one sweep in 200 requests, on a connection of its own.
-                if mixed && (n + i as u64) % 200 == 0 {
+                if mixed && (n + i as u64).is_multiple_of(200) {
                     match client::send(addr, heavy.clone()).await {
                         Ok(r) => st.push(r.status),
                         Err(_) => lost += 1,
