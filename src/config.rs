@@ -7,6 +7,9 @@ use clap::Parser;
 
 /// mechcalc HTTP service configuration. Every flag can also be set through its environment
 /// variable; flags win.
+///
+/// A flag whose text names a unit in brackets carries an explicit `help`: rustdoc needs the
+/// brackets escaped in the doc comment, and clap would print the escapes.
 #[derive(Debug, Clone, Parser)]
 #[command(
     name = "mechcalc",
@@ -67,6 +70,7 @@ pub struct ServiceConfig {
     /// Time a client has to send a complete request head, and the longest an idle keep-alive
     /// connection is kept open \[ms\].
     #[arg(
+        help = "Time a client has to send a complete request head, and the longest an idle keep-alive connection is kept open [ms]",
         long = "header-timeout-ms",
         env = "MECHCALC_HEADER_TIMEOUT_MS",
         default_value_t = 10_000
@@ -75,6 +79,7 @@ pub struct ServiceConfig {
 
     /// Time a client has to send the whole request body \[ms\] (408 after it).
     #[arg(
+        help = "Time a client has to send the whole request body [ms] (408 after it)",
         long = "body-timeout-ms",
         env = "MECHCALC_BODY_TIMEOUT_MS",
         default_value_t = 30_000
@@ -84,6 +89,7 @@ pub struct ServiceConfig {
     /// Longest a single write of a response may stall on a client that does not read \[ms\]; the
     /// connection is closed after it.
     #[arg(
+        help = "Longest a single write of a response may stall on a client that does not read [ms]; the connection is closed after it",
         long = "write-timeout-ms",
         env = "MECHCALC_WRITE_TIMEOUT_MS",
         default_value_t = 30_000
@@ -102,6 +108,7 @@ pub struct ServiceConfig {
     /// After SIGTERM/SIGINT, time in-flight requests get to finish \[ms\]; then running jobs are
     /// cancelled and the process exits.
     #[arg(
+        help = "After SIGTERM/SIGINT, time in-flight requests get to finish [ms]; then running jobs are cancelled and the process exits",
         long = "shutdown-grace-ms",
         env = "MECHCALC_SHUTDOWN_GRACE_MS",
         default_value_t = 20_000
@@ -111,6 +118,7 @@ pub struct ServiceConfig {
     /// Largest response body \[bytes\]; a request whose answer would be larger is refused with a
     /// 422 naming the option to change (before computing where the size is known in advance).
     #[arg(
+        help = "Largest response body [bytes]; a request whose answer would be larger is refused with a 422 naming the option to change (before computing where the size is known in advance)",
         long = "max-response-bytes",
         env = "MECHCALC_MAX_RESPONSE_BYTES",
         default_value_t = 64 * 1024 * 1024
@@ -126,6 +134,42 @@ pub struct ServiceConfig {
         default_value = ""
     )]
     pub cors_origins: Vec<String>,
+
+    /// File of API keys, one a line: `<key id> <sha256 hex of the token> [<requests per
+    /// minute>]`, `#` starts a comment. With keys, every route but `/healthz`, the page and the
+    /// docs needs `Authorization: Bearer <token>`; the file is read again on SIGHUP. Without it
+    /// the service is open to whoever reaches the port.
+    #[arg(
+        help = "File of API keys, one a line: `<key id> <sha256 hex of the token> [<requests per minute>]`, `#` starts a comment. With keys, every route but /healthz, the page and the docs needs `Authorization: Bearer <token>`; the file is read again on SIGHUP. Without it the service is open to whoever reaches the port",
+        long = "api-keys-file",
+        env = "MECHCALC_API_KEYS_FILE"
+    )]
+    pub api_keys_file: Option<std::path::PathBuf>,
+
+    /// Heavy jobs one client (API key, or remote address without keys) may have waiting at once
+    /// (0 = half of `--queue-depth`, at least 1); beyond it that client gets 429. Waiting jobs
+    /// start in round-robin order over the clients.
+    #[arg(
+        long = "client-queue-depth",
+        env = "MECHCALC_CLIENT_QUEUE_DEPTH",
+        default_value_t = 0
+    )]
+    pub client_queue_depth: usize,
+
+    /// Extra address serving only `/metrics` and `/healthz`, never behind API keys (for a
+    /// scraper that a network policy admits to this port alone); off when unset.
+    #[arg(long = "metrics-bind", env = "MECHCALC_METRICS_BIND")]
+    pub metrics_bind: Option<SocketAddr>,
+
+    /// Nice value of the compute threads (0 to 19; 0 = the process's own priority): sweeps yield
+    /// the CPU to the threads that serve connections and cheap requests.
+    #[arg(
+        long = "compute-nice",
+        env = "MECHCALC_COMPUTE_NICE",
+        default_value_t = 10,
+        value_parser = clap::value_parser!(i32).range(0..=19)
+    )]
+    pub compute_nice: i32,
 
     /// Log format: `text` or `json`.
     #[arg(
@@ -153,6 +197,10 @@ impl Default for ServiceConfig {
             shutdown_grace_ms: 20_000,
             max_response_bytes: 64 * 1024 * 1024,
             cors_origins: Vec::new(),
+            api_keys_file: None,
+            client_queue_depth: 0,
+            metrics_bind: None,
+            compute_nice: 10,
             log_format: "text".to_owned(),
         }
     }
@@ -203,6 +251,16 @@ impl ServiceConfig {
             self.max_connections.min(from_fds)
         } else {
             from_fds.min(65_536)
+        }
+    }
+
+    /// Effective per-client queue depth: the configured one, or half the queue (at least 1).
+    #[must_use]
+    pub fn effective_client_queue_depth(&self) -> usize {
+        if self.client_queue_depth > 0 {
+            self.client_queue_depth
+        } else {
+            (self.queue_depth / 2).max(1)
         }
     }
 

@@ -80,9 +80,11 @@ async fn serve(cli: Cli) -> std::process::ExitCode {
     }
 
     // The one compute pool: every calculation and its parallel parts run on these threads.
+    let nice = config.compute_nice;
     if let Err(e) = rayon::ThreadPoolBuilder::new()
         .num_threads(config.effective_compute_threads())
         .thread_name(|i| format!("mechcalc-compute-{i}"))
+        .start_handler(move |_| mechcalc::http::pool::lower_thread_priority(nice))
         .build_global()
     {
         tracing::error!(error = %e, "cannot start the compute pool");
@@ -120,7 +122,27 @@ async fn serve(cli: Cli) -> std::process::ExitCode {
         shutdown_grace_ms = config.shutdown_grace_ms,
         "mechcalc listening"
     );
-    let state = AppState::new(config);
+    let metrics_bind = config.metrics_bind;
+    let state = match AppState::try_new(config) {
+        Ok(s) => s,
+        Err(e) => {
+            tracing::error!(error = %e, "cannot start");
+            return std::process::ExitCode::FAILURE;
+        }
+    };
+    mechcalc::http::auth::reload_on_sighup(state.keys.clone());
+    if let Some(addr) = metrics_bind {
+        match tokio::net::TcpListener::bind(addr).await {
+            Ok(l) => {
+                tracing::info!(bind = %addr, "metrics listening");
+                tokio::spawn(mechcalc::http::serve::serve_metrics(l, state.clone()));
+            }
+            Err(e) => {
+                tracing::error!(bind = %addr, error = %e, "cannot bind the metrics address");
+                return std::process::ExitCode::FAILURE;
+            }
+        }
+    }
     let pool = state.pool.clone();
     mechcalc::http::serve::serve(listener, app(state), limits, pool, shutdown_signal()).await;
     tracing::info!("mechcalc stopped");

@@ -12,6 +12,7 @@ use tower_http::cors::{AllowOrigin, CorsLayer};
 use tower_http::request_id::{MakeRequestId, RequestId};
 use tracing::Instrument;
 
+use super::auth::KeyId;
 use super::pool::{REQUEST_INFO, RequestInfo};
 
 /// The request-id header: accepted from the client, generated when absent, echoed and logged.
@@ -63,8 +64,8 @@ impl Drop for AbortLog {
     }
 }
 
-/// One structured log line per request (method, path, route, status, latency, request id; never
-/// bodies), request metrics, and the route/body size the compute pool learns from.
+/// One structured log line per request (method, path, route, status, latency, request id, API key
+/// id; never bodies or tokens), request metrics (labelled by route, status and key id), and the route/body size the compute pool learns from.
 pub async fn log_request(req: Request, next: Next) -> Response {
     let method = req.method().clone();
     let path = req.uri().path().to_owned();
@@ -96,6 +97,7 @@ pub async fn log_request(req: Request, next: Next) -> Response {
         route: route.clone(),
         body_bytes,
         progress: None,
+        client: std::sync::Arc::from(""),
     };
     let resp = REQUEST_INFO
         .scope(info, next.run(req).instrument(span))
@@ -103,11 +105,16 @@ pub async fn log_request(req: Request, next: Next) -> Response {
     abort.done = true;
     let latency = abort.start.elapsed().as_secs_f64();
     let status = resp.status().as_u16();
-    metrics::counter!("mechcalc_requests_total", "route" => route.clone(), "status" => status.to_string())
+    // The API key id (never the token); `-` when the service has no keys or the request none.
+    let key = resp
+        .extensions()
+        .get::<KeyId>()
+        .map_or_else(|| "-".to_owned(), |k| k.0.to_string());
+    metrics::counter!("mechcalc_requests_total", "route" => route.clone(), "status" => status.to_string(), "key" => key.clone())
         .increment(1);
-    metrics::histogram!("mechcalc_request_duration_seconds", "route" => route.clone())
+    metrics::histogram!("mechcalc_request_duration_seconds", "route" => route.clone(), "key" => key.clone())
         .record(latency);
-    tracing::info!(%method, %path, %route, status, latency_ms = latency * 1e3, %request_id, "request");
+    tracing::info!(%method, %path, %route, status, latency_ms = latency * 1e3, %request_id, %key, "request");
     resp
 }
 
@@ -151,10 +158,16 @@ pub fn cors(origins: &[String]) -> Option<CorsLayer> {
         CorsLayer::new()
             .allow_origin(allow)
             .allow_methods([Method::GET, Method::POST, Method::OPTIONS])
-            .allow_headers([header::CONTENT_TYPE, header::ACCEPT, REQUEST_ID])
+            .allow_headers([
+                header::CONTENT_TYPE,
+                header::ACCEPT,
+                header::AUTHORIZATION,
+                REQUEST_ID,
+            ])
             .expose_headers([
                 REQUEST_ID,
                 header::RETRY_AFTER,
+                header::WWW_AUTHENTICATE,
                 HeaderName::from_static("server-timing"),
             ])
             .max_age(std::time::Duration::from_secs(600)),

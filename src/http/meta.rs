@@ -1,6 +1,7 @@
 //! Service endpoints that are not calculations: health, the endpoint index, the OpenAPI
 //! document and the interactive API docs (Swagger UI, vendored so it works with no network on
-//! the server side).
+//! the server side). The docs' "Authorize" button and the page's token field take an API key
+//! token; `/healthz`, the page, the docs and the document itself answer without one.
 
 use std::sync::OnceLock;
 
@@ -11,6 +12,7 @@ use axum::response::{Html, IntoResponse, Response};
 use serde::Serialize;
 use utoipa::ToSchema;
 
+use super::auth::AuthResponses;
 use super::state::AppState;
 
 /// Liveness and basic capacity information.
@@ -32,7 +34,8 @@ pub struct Health {
     path = "/healthz",
     tag = "service",
     operation_id = "get_health",
-    responses((status = 200, description = "The service is up", body = Health))
+    security(()),
+    responses((status = 200, description = "The service is up (never behind API keys)", body = Health))
 )]
 pub async fn healthz(State(state): State<AppState>) -> Json<Health> {
     Json(Health {
@@ -110,7 +113,7 @@ pub fn endpoint_index() -> EndpointIndex {
     path = "/v1",
     tag = "service",
     operation_id = "list_endpoints",
-    responses((status = 200, description = "Every endpoint with a one-line summary", body = EndpointIndex))
+    responses((status = 200, description = "Every endpoint with a one-line summary", body = EndpointIndex), AuthResponses)
 )]
 pub async fn index() -> Response {
     static BODY: OnceLock<Vec<u8>> = OnceLock::new();
@@ -158,7 +161,7 @@ mod embedded {
     path = "/v1/examples",
     tag = "service",
     operation_id = "list_examples",
-    responses((status = 200, description = "Every example request with its endpoint", body = [ExampleRequest]))
+    responses((status = 200, description = "Every example request with its endpoint", body = [ExampleRequest]), AuthResponses)
 )]
 pub async fn examples() -> Response {
     static BODY: OnceLock<Vec<u8>> = OnceLock::new();
@@ -210,6 +213,8 @@ const DOCS_HTML: &str = r##"<!doctype html>
   <div id="swagger-ui"></div>
   <script src="/docs/swagger-ui-bundle.js"></script>
   <script>
+    // "Authorize" takes the API key token (the document's bearer scheme); it lives in this page
+    // only and is sent with every "Try it out".
     window.ui = SwaggerUIBundle({ url: "/openapi.json", dom_id: "#swagger-ui", deepLinking: true });
   </script>
 </body>

@@ -5,6 +5,7 @@
 //! Adding an endpoint: write `src/http/<module>.rs` with a `#[utoipa::path]` handler that calls
 //! [`run_calc`], and register it in `api_router` with one `.routes(routes!(...))` line.
 
+pub mod auth;
 pub mod bezier_motion;
 pub mod bus_fuel_economy;
 pub mod cam_law;
@@ -106,6 +107,12 @@ pub enum ProblemResponses {
         content_type = "application/problem+json"
     )]
     Internal(Problem),
+    /// No bearer token, or one that matches no API key (only when the service has API keys).
+    #[response(status = 401, description = "Missing or unknown API key (`/problems/unauthorized`); send `Authorization: Bearer <token>`", content_type = "application/problem+json", headers(("WWW-Authenticate" = String, description = "`Bearer realm=\"mechcalc\"`")))]
+    Unauthorized(Problem),
+    /// The key's rate is spent, or the client has its share of waiting jobs.
+    #[response(status = 429, description = "The API key's requests per minute are spent (`RATE_LIMITED`) or the client has as many jobs waiting as one client may (`CLIENT_QUEUE_FULL`) (`/problems/too-many-requests`); retry after `Retry-After` seconds", content_type = "application/problem+json", headers(("Retry-After" = u64, description = "Seconds to wait before retrying")))]
+    TooManyRequests(Problem),
     /// Every compute slot is busy and the queue is full.
     #[response(status = 503, description = "Compute pool saturated (`/problems/overloaded`); retry after `Retry-After` seconds", content_type = "application/problem+json", headers(("Retry-After" = u64, description = "Seconds to wait before retrying")))]
     Overloaded(Problem),
@@ -133,9 +140,39 @@ JSON pointers to the offending fields.",
         (name = "spatial-linkages", description = "Spatial couplings: closed-form kinematics of the RP1PR coupling between crossed shafts"),
         (name = "vibration", description = "Structural vibration control: active electromagnetic vibration absorber on a cantilever"),
     ),
-    components(schemas(Problem, ProblemField))
+    components(schemas(Problem, ProblemField)),
+    modifiers(&BearerAuth)
 )]
 struct ApiDoc;
+
+/// The bearer security scheme, required by every operation that does not opt out (`/healthz`).
+struct BearerAuth;
+
+impl utoipa::Modify for BearerAuth {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::security::{
+            HttpAuthScheme, HttpBuilder, SecurityRequirement, SecurityScheme,
+        };
+        doc.components
+            .get_or_insert_with(Default::default)
+            .add_security_scheme(
+                auth::SCHEME,
+                SecurityScheme::Http(
+                    HttpBuilder::new()
+                        .scheme(HttpAuthScheme::Bearer)
+                        .description(Some(
+                            "API key token (only when the service runs with `--api-keys-file`): \
+                         `Authorization: Bearer <token>`",
+                        ))
+                        .build(),
+                ),
+            );
+        doc.security = Some(vec![SecurityRequirement::new(
+            auth::SCHEME,
+            Vec::<String>::new(),
+        )]);
+    }
+}
 
 /// The documented routes; the OpenAPI document is generated from exactly these. Also returns
 /// the schema names claimed by two different Rust types (see [`openapi::Registry`]).
@@ -200,6 +237,7 @@ pub fn openapi_yaml() -> Result<String, serde_norway::Error> {
 pub fn app(state: AppState) -> Router {
     let (router, _api) = api_router().0.split_for_parts();
     let body_limit = state.config.max_body_bytes;
+    let authenticate = middleware::from_fn_with_state(state.clone(), auth::authenticate);
     let cors = layers::cors(&state.config.cors_origins);
     let mut app = router
         .route("/", get(meta::page))
@@ -217,6 +255,7 @@ pub fn app(state: AppState) -> Router {
         .layer(middleware::from_fn(picture::picture))
         .layer(middleware::from_fn(formats::formats))
         .layer(middleware::from_fn(stream::event_stream))
+        .layer(authenticate)
         .layer(middleware::from_fn(layers::log_request));
     for (name, value) in layers::hardening_headers() {
         app = app.layer(SetResponseHeaderLayer::if_not_present(name, value));

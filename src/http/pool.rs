@@ -5,8 +5,17 @@
 //!   that a request is refused with 503 + `Retry-After`. The `Retry-After` value is the real
 //!   backlog: jobs ahead × the recent mean job time / slots. A request whose expected wait already
 //!   exceeds its time budget is refused at once instead of after waiting for nothing.
+//! * **Fair queue.** Waiting heavy jobs sit in one queue per client (API key id, or remote
+//!   address without keys) and a freed slot goes to the waiting client that started a job least
+//!   recently (round-robin when all wait), so a client with one job waits about one running job
+//!   per other busy client, never behind another client's whole backlog. A client may have at most `client_queue_depth` jobs waiting (beyond: 429
+//!   `CLIENT_QUEUE_FULL`, its own backlog, other clients unaffected); when the whole queue is full,
+//!   a client with a shorter queue takes the place of the newest job of the longest one (which
+//!   gets 503), so the room is shared too.
 //! * **Cheap lane.** Requests known to be cheap (a closed-form evaluation: the route's recent jobs
-//!   took well under a millisecond and the body is small) do not queue behind sweeps: they run on
+//!   took well under a millisecond of CPU and the body is small) do not queue behind sweeps: they
+//!   are classified by the CPU time their jobs took, not by wall time, so a loaded machine that
+//!   stretches them does not push them into the heavy queue; they run on
 //!   a small separate lane (twice the slots at once, on tokio's blocking threads), or, below half a
 //!   millisecond, inline on the thread serving the request (at most cores − 1 at once, so one
 //!   connection thread is always free). Their CPU is bounded by that lane's size × their (short)
@@ -18,7 +27,7 @@
 //!   deadline passes, so the job stops at its next budget check and frees its slot.
 //! * A panic inside a job is logged and becomes a 500 whose body does not echo it.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, Weak};
@@ -39,6 +48,8 @@ const INLINE_JOB: Duration = Duration::from_micros(500);
 const CHEAP_BODY_BYTES: usize = 64 * 1024;
 /// Weight of the newest observation in the running mean of job times.
 const EWMA_WEIGHT: f64 = 0.2;
+/// The client of a request that came with no remote address and no key (in-process calls).
+const LOCAL_CLIENT: &str = "local";
 
 /// What a handler knows about a request before it is queued.
 #[derive(Debug, Clone, Default)]
@@ -85,6 +96,9 @@ pub struct RequestInfo {
     pub body_bytes: usize,
     /// Progress sink of a streaming request (`Accept: text/event-stream`).
     pub progress: Option<Arc<crate::numerics::budget::ProgressSink>>,
+    /// Who the request belongs to for fair queueing: its API key id, else its remote address
+    /// (set by [`crate::http::auth::authenticate`]); empty means in-process.
+    pub client: Arc<str>,
 }
 
 /// Where a job runs.
@@ -105,22 +119,199 @@ pub struct ComputePool {
 }
 
 struct Inner {
-    slots: Arc<Semaphore>,
+    /// The heavy lane's slots and per-client queues.
+    fair: Mutex<Fair>,
     n_slots: usize,
     cheap: Arc<Semaphore>,
     /// Jobs running inline on the connection threads at once (always leaves one thread free).
     inline: Arc<Semaphore>,
-    waiting: AtomicUsize,
     queue_depth: usize,
+    client_queue_depth: AtomicUsize,
     max_budget: Duration,
     threads_per_job: AtomicUsize,
-    /// Recent mean job time per route [µs].
+    /// Recent mean job CPU time per route [µs] (lane choice).
     route_us: Mutex<HashMap<String, f64>>,
     /// Recent mean heavy-lane job time [µs], for the backlog estimate.
     heavy_mean_us: AtomicU64,
     /// Cancellation flags of running jobs (weak: a finished job's flag is gone).
     running: Mutex<Vec<Weak<AtomicBool>>>,
     stopping: AtomicBool,
+}
+
+/// Free heavy slots and the jobs waiting for one, a FIFO queue per client.
+#[derive(Default)]
+struct Fair {
+    free: usize,
+    queues: HashMap<Arc<str>, VecDeque<Waiter>>,
+    /// Clients with a waiting job, in the order they queued (ties of `served`).
+    rotation: VecDeque<Arc<str>>,
+    /// When each client last started a job (a sequence number; absent = never): the waiting
+    /// client served least recently goes first, so a client whose job took a free slot directly
+    /// does not also take the next freed one ahead of a client that has waited.
+    served: HashMap<Arc<str>, u64>,
+    serve_seq: u64,
+    waiting: usize,
+    next_ticket: u64,
+}
+
+struct Waiter {
+    ticket: u64,
+    tx: tokio::sync::oneshot::Sender<Slot>,
+}
+
+impl Fair {
+    fn set_gauge(&self) {
+        metrics::gauge!("mechcalc_queue_waiting").set(self.waiting as f64);
+    }
+
+    /// Jobs a new job of `client` would wait behind: its own queue, and from every other client
+    /// as many as the round-robin serves before it.
+    fn ahead(&self, client: &str) -> usize {
+        let own = self.queues.get(client).map_or(0, VecDeque::len);
+        own + self
+            .queues
+            .iter()
+            .filter(|(c, _)| &***c != client)
+            .map(|(_, q)| q.len().min(own + 1))
+            .sum::<usize>()
+    }
+
+    /// Record that `client` starts a job now.
+    fn mark_served(&mut self, client: &Arc<str>) {
+        self.serve_seq += 1;
+        self.served.insert(Arc::clone(client), self.serve_seq);
+        // Forget clients that have nothing waiting once the table grows (a forgotten client
+        // counts as never served: at most one early start for it).
+        if self.served.len() > 4096 {
+            let queues = &self.queues;
+            self.served.retain(|c, _| queues.contains_key(c));
+        }
+    }
+
+    /// The next waiting job: the oldest of the waiting client served least recently (queue order
+    /// among equals), removed from its queue. With every client waiting this is round-robin.
+    fn pop_next(&mut self) -> Option<Waiter> {
+        let pos = self
+            .rotation
+            .iter()
+            .enumerate()
+            .min_by_key(|(i, c)| (self.served.get(*c).copied().unwrap_or(0), *i))
+            .map(|(i, _)| i)?;
+        let client = self.rotation.remove(pos)?;
+        let queue = self.queues.get_mut(&client)?;
+        let w = queue.pop_front();
+        if queue.is_empty() {
+            self.queues.remove(&client);
+        } else {
+            self.rotation.push_back(Arc::clone(&client));
+        }
+        if w.is_some() {
+            self.waiting -= 1;
+            self.mark_served(&client);
+        }
+        w
+    }
+
+    /// Remove the waiting job `ticket` of `client` (it gave up); false when it is not waiting.
+    fn remove(&mut self, client: &str, ticket: u64) -> bool {
+        let Some(queue) = self.queues.get_mut(client) else {
+            return false;
+        };
+        let Some(pos) = queue.iter().position(|w| w.ticket == ticket) else {
+            return false;
+        };
+        queue.remove(pos);
+        if queue.is_empty() {
+            self.queues.remove(client);
+            self.rotation.retain(|c| &**c != client);
+        }
+        self.waiting -= 1;
+        true
+    }
+
+    /// Drop the newest waiting job of the client with the longest queue, if that queue is longer
+    /// than `than + 1` (Longest Queue Drop: the room of a full queue is shared); its request gets
+    /// 503.
+    fn displace_longest(&mut self, than: usize) -> bool {
+        let Some(longest) = self
+            .queues
+            .iter()
+            .max_by_key(|(_, q)| q.len())
+            .map(|(c, q)| (Arc::clone(c), q.len()))
+        else {
+            return false;
+        };
+        if longest.1 <= than + 1 {
+            return false;
+        }
+        if let Some(q) = self.queues.get_mut(&longest.0) {
+            q.pop_back();
+            self.waiting -= 1;
+            metrics::counter!("mechcalc_rejected_total", "cause" => "displaced").increment(1);
+            return true;
+        }
+        false
+    }
+}
+
+/// A heavy-lane slot; dropping it hands it to the next waiting job in round-robin order.
+pub struct Slot {
+    pool: Option<Arc<Inner>>,
+}
+
+impl std::fmt::Debug for Slot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Slot")
+    }
+}
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        let Some(inner) = self.pool.take() else {
+            return;
+        };
+        let Ok(mut fair) = inner.fair.lock() else {
+            return;
+        };
+        while let Some(w) = fair.pop_next() {
+            let slot = Slot {
+                pool: Some(Arc::clone(&inner)),
+            };
+            match w.tx.send(slot) {
+                Ok(()) => {
+                    fair.set_gauge();
+                    return;
+                }
+                // The waiter is gone (timed out or its client left): disarm and try the next.
+                Err(mut unsent) => drop(unsent.pool.take()),
+            }
+        }
+        fair.free += 1;
+        fair.set_gauge();
+    }
+}
+
+/// What a job holds while it runs: a heavy slot or a permit of the cheap or inline lane.
+enum Held {
+    Slot(#[expect(dead_code, reason = "held for its Drop")] Slot),
+    Permit(#[expect(dead_code, reason = "held for its Drop")] OwnedSemaphorePermit),
+}
+
+/// Takes a waiting job out of its queue however the wait ends (timeout, client gone).
+struct WaitGuard<'a> {
+    inner: &'a Inner,
+    client: Arc<str>,
+    ticket: u64,
+}
+
+impl Drop for WaitGuard<'_> {
+    fn drop(&mut self) {
+        if let Ok(mut fair) = self.inner.fair.lock()
+            && fair.remove(&self.client, self.ticket)
+        {
+            fair.set_gauge();
+        }
+    }
 }
 
 /// Raises the job's cancellation flag when the request is dropped before the job finished.
@@ -142,16 +333,6 @@ impl Drop for CancelOnDrop {
     }
 }
 
-/// Decrements the waiting counter however the wait ends (permit, timeout or cancellation).
-struct WaitGuard<'a>(&'a AtomicUsize);
-
-impl Drop for WaitGuard<'_> {
-    fn drop(&mut self) {
-        self.0.fetch_sub(1, Ordering::SeqCst);
-        metrics::gauge!("mechcalc_queue_waiting").decrement(1.0);
-    }
-}
-
 impl ComputePool {
     /// A pool with `slots` concurrent heavy jobs, `queue_depth` waiters and a server-wide budget
     /// cap; each job may use every thread of the rayon pool for its parallel parts; the cheap lane
@@ -161,7 +342,10 @@ impl ComputePool {
         let slots = slots.max(1);
         Self {
             inner: Arc::new(Inner {
-                slots: Arc::new(Semaphore::new(slots)),
+                fair: Mutex::new(Fair {
+                    free: slots,
+                    ..Fair::default()
+                }),
                 n_slots: slots,
                 cheap: Arc::new(Semaphore::new(2 * slots)),
                 inline: Arc::new(Semaphore::new(
@@ -170,8 +354,8 @@ impl ComputePool {
                         .saturating_sub(1)
                         .max(1),
                 )),
-                waiting: AtomicUsize::new(0),
                 queue_depth,
+                client_queue_depth: AtomicUsize::new((queue_depth / 2).max(1)),
                 max_budget,
                 threads_per_job: AtomicUsize::new(rayon::current_num_threads()),
                 route_us: Mutex::new(HashMap::new()),
@@ -191,6 +375,15 @@ impl ComputePool {
         self
     }
 
+    /// The same pool with at most `depth` waiting heavy jobs per client (at least 1).
+    #[must_use]
+    pub fn with_client_queue_depth(self, depth: usize) -> Self {
+        self.inner
+            .client_queue_depth
+            .store(depth.max(1), Ordering::Relaxed);
+        self
+    }
+
     /// Threads one job may use for its parallel parts.
     #[must_use]
     pub fn threads_per_job(&self) -> usize {
@@ -206,7 +399,7 @@ impl ComputePool {
     /// Heavy-lane slots free right now.
     #[must_use]
     pub fn available_slots(&self) -> usize {
-        self.inner.slots.available_permits()
+        self.inner.fair.lock().map_or(0, |f| f.free)
     }
 
     /// Heavy-lane slots in all.
@@ -218,7 +411,13 @@ impl ComputePool {
     /// Requests waiting for a heavy-lane slot right now.
     #[must_use]
     pub fn waiting(&self) -> usize {
-        self.inner.waiting.load(Ordering::SeqCst)
+        self.inner.fair.lock().map_or(0, |f| f.waiting)
+    }
+
+    /// Clients with a heavy job waiting right now.
+    #[must_use]
+    pub fn waiting_clients(&self) -> usize {
+        self.inner.fair.lock().map_or(0, |f| f.queues.len())
     }
 
     /// Stop taking work and cancel every running job (the shutdown deadline has passed).
@@ -235,6 +434,13 @@ impl ComputePool {
             f.store(true, Ordering::Relaxed);
             n += 1;
         }
+        // Waiting jobs are told at once (their senders are dropped: 503 shutting down).
+        if let Ok(mut fair) = self.inner.fair.lock() {
+            fair.queues.clear();
+            fair.rotation.clear();
+            fair.waiting = 0;
+            fair.set_gauge();
+        }
         metrics::counter!("mechcalc_jobs_cancelled_total", "cause" => "shutdown").increment(n);
         tracing::warn!(jobs = n, "shutdown deadline: running jobs cancelled");
     }
@@ -247,46 +453,110 @@ impl ComputePool {
         ((ahead as f64 + 0.5 * slots) * mean / slots).round() as u64
     }
 
-    /// Seconds to tell a refused client: the backlog ahead of it, at least 1.
-    fn retry_after_s(&self) -> u64 {
-        self.expected_wait_us(self.waiting())
-            .div_ceil(1_000_000)
-            .max(1)
+    /// Seconds to tell a refused client: the backlog ahead of `ahead` jobs, at least 1.
+    fn retry_after_s(&self, ahead: usize) -> u64 {
+        self.expected_wait_us(ahead).div_ceil(1_000_000).max(1)
     }
 
-    /// Take a heavy slot, waiting in the queue if there is room; 503 when the queue is full, when
-    /// the expected wait already exceeds `max_wait`, or when the wait outlasts it.
-    pub async fn acquire(&self, max_wait: Duration) -> Result<OwnedSemaphorePermit, ApiError> {
-        if self.inner.stopping.load(Ordering::SeqCst) {
-            return Err(ApiError::shutting_down());
-        }
-        if let Ok(p) = Arc::clone(&self.inner.slots).try_acquire_owned() {
-            return Ok(p);
-        }
-        let ahead = self.inner.waiting.fetch_add(1, Ordering::SeqCst);
-        metrics::gauge!("mechcalc_queue_waiting").increment(1.0);
-        let _guard = WaitGuard(&self.inner.waiting);
-        if ahead >= self.inner.queue_depth {
-            metrics::counter!("mechcalc_rejected_total", "cause" => "queue_full").increment(1);
-            return Err(ApiError::overloaded(self.retry_after_s()));
-        }
-        let wait_us = self.expected_wait_us(ahead);
-        let budget_us = u64::try_from(max_wait.as_micros()).unwrap_or(u64::MAX);
-        if wait_us > budget_us {
-            metrics::counter!("mechcalc_rejected_total", "cause" => "cannot_start_in_time")
-                .increment(1);
-            return Err(ApiError::cannot_start_in_time(
-                self.retry_after_s(),
-                wait_us / 1000,
-                budget_us / 1000,
-            ));
-        }
-        match tokio::time::timeout(max_wait, Arc::clone(&self.inner.slots).acquire_owned()).await {
-            Ok(Ok(p)) => Ok(p),
-            _ => {
+    /// Take a heavy slot for the client of the request in flight (see [`RequestInfo::client`]),
+    /// waiting in its queue if there is room; see [`ComputePool::acquire_for`].
+    pub async fn acquire(&self, max_wait: Duration) -> Result<Slot, ApiError> {
+        let client = REQUEST_INFO
+            .try_with(|i| Arc::clone(&i.client))
+            .unwrap_or_default();
+        self.acquire_for(client, max_wait).await
+    }
+
+    /// Take a heavy slot for `client`, waiting in its queue if there is room: 429 when the
+    /// client already has its share of waiting jobs; 503 when the whole queue is full (and no
+    /// longer queue can give up a place), when the expected wait already exceeds `max_wait`, or
+    /// when the wait outlasts it.
+    pub async fn acquire_for(
+        &self,
+        client: Arc<str>,
+        max_wait: Duration,
+    ) -> Result<Slot, ApiError> {
+        let client: Arc<str> = if client.is_empty() {
+            Arc::from(LOCAL_CLIENT)
+        } else {
+            client
+        };
+        let (rx, ticket) = {
+            let Ok(mut fair) = self.inner.fair.lock() else {
+                return Err(ApiError::internal());
+            };
+            if self.inner.stopping.load(Ordering::SeqCst) {
+                return Err(ApiError::shutting_down());
+            }
+            if fair.free > 0 {
+                fair.free -= 1;
+                fair.mark_served(&client);
+                return Ok(Slot {
+                    pool: Some(Arc::clone(&self.inner)),
+                });
+            }
+            let own = fair.queues.get(&client).map_or(0, VecDeque::len);
+            let cap = self.inner.client_queue_depth.load(Ordering::Relaxed);
+            if own >= cap {
+                metrics::counter!("mechcalc_rejected_total", "cause" => "client_queue_full")
+                    .increment(1);
+                let retry = self.retry_after_s(own);
+                return Err(ApiError::too_many_requests(
+                    "CLIENT_QUEUE_FULL",
+                    retry,
+                    format!(
+                        "this client already has {own} calculations waiting for a compute slot \
+                         (at most {cap} per client); retry in {retry} s"
+                    ),
+                ));
+            }
+            if fair.waiting >= self.inner.queue_depth && !fair.displace_longest(own) {
+                metrics::counter!("mechcalc_rejected_total", "cause" => "queue_full").increment(1);
+                return Err(ApiError::overloaded(self.retry_after_s(fair.waiting)));
+            }
+            let ahead = fair.ahead(&client);
+            let wait_us = self.expected_wait_us(ahead);
+            let budget_us = u64::try_from(max_wait.as_micros()).unwrap_or(u64::MAX);
+            if wait_us > budget_us {
+                metrics::counter!("mechcalc_rejected_total", "cause" => "cannot_start_in_time")
+                    .increment(1);
+                return Err(ApiError::cannot_start_in_time(
+                    self.retry_after_s(ahead),
+                    wait_us / 1000,
+                    budget_us / 1000,
+                ));
+            }
+            let (tx, rx) = tokio::sync::oneshot::channel();
+            fair.next_ticket += 1;
+            let ticket = fair.next_ticket;
+            let queue = fair.queues.entry(Arc::clone(&client)).or_default();
+            queue.push_back(Waiter { ticket, tx });
+            if queue.len() == 1 {
+                fair.rotation.push_back(Arc::clone(&client));
+            }
+            fair.waiting += 1;
+            fair.set_gauge();
+            (rx, ticket)
+        };
+        let guard = WaitGuard {
+            inner: &self.inner,
+            client,
+            ticket,
+        };
+        let got = tokio::time::timeout(max_wait, rx).await;
+        // A slot that arrived just as the wait ended is dropped with `got` and passes on.
+        drop(guard);
+        match got {
+            Ok(Ok(slot)) => Ok(slot),
+            Ok(Err(_)) if self.inner.stopping.load(Ordering::SeqCst) => {
+                Err(ApiError::shutting_down())
+            }
+            // Displaced by a client with a shorter queue.
+            Ok(Err(_)) => Err(ApiError::overloaded(self.retry_after_s(self.waiting()))),
+            Err(_) => {
                 metrics::counter!("mechcalc_rejected_total", "cause" => "wait_timeout")
                     .increment(1);
-                Err(ApiError::overloaded(self.retry_after_s()))
+                Err(ApiError::overloaded(self.retry_after_s(self.waiting())))
             }
         }
     }
@@ -315,12 +585,19 @@ impl ComputePool {
         }
     }
 
-    fn observe(&self, route: &str, heavy: bool, elapsed: Duration) {
-        let us = elapsed.as_secs_f64() * 1e6;
+    /// Learn from a finished job: the route's CPU time per job (lane choice: wall time would
+    /// grow with the machine's load and push cheap routes into the heavy queue) and the heavy
+    /// lane's wall time per job (backlog estimate).
+    fn observe(&self, route: &str, heavy: bool, times: Times) {
+        let Times { elapsed, cpu } = times;
+        // The job's own thread's CPU (a parallel job also uses others, but then its own share
+        // alone is far above the cheap threshold); wall time where the clock is unavailable.
+        let cpu_us = if cpu.is_zero() { elapsed } else { cpu }.as_secs_f64() * 1e6;
         if let Ok(mut m) = self.inner.route_us.lock() {
-            let e = m.entry(route.to_owned()).or_insert(us);
-            *e += EWMA_WEIGHT * (us - *e);
+            let e = m.entry(route.to_owned()).or_insert(cpu_us);
+            *e += EWMA_WEIGHT * (cpu_us - *e);
         }
+        let us = elapsed.as_secs_f64() * 1e6;
         if heavy {
             let old = self.inner.heavy_mean_us.load(Ordering::Relaxed) as f64;
             let new = if old == 0.0 {
@@ -369,14 +646,21 @@ impl ComputePool {
         }
         let heavy = lane == Lane::Heavy;
         let permit = match (lane, inline_permit) {
-            (Lane::Inline, Some(p)) => p,
-            (Lane::Heavy, _) => self.acquire(limit).await?,
+            (Lane::Inline, Some(p)) => Held::Permit(p),
+            (Lane::Heavy, _) => {
+                let client = if info.client.is_empty() {
+                    Arc::from(LOCAL_CLIENT)
+                } else {
+                    Arc::clone(&info.client)
+                };
+                Held::Slot(self.acquire_for(client, limit).await?)
+            }
             // Cheap jobs last microseconds: wait for the cheap lane rather than queue behind
             // sweeps.
             _ => match tokio::time::timeout(limit, Arc::clone(&self.inner.cheap).acquire_owned())
                 .await
             {
-                Ok(Ok(p)) => p,
+                Ok(Ok(p)) => Held::Permit(p),
                 _ => return Err(ApiError::overloaded(1)),
             },
         };
@@ -402,12 +686,14 @@ impl ComputePool {
         let task = move || {
             let _entered = span.enter();
             let started = Instant::now();
+            let cpu0 = thread_cpu();
             let out = std::panic::catch_unwind(AssertUnwindSafe(|| job(&budget)));
+            let cpu = thread_cpu().saturating_sub(cpu0);
             let elapsed = started.elapsed();
             let stopped_early = budget.cancelled() || budget.expired();
             drop(permit);
             // The receiver is gone only when the request was dropped; nobody wants the answer.
-            let _ = tx.send((out, elapsed, stopped_early));
+            let _ = tx.send((out, Times { elapsed, cpu }, stopped_early));
         };
         match lane {
             Lane::Heavy => rayon::spawn(task),
@@ -418,8 +704,8 @@ impl ComputePool {
         cancel.done = true;
         metrics::gauge!(gauge).decrement(1.0);
         match out {
-            Ok((Ok(v), elapsed, stopped_early)) => {
-                self.observe(&info.route, heavy, elapsed);
+            Ok((Ok(v), times, stopped_early)) => {
+                self.observe(&info.route, heavy, times);
                 if stopped_early {
                     metrics::counter!("mechcalc_budget_stops_total", "route" => info.route.clone())
                         .increment(1);
@@ -435,6 +721,34 @@ impl ComputePool {
                 Err(ApiError::internal())
             }
         }
+    }
+}
+
+/// Wall and CPU time of one job.
+#[derive(Debug, Clone, Copy)]
+struct Times {
+    elapsed: Duration,
+    cpu: Duration,
+}
+
+/// CPU time the calling thread has used so far (zero where the clock is unavailable).
+fn thread_cpu() -> Duration {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+    Duration::new(
+        u64::try_from(t.tv_sec).unwrap_or(0),
+        u32::try_from(t.tv_nsec).unwrap_or(0),
+    )
+}
+
+/// Lower the calling thread's priority to `nice` (0 to 19; 0 leaves it): the compute pool's
+/// start handler, so sweeps yield the CPU to the threads that serve connections and cheap
+/// requests. Only ever lowers; failure is logged and harmless.
+pub fn lower_thread_priority(nice: i32) {
+    if nice <= 0 {
+        return;
+    }
+    if let Err(e) = rustix::process::setpriority_process(None, nice.min(19)) {
+        tracing::warn!(error = %e, "cannot lower the compute threads' priority");
     }
 }
 
@@ -537,7 +851,14 @@ mod tests {
     #[tokio::test]
     async fn expected_wait_beyond_the_budget_is_refused_at_once() {
         let pool = ComputePool::new(1, 8, Duration::from_secs(30));
-        pool.observe("/x", true, Duration::from_secs(2));
+        pool.observe(
+            "/x",
+            true,
+            Times {
+                elapsed: Duration::from_secs(2),
+                cpu: Duration::from_secs(2),
+            },
+        );
         let held = pool.acquire(Duration::from_secs(1)).await.expect("free");
         let t = Instant::now();
         let err = pool
@@ -548,5 +869,151 @@ mod tests {
         assert!(t.elapsed() < Duration::from_millis(100), "refused at once");
         assert!(err.body().detail.contains("expected wait"));
         drop(held);
+    }
+
+    /// Start a waiter of `client` that records the order it got its slot in `order`.
+    fn waiter(
+        pool: &ComputePool,
+        client: &str,
+        order: &Arc<Mutex<Vec<String>>>,
+    ) -> tokio::task::JoinHandle<bool> {
+        let (p, c, o) = (pool.clone(), Arc::<str>::from(client), Arc::clone(order));
+        tokio::spawn(async move {
+            match p.acquire_for(Arc::clone(&c), Duration::from_secs(5)).await {
+                Ok(slot) => {
+                    if let Ok(mut v) = o.lock() {
+                        v.push(c.to_string());
+                    }
+                    tokio::time::sleep(Duration::from_millis(5)).await;
+                    drop(slot);
+                    true
+                }
+                Err(_) => false,
+            }
+        })
+    }
+
+    #[tokio::test]
+    async fn a_second_client_does_not_wait_behind_the_first_clients_backlog() {
+        let pool = ComputePool::new(1, 16, Duration::from_secs(30)).with_client_queue_depth(8);
+        let held = pool
+            .acquire_for(Arc::from("a"), Duration::from_secs(1))
+            .await
+            .expect("free");
+        let order = Arc::new(Mutex::new(Vec::new()));
+        let mut tasks = Vec::new();
+        for _ in 0..6 {
+            tasks.push(waiter(&pool, "a", &order));
+            tokio::time::sleep(Duration::from_millis(2)).await;
+        }
+        tasks.push(waiter(&pool, "b", &order));
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        assert_eq!(pool.waiting(), 7);
+        assert_eq!(pool.waiting_clients(), 2);
+        drop(held);
+        for t in tasks {
+            assert!(t.await.expect("join"), "every waiter got a slot");
+        }
+        let order = order.lock().expect("order").clone();
+        let b_at = order.iter().position(|c| c == "b").expect("b served");
+        // a's first job took the free slot: b, never served, takes the next one, then a and b
+        // would alternate.
+        assert_eq!(b_at, 0, "b served at position {b_at} of {order:?}");
+        assert_eq!(pool.waiting(), 0);
+        assert_eq!(pool.available_slots(), 1);
+    }
+
+    #[tokio::test]
+    async fn a_client_over_its_queue_share_gets_429_and_others_still_queue() {
+        let pool = ComputePool::new(1, 16, Duration::from_secs(30)).with_client_queue_depth(2);
+        let held = pool
+            .acquire_for(Arc::from("a"), Duration::from_secs(1))
+            .await
+            .expect("free");
+        let order = Arc::new(Mutex::new(Vec::new()));
+        let a1 = waiter(&pool, "a", &order);
+        let a2 = waiter(&pool, "a", &order);
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        let err = pool
+            .acquire_for(Arc::from("a"), Duration::from_secs(1))
+            .await
+            .expect_err("a's share is 2");
+        assert_eq!(err.status().as_u16(), 429);
+        assert_eq!(err.body().code, "CLIENT_QUEUE_FULL");
+        let b = waiter(&pool, "b", &order);
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        assert_eq!(pool.waiting(), 3);
+        drop(held);
+        for t in [a1, a2, b] {
+            assert!(t.await.expect("join"));
+        }
+    }
+
+    #[tokio::test]
+    async fn a_full_queue_makes_room_for_a_new_client_from_the_longest_queue() {
+        let pool = ComputePool::new(1, 3, Duration::from_secs(30)).with_client_queue_depth(3);
+        let held = pool
+            .acquire_for(Arc::from("a"), Duration::from_secs(1))
+            .await
+            .expect("free");
+        let order = Arc::new(Mutex::new(Vec::new()));
+        let a: Vec<_> = (0..3).map(|_| waiter(&pool, "a", &order)).collect();
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        assert_eq!(pool.waiting(), 3);
+        let b = waiter(&pool, "b", &order);
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        assert_eq!(pool.waiting(), 3, "b took the place of a's newest job");
+        drop(held);
+        let served_a = futures_util::future::join_all(a)
+            .await
+            .into_iter()
+            .filter(|r| matches!(r, Ok(true)))
+            .count();
+        assert_eq!(served_a, 2, "one of a's jobs was displaced (503)");
+        assert!(b.await.expect("join"));
+        // A third client finds the queue full and no queue longer than its own + 1: refused.
+        let held = pool
+            .acquire_for(Arc::from("a"), Duration::from_secs(1))
+            .await
+            .expect("free again");
+        let w: Vec<_> = ["a", "b", "c"]
+            .iter()
+            .map(|c| waiter(&pool, c, &order))
+            .collect();
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        let err = pool
+            .acquire_for(Arc::from("d"), Duration::from_secs(1))
+            .await
+            .expect_err("full, every queue has one");
+        assert_eq!(err.status().as_u16(), 503);
+        drop(held);
+        for t in w {
+            assert!(t.await.expect("join"));
+        }
+    }
+
+    #[test]
+    fn thread_cpu_time_advances_with_work_not_with_sleep() {
+        let t0 = thread_cpu();
+        std::thread::sleep(Duration::from_millis(30));
+        let slept = thread_cpu().saturating_sub(t0);
+        let t1 = thread_cpu();
+        let start = Instant::now();
+        let mut x = 0u64;
+        // Busy until the clock shows 20 ms of CPU (on a loaded machine that takes longer).
+        while thread_cpu().saturating_sub(t1) < Duration::from_millis(20)
+            && start.elapsed() < Duration::from_secs(10)
+        {
+            for _ in 0..10_000 {
+                x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            }
+        }
+        std::hint::black_box(x);
+        let worked = thread_cpu().saturating_sub(t1);
+        assert!(slept < Duration::from_millis(5), "sleep counted {slept:?}");
+        assert!(
+            worked >= Duration::from_millis(20),
+            "work counted {worked:?}"
+        );
     }
 }

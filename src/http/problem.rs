@@ -254,6 +254,32 @@ impl ApiError {
         e
     }
 
+    /// 401: the request carries no bearer token, or one that matches no API key (the caller adds
+    /// `WWW-Authenticate: Bearer`).
+    pub fn unauthorized(detail: impl Into<String>) -> Self {
+        Self::new(
+            StatusCode::UNAUTHORIZED,
+            "unauthorized",
+            "Unauthorized",
+            "UNAUTHORIZED",
+            detail,
+        )
+    }
+
+    /// 429: the client sent more than its API key allows (`RATE_LIMITED`) or already has as many
+    /// jobs waiting as one client may (`CLIENT_QUEUE_FULL`); retry after `retry_after_s`.
+    pub fn too_many_requests(code: &str, retry_after_s: u64, detail: impl Into<String>) -> Self {
+        let mut e = Self::new(
+            StatusCode::TOO_MANY_REQUESTS,
+            "too-many-requests",
+            "Too many requests",
+            code,
+            detail,
+        );
+        e.0.retry_after_s = Some(retry_after_s);
+        e
+    }
+
     /// 500: a bug. The detail sent to the client is generic; the cause is logged, never echoed.
     pub fn internal() -> Self {
         Self::new(

@@ -10,6 +10,10 @@
 //! * **Connection limit**: beyond `--max-connections` open connections, a new one gets an
 //!   immediate `503` and is closed, so descriptors never run out and `/healthz` keeps answering on
 //!   the connections that are served.
+//! * **Remote address**: every request carries the connection's peer address
+//!   (`ConnectInfo<SocketAddr>`); without API keys it names the client for fair queueing.
+//! * **Metrics port** (`--metrics-bind`): [`serve_metrics`] answers `/metrics` and `/healthz`
+//!   only, never behind API keys, so a network policy can admit the scraper to that port alone.
 //! * **Shutdown**: on the signal the listener closes, in-flight requests get
 //!   `--shutdown-grace-ms` to finish, then every running job is cancelled and `serve` returns.
 
@@ -18,12 +22,14 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use axum::Router;
+use axum::extract::ConnectInfo;
 use hyper_util::rt::{TokioIo, TokioTimer};
 use hyper_util::server::graceful::GracefulShutdown;
 use hyper_util::service::TowerToHyperService;
 use tokio::net::TcpListener;
 use tokio::sync::Semaphore;
 use tokio_io_timeout::TimeoutStream;
+use tower::ServiceExt;
 
 use super::pool::ComputePool;
 
@@ -66,7 +72,7 @@ pub async fn serve(
             a = listener.accept() => a,
             () = &mut shutdown => break,
         };
-        let (tcp, _peer) = match accepted {
+        let (tcp, peer) = match accepted {
             Ok(c) => c,
             Err(e) => {
                 // Out of descriptors or a transient network error: back off briefly, keep serving.
@@ -89,7 +95,14 @@ pub async fn serve(
         let mut stream = TimeoutStream::new(tcp);
         stream.set_write_timeout(Some(limits.write_timeout));
         let io = TokioIo::new(Box::pin(stream));
-        let conn = http.serve_connection(io, TowerToHyperService::new(app.clone()));
+        // The remote address reaches the app (fair queueing names a client without a key by it).
+        let svc =
+            app.clone()
+                .map_request(move |mut r: axum::http::Request<hyper::body::Incoming>| {
+                    r.extensions_mut().insert(ConnectInfo(peer));
+                    r
+                });
+        let conn = http.serve_connection(io, TowerToHyperService::new(svc));
         let conn = graceful.watch(conn);
         metrics::gauge!("mechcalc_connections_open").increment(1.0);
         tokio::spawn(async move {
@@ -111,6 +124,18 @@ pub async fn serve(
             tracing::warn!("shutdown deadline reached; cancelling running jobs and closing connections");
             pool.cancel_all();
         }
+    }
+}
+
+/// Serve `/metrics` and `/healthz` of `state` on `listener` (the `--metrics-bind` port) until
+/// the process ends.
+pub async fn serve_metrics(listener: TcpListener, state: super::AppState) {
+    let app = Router::new()
+        .route("/metrics", axum::routing::get(super::meta::metrics))
+        .route("/healthz", axum::routing::get(super::meta::healthz))
+        .with_state(state);
+    if let Err(e) = axum::serve(listener, app).await {
+        tracing::error!(error = %e, "the metrics listener stopped");
     }
 }
 

@@ -11,6 +11,7 @@ mod api_examples;
 mod cli;
 mod contract;
 mod formats;
+mod http_auth;
 mod http_bezier_motion;
 mod http_bus_fuel_economy;
 mod http_cam_law;

@@ -66,6 +66,13 @@ impl Server {
         self.log.lock().map(|l| l.clone()).unwrap_or_default()
     }
 
+    /// Send SIGHUP (the service rereads its API keys file).
+    pub fn hup(&self) {
+        let _ = std::process::Command::new("kill")
+            .args(["-HUP", &self.pid().to_string()])
+            .status();
+    }
+
     /// SIGTERM, then wait up to `limit` for the exit.
     pub async fn terminate_and_wait(mut self, limit: Duration) -> Option<ExitStatus> {
         let pid = self.pid();
@@ -93,10 +100,29 @@ impl Server {
 /// An answer.
 pub struct Reply {
     pub status: u16,
+    /// The response head (status line and headers), lowercase.
+    pub head: String,
     pub body: Vec<u8>,
 }
 
 impl Reply {
+    /// A header's value (`name` lowercase).
+    pub fn header(&self, name: &str) -> Option<&str> {
+        self.head.lines().find_map(|l| {
+            let (k, v) = l.split_once(':')?;
+            (k.trim() == name).then(|| v.trim())
+        })
+    }
+
+    /// The `queue` duration of the Server-Timing header [ms].
+    pub fn queue_ms(&self) -> Option<f64> {
+        self.header("server-timing")?
+            .split(',')
+            .find_map(|p| p.trim().strip_prefix("queue;dur="))?
+            .parse()
+            .ok()
+    }
+
     pub fn json(&self) -> Value {
         serde_json::from_slice(&self.body).unwrap_or(Value::Null)
     }
@@ -116,7 +142,7 @@ async fn exchange(addr: SocketAddr, request: Vec<u8>) -> std::io::Result<Reply> 
         .windows(4)
         .position(|w| w == b"\r\n\r\n")
         .ok_or_else(|| std::io::Error::other("no response head"))?;
-    let head = String::from_utf8_lossy(&buf[..text_end]).into_owned();
+    let head = String::from_utf8_lossy(&buf[..text_end]).to_ascii_lowercase();
     let status = head
         .split_whitespace()
         .nth(1)
@@ -124,6 +150,7 @@ async fn exchange(addr: SocketAddr, request: Vec<u8>) -> std::io::Result<Reply> 
         .ok_or_else(|| std::io::Error::other("no status"))?;
     Ok(Reply {
         status,
+        head,
         body: buf[text_end + 4..].to_vec(),
     })
 }
@@ -138,14 +165,109 @@ pub async fn get(addr: SocketAddr, path: &str) -> std::io::Result<Reply> {
 }
 
 fn post_bytes(path: &str, body: &Value) -> Vec<u8> {
-    let b = serde_json::to_vec(body).expect("serializes");
-    let mut r = format!(
-        "POST {path} HTTP/1.1\r\nhost: t\r\ncontent-type: application/json\r\ncontent-length: {}\r\nconnection: close\r\n\r\n",
-        b.len()
-    )
-    .into_bytes();
+    request_bytes("POST", path, Some(body), None, false)
+}
+
+/// An HTTP/1.1 request: `body` as JSON, an optional bearer `token`, keep-alive or close.
+pub fn request_bytes(
+    method: &str,
+    path: &str,
+    body: Option<&Value>,
+    token: Option<&str>,
+    keep_alive: bool,
+) -> Vec<u8> {
+    let b = body
+        .map(|b| serde_json::to_vec(b).expect("serializes"))
+        .unwrap_or_default();
+    let mut head = format!("{method} {path} HTTP/1.1\r\nhost: t\r\n");
+    if body.is_some() {
+        head.push_str(&format!(
+            "content-type: application/json\r\ncontent-length: {}\r\n",
+            b.len()
+        ));
+    }
+    if let Some(t) = token {
+        head.push_str(&format!("authorization: Bearer {t}\r\n"));
+    }
+    if !keep_alive {
+        head.push_str("connection: close\r\n");
+    }
+    head.push_str("\r\n");
+    let mut r = head.into_bytes();
     r.extend_from_slice(&b);
     r
+}
+
+/// Send prepared request bytes on a fresh connection (closed after the answer).
+pub async fn send(addr: SocketAddr, request: Vec<u8>) -> std::io::Result<Reply> {
+    exchange(addr, request).await
+}
+
+/// A keep-alive connection that sends one request after another (as load generators do).
+pub struct KeepAlive {
+    stream: TcpStream,
+    buf: Vec<u8>,
+}
+
+impl KeepAlive {
+    pub async fn connect(addr: SocketAddr) -> std::io::Result<Self> {
+        let stream = TcpStream::connect(addr).await?;
+        stream.set_nodelay(true)?;
+        Ok(Self {
+            stream,
+            buf: Vec::new(),
+        })
+    }
+
+    /// Send `request` and read one answer (its head and `content-length` bytes of body).
+    pub async fn exchange(&mut self, request: &[u8]) -> std::io::Result<Reply> {
+        self.stream.write_all(request).await?;
+        let mut chunk = [0u8; 16 * 1024];
+        loop {
+            if let Some(end) = self.buf.windows(4).position(|w| w == b"\r\n\r\n") {
+                let head = String::from_utf8_lossy(&self.buf[..end]).to_ascii_lowercase();
+                let len: usize = head
+                    .lines()
+                    .find_map(|l| l.strip_prefix("content-length:"))
+                    .and_then(|v| v.trim().parse().ok())
+                    .ok_or_else(|| std::io::Error::other("no content-length"))?;
+                while self.buf.len() < end + 4 + len {
+                    let n = self.read(&mut chunk).await?;
+                    self.buf.extend_from_slice(&chunk[..n]);
+                }
+                let body = self.buf[end + 4..end + 4 + len].to_vec();
+                self.buf.drain(..end + 4 + len);
+                let status = head
+                    .split_whitespace()
+                    .nth(1)
+                    .and_then(|s| s.parse().ok())
+                    .ok_or_else(|| std::io::Error::other("no status"))?;
+                return Ok(Reply { status, head, body });
+            }
+            let n = self.read(&mut chunk).await?;
+            self.buf.extend_from_slice(&chunk[..n]);
+        }
+    }
+
+    async fn read(&mut self, chunk: &mut [u8]) -> std::io::Result<usize> {
+        let n = tokio::time::timeout(Duration::from_secs(60), self.stream.read(chunk))
+            .await
+            .map_err(|_| std::io::Error::other("no answer within 60 s"))??;
+        if n == 0 {
+            return Err(std::io::Error::other("connection closed"));
+        }
+        Ok(n)
+    }
+}
+
+/// The `q` quantile of `samples` (sorted in place), 0 when empty.
+pub fn quantile(samples: &mut [f64], q: f64) -> f64 {
+    if samples.is_empty() {
+        return 0.0;
+    }
+    samples.sort_by(f64::total_cmp);
+    let i = ((samples.len() as f64 - 1.0) * q).round() as usize;
+    samples[i.min(samples.len() - 1)]
 }
 
 /// `POST path` with a JSON body on a fresh connection.

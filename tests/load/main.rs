@@ -5,6 +5,7 @@
 //! `MECHCALC_LOAD_SCALE` (default 1) multiplies the connection and request counts for a longer run.
 
 mod client;
+mod keys_and_fairness;
 
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
