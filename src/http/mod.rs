@@ -168,6 +168,14 @@ pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRul
     use crate::calc;
     vec![
         (
+            "/v1/bus-fuel-economy",
+            calc::bus_fuel_economy::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/bus-fuel-economy/motor-map",
+            calc::bus_fuel_economy::input::MOTOR_MAP_RULES,
+        ),
+        (
             "/v1/cam-law/evaluate",
             calc::cam_law::input::CROSS_FIELD_RULES,
         ),
