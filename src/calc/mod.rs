@@ -56,13 +56,9 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         common::schema_bounds(),
         bezier_motion::wire::schema_bounds(),
-        bus_fuel_economy::wire::schema_bounds(),
-        bus_fuel_economy::wire::variant_bounds(),
         cam_law_fit::wire::schema_bounds(),
         cognates::wire::schema_bounds(),
         cognates::wire::variant_bounds(),
-        component_importance::wire::schema_bounds(),
-        component_importance::wire::variant_bounds(),
         continuum_workspace::wire::schema_bounds(),
         continuum_workspace::wire::nested_bounds(),
         irefc::wire::schema_bounds(),

@@ -599,9 +599,9 @@ impl DocRules {
     }
 
     /// Add one rule.
-    pub fn push(&mut self, schema: &Cow<'static, str>, pointer: &'static str, kind: Kind) {
+    pub fn push(&mut self, schema: &str, pointer: &'static str, kind: Kind) {
         self.rules.push(DocRule {
-            schema: schema.clone(),
+            schema: Cow::Owned(schema.to_owned()),
             pointer,
             kind,
         });

@@ -4,11 +4,11 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
 use crate::calc::bus_fuel_economy::{
-    self, BusFuelEconomyRequest, BusFuelEconomyResponse, MotorMapRequest, MotorMapResponse,
+    self, BusFuelEconomyInput, BusFuelEconomyRequest, BusFuelEconomyResponse, MotorMapInput,
+    MotorMapRequest, MotorMapResponse,
 };
-use crate::calc::common::TimeLimited;
 
 /// Energy and fuel economy of an electric bus over drive cycles, for 1..8 traction motors.
 ///
@@ -34,11 +34,10 @@ use crate::calc::common::TimeLimited;
 )]
 pub async fn compute(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<BusFuelEconomyRequest>,
+    Valid { input, limit, .. }: Valid<BusFuelEconomyRequest, BusFuelEconomyInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        bus_fuel_economy::run(req, budget)
+        bus_fuel_economy::run_valid(&input, budget)
     })
     .await
 }
@@ -62,11 +61,10 @@ pub async fn compute(
 )]
 pub async fn motor_map(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<MotorMapRequest>,
+    Valid { input, limit, .. }: Valid<MotorMapRequest, MotorMapInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        bus_fuel_economy::run_motor_map(req, budget)
+        bus_fuel_economy::run_motor_map_valid(&input, budget)
     })
     .await
 }

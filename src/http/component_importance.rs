@@ -3,10 +3,9 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::common::TimeLimited;
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
 use crate::calc::component_importance::{
-    self, ComponentImportanceRequest, ComponentImportanceResponse,
+    self, ComponentImportanceInput, ComponentImportanceRequest, ComponentImportanceResponse,
 };
 
 /// Rank machine components by how far and how harmfully their faults spread at given ages.
@@ -31,11 +30,10 @@ use crate::calc::component_importance::{
 )]
 pub async fn rank(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<ComponentImportanceRequest>,
+    Valid { input, limit, .. }: Valid<ComponentImportanceRequest, ComponentImportanceInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        component_importance::run(req, budget)
+        component_importance::run_valid(&input, budget)
     })
     .await
 }

@@ -204,10 +204,24 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
 #[must_use]
 pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRule])> {
     use crate::calc;
-    vec![(
-        "/v1/cam-law/evaluate",
-        calc::cam_law::input::CROSS_FIELD_RULES,
-    )]
+    vec![
+        (
+            "/v1/bus-fuel-economy",
+            calc::bus_fuel_economy::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/bus-fuel-economy/motor-map",
+            calc::bus_fuel_economy::input::MOTOR_MAP_RULES,
+        ),
+        (
+            "/v1/cam-law/evaluate",
+            calc::cam_law::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/component-importance",
+            calc::component_importance::input::CROSS_FIELD_RULES,
+        ),
+    ]
 }
 
 /// The document as utoipa generates it, before [`openapi::document`] completes it.

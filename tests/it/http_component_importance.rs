@@ -110,6 +110,20 @@ async fn wrong_type_and_unknown_field_are_422_with_pointers() {
 
 #[tokio::test]
 async fn every_bad_field_is_listed() {
+    // Per-field rules (the door): every offending field in one 422.
+    let mut b = machining_center();
+    b["times_h"][0] = json!(-1.0);
+    b["components"][1]["weibull"]["beta"] = json!(25.0);
+    b["overrides"][1]["F"]["S"] = json!(1.5);
+    let r = post_json(PATH, &b).await;
+    r.invalid_input_at(&[
+        "/times_h/0",
+        "/components/1/weibull/beta",
+        "/overrides/1/F/S",
+    ]);
+
+    // Rules between fields (after the door): every offending field in one 422, each issue with
+    // its rule's code.
     let mut b = machining_center();
     b["edges"]
         .as_array_mut()
@@ -120,18 +134,198 @@ async fn every_bad_field_is_listed() {
         .expect("edges")
         .push(json!(["S", "X"]));
     b["options"]["q_in"] = json!(0.3);
-    b["times_h"][0] = json!(-1.0);
-    b["components"][1]["weibull"]["beta"] = json!(25.0);
-    b["overrides"][1]["F"]["S"] = json!(1.5);
     let r = post_json(PATH, &b).await;
-    r.invalid_input_at(&[
-        "/edges/16",
-        "/edges/17/1",
-        "/options/o_out",
-        "/times_h/0",
-        "/components/1/weibull/beta",
-        "/overrides/1/F/S",
-    ]);
+    let p = r.problem(422);
+    assert_eq!(p["type"], "/problems/invalid-input");
+    assert_eq!(r.pointers(), ["/edges/16", "/edges/17/1", "/options/o_out"]);
+    let details: Vec<&str> = p["errors"]
+        .as_array()
+        .expect("errors")
+        .iter()
+        .filter_map(|e| e["detail"].as_str())
+        .collect();
+    for (d, code) in details
+        .iter()
+        .zip(["SELF_LOOP", "UNKNOWN_COMPONENT_ID", "Q_PLUS_O"])
+    {
+        assert!(d.starts_with(&format!("{code}: ")), "{d}");
+    }
+}
+
+/// The document's `x-cross-field-rules` of this operation: their codes.
+fn documented_rule_codes() -> Vec<String> {
+    let doc = serde_json::to_value(mechcalc::http::openapi()).expect("openapi");
+    let rules = doc
+        .pointer("/paths/~1v1~1component-importance/post/x-cross-field-rules")
+        .and_then(Value::as_array)
+        .expect("x-cross-field-rules");
+    rules
+        .iter()
+        .map(|r| r["code"].as_str().expect("code").to_owned())
+        .collect()
+}
+
+/// Each rule between fields the operation lists is reachable: a request that passes every
+/// per-field rule and breaks that one rule gets a 422 with the rule's code at the rule's pointer.
+#[tokio::test]
+async fn every_cross_field_rule_is_reachable() {
+    type Edit = fn(&mut Value);
+    let cases: [(&str, &str, Edit); 12] = [
+        ("DUPLICATE_ID", "/components/10/id", |b| {
+            b["components"].as_array_mut().expect("components").push(
+                json!({"id": "S", "weibull": {"eta_h": 1000.0, "beta": 1.0}, "mode_sum": 0.2}),
+            );
+        }),
+        ("UNKNOWN_COMPONENT_ID", "/overrides/0/F/X", |b| {
+            b["overrides"][0]["F"]["X"] = json!(0.5);
+        }),
+        ("SELF_LOOP", "/edges/16", |b| {
+            b["edges"]
+                .as_array_mut()
+                .expect("edges")
+                .push(json!(["K", "K"]));
+        }),
+        ("DUPLICATE_EDGE", "/edges/16", |b| {
+            b["edges"]
+                .as_array_mut()
+                .expect("edges")
+                .push(json!(["S", "M"]));
+        }),
+        ("OVERRIDE_TIME", "/overrides/1/time_h", |b| {
+            b["overrides"][1]["time_h"] = json!(500.0);
+        }),
+        ("WEIBULL_REQUIRED", "/components/2/weibull", |b| {
+            b["components"][2]
+                .as_object_mut()
+                .expect("component")
+                .remove("weibull");
+        }),
+        ("MODE_DATA_REQUIRED", "/components/2/failure_modes", |b| {
+            b["components"][2]
+                .as_object_mut()
+                .expect("component")
+                .remove("failure_modes");
+        }),
+        ("MODE_DATA_CONFLICT", "/components/2/mode_sum", |b| {
+            b["components"][2]["mode_sum"] = json!(0.2);
+        }),
+        ("MODE_SUM_OVERFLOW", "/components/2/failure_modes", |b| {
+            b["components"][2]["failure_modes"] =
+                json!([{"alpha": 1.0, "impact": 1e308}, {"alpha": 1.0, "impact": 1e308}]);
+        }),
+        ("Q_PLUS_O", "/options/o_out", |b| {
+            b["options"]["o_out"] = json!(0.7);
+        }),
+        ("WEIGHT_SUM", "/options/constant_weights/subjective", |b| {
+            b["options"]["constant_weights"] =
+                json!({"subjective": [0.5, 0.6], "entropy_at_h": 500});
+        }),
+        (
+            "ENTROPY_TIME",
+            "/options/constant_weights/entropy_at_h",
+            |b| {
+                b["options"]["constant_weights"] =
+                    json!({"subjective": [0.5, 0.5], "entropy_at_h": 1000});
+            },
+        ),
+    ];
+    for (code, pointer, edit) in cases {
+        let mut b = machining_center();
+        edit(&mut b);
+        let r = post_json(PATH, &b).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], code, "{p}");
+        assert_eq!(r.pointers(), [pointer], "{code}: {p}");
+    }
+    // Every listed code is one of these, or a failure of the computation that the tests above
+    // reach (budgets, hazard rate) or a backstop (non-finite result, answer size).
+    let computed = [
+        "SIMPLE_PATH_BUDGET_EXCEEDED",
+        "PROPAGATION_PATH_BUDGET_EXCEEDED",
+        "BUDGET_EXHAUSTED",
+        "HAZARD_RATE_OVERFLOW",
+        "NUMERICAL_FAILURE",
+        "RESPONSE_TOO_LARGE",
+    ];
+    let mut want: Vec<String> = cases
+        .iter()
+        .map(|c| c.0)
+        .chain(computed)
+        .map(str::to_owned)
+        .collect();
+    want.sort();
+    let mut got = documented_rule_codes();
+    got.sort();
+    assert_eq!(got, want);
+}
+
+/// `null` for an optional field is the same as leaving it out, at every depth: the example with
+/// every optional field it omits set to `null` gets the example's answer, and `null` for an
+/// optional object it gives gets the answer of that object's defaults.
+#[tokio::test]
+async fn null_means_absent() {
+    let answer = |r: &common::Reply| {
+        assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+        let mut v = r.json();
+        v["meta"]
+            .as_object_mut()
+            .expect("meta")
+            .retain(|k, _| k != "elapsed_ms" && k != "report");
+        v
+    };
+    let plain = answer(&post_json(PATH, &machining_center()).await);
+    let mut b = machining_center();
+    b["time_limit_ms"] = Value::Null;
+    b["options"]["max_simple_paths"] = Value::Null;
+    for c in b["components"].as_array_mut().expect("components") {
+        for k in ["mode_sum", "efficiency_override", "level_override"] {
+            c.as_object_mut()
+                .expect("component")
+                .entry(k)
+                .or_insert(Value::Null);
+        }
+    }
+    for o in b["overrides"].as_array_mut().expect("overrides") {
+        o["RI"] = Value::Null;
+    }
+    assert_eq!(answer(&post_json(PATH, &b).await), plain);
+
+    // Every option and output given as null = every one absent = the defaults; and null for the
+    // top-level optional members is the same as leaving them out.
+    let mut nulls = machining_center();
+    for k in [
+        "q_in",
+        "o_out",
+        "constant_weights",
+        "path_cap",
+        "path_method",
+        "levels",
+        "betweenness",
+    ] {
+        nulls["options"][k] = Value::Null;
+    }
+    for k in ["matrices", "indices", "reliability", "centralities"] {
+        nulls["outputs"][k] = Value::Null;
+    }
+    let mut absent = machining_center();
+    absent["options"] = json!({});
+    absent["outputs"] = json!({});
+    let defaults = answer(&post_json(PATH, &absent).await);
+    assert_eq!(answer(&post_json(PATH, &nulls).await), defaults);
+    // The example's options and outputs are the defaults.
+    assert_eq!(defaults, plain);
+    let mut top = machining_center();
+    for k in ["overrides", "options", "outputs"] {
+        top[k] = Value::Null;
+    }
+    let mut gone = machining_center();
+    for k in ["overrides", "options", "outputs"] {
+        gone.as_object_mut().expect("request").remove(k);
+    }
+    assert_eq!(
+        answer(&post_json(PATH, &top).await),
+        answer(&post_json(PATH, &gone).await)
+    );
 }
 
 #[tokio::test]

@@ -298,8 +298,8 @@ fn vc1_he_with_computed_efficiency() {
 fn vc1_printed_eq22_explained() {
     let mut r = paper_request();
     r.outputs.matrices = true;
-    r.options.q_in = 0.30;
-    r.options.o_out = 0.70;
+    r.options.q_in = Some(0.30);
+    r.options.o_out = Some(0.70);
     let he = edge_map(&run_ok(r).matrices.unwrap().he);
     let printed_offdiag = [
         ("S>M", 0.076_057),
@@ -698,7 +698,7 @@ fn vc4_paper_inputs_reference() {
     close("tail bound 2000 h", tb[1], 1.20e-4, 5e-3, 0.0);
     // The graph's longest path has 3 edges: K = 3 is exact here (K = 8 gives the same numbers).
     let mut r = paper_request();
-    r.options.path_cap = 8;
+    r.options.path_cap = Some(8);
     let k8 = run_ok(r);
     for (a, b) in out.results.iter().zip(&k8.results) {
         close_all("CI K=8 vs K=3", &b.ci, &a.ci, 1e-14, 1e-16);
@@ -873,7 +873,7 @@ fn truncation_error_vs_infinite_sum_paper_graph() {
     // The reported bound holds: actual relative error ≤ ρ^K/(1−ρ).
     for k in 1..=3u32 {
         let mut r = clean_request();
-        r.options.path_cap = k;
+        r.options.path_cap = Some(k);
         let bound = run_ok(r).results[0]
             .tail_bound
             .clone()

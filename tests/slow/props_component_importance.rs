@@ -112,7 +112,7 @@ fn request(c: &Case) -> ComponentImportanceRequest {
         times_h: c.times.clone(),
         overrides: Vec::new(),
         options: Options {
-            max_simple_paths: 1e8,
+            max_simple_paths: Some(1e8),
             ..Options::default()
         },
         outputs: Outputs {

@@ -311,7 +311,7 @@ fn stop_only_cycle_is_rejected() {
     let c = json!({"name": "stops", "time_s": [0, 1, 2, 3], "speed_kmh": [0, 0, 0, 0]});
     expect_failure(
         json!({"cycles": [c], "motors": [demo_ipmsm()]}),
-        "INVALID_INPUT",
+        "ZERO_DISTANCE",
         "/cycles/0",
     );
 }
@@ -405,7 +405,7 @@ fn tiny_steps_and_jumps_stay_finite() {
     let c = json!({"name": "c", "time_s": [0.0, 1e-300], "speed_mps": [0.0, 1.0]});
     expect_failure(
         json!({"cycles": [c], "motors": [demo_ipmsm()]}),
-        "INVALID_INPUT",
+        "TIME_STEP",
         "/cycles/0/time_s/1",
     );
     expect_failure(
@@ -470,39 +470,55 @@ fn degenerate_maps() {
             "/motors/0/n_max_rpm",
         ),
     ];
-    for (m, ptr) in bad {
-        expect_failure(
-            json!({"cycles": ["hwfet"], "motors": [m]}),
-            "INVALID_INPUT",
-            ptr,
-        );
+    // Values out of range are refused at the door; the rest are rules between fields.
+    let codes = [
+        "INVALID_INPUT",
+        "INVALID_INPUT",
+        "AXIS_ORDER",
+        "LOSS_AXIS_ZERO",
+        "LENGTH_MISMATCH",
+        "CYCLE_ABOVE_MOTOR_SPEED",
+    ];
+    for ((m, ptr), code) in bad.into_iter().zip(codes) {
+        expect_failure(json!({"cycles": ["hwfet"], "motors": [m]}), code, ptr);
     }
 }
 
 #[test]
 fn every_invalid_field_is_reported() {
+    // Per-field rules (the door): every offending field in one failure.
     let req: BusFuelEconomyRequest = serde_json::from_value(json!({
         "vehicle": {"curb_mass_kg": -1, "gear_efficiency": 0, "grade": 0.5},
         "inverter": {"efficiency": 1.5},
-        "cycles": ["nowhere", {"name": "c", "time_s": [0, 2, 1], "speed_kmh": [0, 10, 0]}],
-        "motors": [{"id": "x", "model": "ipmsm", "pole_pairs": 0, "psi_m_wb": 0.2, "ld_h": 0.001, "lq_h": 0.0005,
+        "cycles": ["hwfet"],
+        "motors": [{"id": "x", "model": "ipmsm", "pole_pairs": 0, "psi_m_wb": 0.2, "ld_h": 0.001, "lq_h": 0.0015,
                     "r_phase_20c_ohm": 0.01, "i_max_arms": 100, "v_dc": 400, "n_max_rpm": 6000}],
         "options": {"substeps": 33}
     }))
     .expect("decodes");
     let f = run(req, &Budget::unlimited()).expect_err("invalid");
+    assert_eq!(f.code, "INVALID_INPUT", "{f}");
     let ptrs: Vec<&str> = f.errors.iter().map(|e| e.pointer.as_str()).collect();
     for p in [
         "/vehicle/curb_mass_kg",
         "/vehicle/gear_efficiency",
         "/vehicle/grade",
         "/inverter/efficiency",
-        "/cycles/0",
-        "/cycles/1/time_s/2",
         "/motors/0/pole_pairs",
-        "/motors/0/lq_h",
         "/options/substeps",
     ] {
+        assert!(ptrs.contains(&p), "missing {p} in {ptrs:?}");
+    }
+    // Rules between fields (after the door): every offending field in one failure.
+    let req: BusFuelEconomyRequest = serde_json::from_value(json!({
+        "cycles": ["nowhere", {"name": "c", "time_s": [0, 2, 1], "speed_kmh": [0, 10, 0]}],
+        "motors": [{"id": "x", "model": "ipmsm", "pole_pairs": 4, "psi_m_wb": 0.2, "ld_h": 0.001, "lq_h": 0.0005,
+                    "r_phase_20c_ohm": 0.01, "i_max_arms": 100, "v_dc": 400, "n_max_rpm": 6000}]
+    }))
+    .expect("decodes");
+    let f = run(req, &Budget::unlimited()).expect_err("invalid");
+    let ptrs: Vec<&str> = f.errors.iter().map(|e| e.pointer.as_str()).collect();
+    for p in ["/cycles/0", "/cycles/1/time_s/2", "/motors/0/lq_h"] {
         assert!(ptrs.contains(&p), "missing {p} in {ptrs:?}");
     }
 }

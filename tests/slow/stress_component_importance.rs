@@ -260,18 +260,15 @@ fn rejects_reliability_and_time_errors() {
 
 #[test]
 fn rejects_override_errors() {
+    // Values out of range are refused at the door (all of them at once), unknown ids after it.
     let mut r = paper();
     r.overrides[0].f.insert("S".into(), 1.2);
-    r.overrides[0].f.insert("a/b".into(), 0.1);
     r.overrides[1].ri.insert("NC".into(), -1e-6);
-    rejects_at_all(
-        r,
-        &[
-            "/overrides/0/F/S",
-            "/overrides/0/F/a~1b",
-            "/overrides/1/RI/NC",
-        ],
-    );
+    rejects_at_all(r, &["/overrides/0/F/S", "/overrides/1/RI/NC"]);
+    let mut r = paper();
+    r.overrides[0].f.insert("a/b".into(), 0.1);
+    let e = rejects_at(r, "/overrides/0/F/a~1b");
+    assert_eq!(e.code, "UNKNOWN_COMPONENT_ID");
     let mut r = paper();
     r.overrides[1].time_h = 1999.0;
     rejects_at(r, "/overrides/1/time_h");
@@ -291,12 +288,12 @@ fn rejects_override_errors() {
 #[test]
 fn rejects_option_errors() {
     let mut r = paper();
-    r.options.q_in = 0.3;
+    r.options.q_in = Some(0.3);
     let e = rejects_at(r, "/options/o_out");
     assert!(e.to_string().contains("Q + O must equal 1"), "{e}");
     let mut r = paper();
-    r.options.q_in = 1.2;
-    r.options.o_out = -0.2;
+    r.options.q_in = Some(1.2);
+    r.options.o_out = Some(-0.2);
     rejects_at_all(r, &["/options/q_in", "/options/o_out"]);
     let mut r = paper();
     r.options.constant_weights = ConstantWeights::Fixed(vec![0.6, 0.5]);
@@ -315,12 +312,12 @@ fn rejects_option_errors() {
     rejects_at(r, "/options/constant_weights/entropy_at_h");
     for k in [0, 9] {
         let mut r = paper();
-        r.options.path_cap = k;
+        r.options.path_cap = Some(k);
         rejects_at(r, "/options/path_cap");
     }
     for m in [999.0, 1.000_000_1e8] {
         let mut r = paper();
-        r.options.max_simple_paths = m;
+        r.options.max_simple_paths = Some(m);
         rejects_at(r, "/options/max_simple_paths");
     }
 }
@@ -571,7 +568,7 @@ fn cyclic_enumeration_budget() {
     assert_eq!(e.errors[0].pointer, "/options/betweenness");
 
     let mut r2 = r.clone();
-    r2.options.max_simple_paths = 1e7;
+    r2.options.max_simple_paths = Some(1e7);
     let out = ok(r2);
     assert_eq!(out.meta.simple_paths_enumerated, 2 * 9_864_090);
 
@@ -589,13 +586,13 @@ fn cyclic_enumeration_budget() {
 fn cyclic_propagation_budget() {
     let mut r = graph_request(30, &complete_edges(30));
     r.options.betweenness = BetweennessMode::ShortestPaths;
-    r.options.path_cap = 5;
+    r.options.path_cap = Some(5);
     let e = err(r.clone());
     assert_eq!(e.code, "PROPAGATION_PATH_BUDGET_EXCEEDED");
     assert!(e.detail.contains("\"walks\""), "{e}");
     // K = 3 uses the exact closed form, walks the upper bound.
     let mut r3 = r.clone();
-    r3.options.path_cap = 3;
+    r3.options.path_cap = Some(3);
     let exact = ok(r3.clone());
     r3.options.path_method = PathMethod::Walks;
     let walks = ok(r3);
@@ -606,7 +603,7 @@ fn cyclic_propagation_budget() {
     );
     assert!(a.iter().zip(b).all(|(x, y)| y >= x));
     r.options.path_method = PathMethod::Walks;
-    r.options.path_cap = 8;
+    r.options.path_cap = Some(8);
     ok(r);
 }
 
@@ -716,7 +713,7 @@ fn random_graphs_never_give_nan() {
         let n = 2 + usize::try_from(seed * 7 % 60).unwrap();
         let d = [0.5, 1.0, 2.0, 3.0, 6.0][usize::try_from(seed % 5).unwrap()];
         let mut r = random_request(n, d, seed % 2 == 0, seed);
-        r.options.path_cap = u32::try_from(1 + seed % 8).unwrap();
+        r.options.path_cap = Some(u32::try_from(1 + seed % 8).unwrap());
         r.options.path_method = if seed % 3 == 0 {
             PathMethod::Walks
         } else {

@@ -1,6 +1,6 @@
 //! Failures of the bus fuel-economy computation (after validation).
 
-use crate::calc::{CalcFailure, ProblemClass};
+use crate::calc::{CalcFailure, CrossRule};
 
 /// Why a validated request could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -50,31 +50,45 @@ pub enum BusFuelEconomyError {
     },
 }
 
+/// The simulation finishes within the request's time budget.
+pub const DEADLINE_RULE: CrossRule = CrossRule::too_large(
+    "DEADLINE_EXCEEDED",
+    &["/time_limit_ms"],
+    "The simulation finishes within the request's time_limit_ms (capped by the service).",
+);
+/// Every ipmsm produces torque at every speed a cycle needs.
+pub const SPEED_UNREACHABLE_RULE: CrossRule = CrossRule::infeasible(
+    "MOTOR_SPEED_UNREACHABLE",
+    &["/motors/*/n_max_rpm", "/cycles"],
+    "Each ipmsm motor has torque left (voltage limit) at the top motor speed of every cycle.",
+);
+/// The operating-point histogram stays within its bin limit.
+pub const HISTOGRAM_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
+    "HISTOGRAM_TOO_LARGE",
+    &["/options/op_histogram"],
+    "The op_histogram's speed × torque bins over the motors' ranges stay within the service's bin limit.",
+);
+/// A motor map stays within its grid-point limit.
+pub const MAP_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
+    "MAP_TOO_LARGE",
+    &["/options/loss_map_grid", "/grid"],
+    "A motor's loss or efficiency map on the grid steps stays within the service's grid-point limit.",
+);
+
 impl From<BusFuelEconomyError> for CalcFailure {
     fn from(e: BusFuelEconomyError) -> Self {
         let detail = e.to_string();
         match e {
-            BusFuelEconomyError::Deadline { .. } => {
-                CalcFailure::general(ProblemClass::TooLarge, "DEADLINE_EXCEEDED", detail)
+            BusFuelEconomyError::Deadline { .. } => DEADLINE_RULE.fail_general(detail),
+            BusFuelEconomyError::SpeedUnreachable { motor_index, .. } => {
+                SPEED_UNREACHABLE_RULE.fail(format!("/motors/{motor_index}/n_max_rpm"), detail)
             }
-            BusFuelEconomyError::SpeedUnreachable { motor_index, .. } => CalcFailure::field(
-                ProblemClass::Infeasible,
-                "MOTOR_SPEED_UNREACHABLE",
-                format!("/motors/{motor_index}/n_max_rpm"),
-                detail,
-            ),
-            BusFuelEconomyError::HistogramTooLarge { .. } => CalcFailure::field(
-                ProblemClass::TooLarge,
-                "HISTOGRAM_TOO_LARGE",
-                "/options/op_histogram",
-                detail,
-            ),
-            BusFuelEconomyError::MapTooLarge { .. } => CalcFailure::field(
-                ProblemClass::TooLarge,
-                "MAP_TOO_LARGE",
-                "/options/loss_map_grid",
-                detail,
-            ),
+            BusFuelEconomyError::HistogramTooLarge { .. } => {
+                HISTOGRAM_TOO_LARGE_RULE.fail("/options/op_histogram", detail)
+            }
+            BusFuelEconomyError::MapTooLarge { .. } => {
+                MAP_TOO_LARGE_RULE.fail("/options/loss_map_grid", detail)
+            }
         }
     }
 }

@@ -1,8 +1,15 @@
-//! Validation of the wire request into SI domain inputs (spec §3, §3.7), collecting every issue.
+//! The rules between fields of the wire requests (spec §3, §3.7), turning them into SI domain
+//! inputs. Every per-field rule (counts, name lengths, ranges of every number and table value,
+//! exactly one of `speed_kmh`/`speed_mps` and of `psi_m_wb`/`back_emf`) is declared on the wire
+//! types and checked at the door; what is left here is what JSON Schema cannot state, each rule
+//! with its own code ([`CROSS_FIELD_RULES`], [`MOTOR_MAP_RULES`]).
 
 use super::ac_factor::{AcFactor, Dowell};
 use super::battery::{Battery, Ecm};
 use super::cycles::{self, Cycle};
+use super::error::{
+    DEADLINE_RULE, HISTOGRAM_TOO_LARGE_RULE, MAP_TOO_LARGE_RULE, SPEED_UNREACHABLE_RULE,
+};
 use super::ipmsm::{Ipmsm, IpmsmParams, psi_from_back_emf, rpm_to_rad_s};
 use super::maps::{Envelope, Grid2, efficiency_to_loss};
 use super::motor::{MotorInput, MotorKind};
@@ -10,17 +17,179 @@ use super::sim::{Mode, PowerConvention, Vehicle};
 use super::wire as w;
 use super::wire::{
     AcFactorSpec, BatteryModel, BatterySpec, BusFuelEconomyRequest, CycleSpec, EfficiencyMapMotor,
-    EnvelopeTable, GridSpec, IpmsmMotor, LossMapMotor, MotorSpec, OptionsSpec, OutputKind,
+    EnvelopeTable, GridSpec, IpmsmMotor, LossMapMotor, MotorMapRequest, MotorSpec, OutputKind,
     VehicleSpec,
 };
-use crate::calc::{CalcFailure, ProblemClass, Range, Validator};
+pub use super::wire::{MAX_CYCLE_SAMPLES, MAX_CYCLES, MAX_MOTORS};
+use crate::calc::common::{RESPONSE_TOO_LARGE_RULE, SHARD_INDEX_BELOW_COUNT};
+use crate::calc::{CalcFailure, CrossRule, Validator};
 
-/// Most motors per request (spec §3.5).
-pub const MAX_MOTORS: usize = 8;
-/// Most cycles per request (spec §3.4).
-pub const MAX_CYCLES: usize = 16;
-/// Most samples of one custom cycle (spec §3.4).
-pub const MAX_CYCLE_SAMPLES: usize = 200_000;
+/// Model fields of the other battery model are absent.
+pub const BATTERY_MODEL_FIELDS: CrossRule = CrossRule::invalid(
+    "BATTERY_MODEL_FIELDS",
+    &["/battery/model", "/battery/*"],
+    "A battery gives only the fields of its model: efficiency for constant; nominal_voltage, \
+     capacity_kwh, soc_initial, ocv_soc, ocv_v, r0_ohm, r1_ohm, c1_f, r2_ohm, c2_f for ecm_2rc.",
+);
+/// The ecm_2rc model's required fields are given.
+pub const BATTERY_ECM_REQUIRED: CrossRule = CrossRule::invalid(
+    "BATTERY_ECM_REQUIRED",
+    &["/battery/model", "/battery/*"],
+    "With model ecm_2rc, soc_initial, ocv_soc, ocv_v, r0_ohm, r1_ohm, c1_f, r2_ohm and c2_f are given.",
+);
+/// Axes strictly increase.
+pub const AXIS_ORDER: CrossRule = CrossRule::invalid(
+    "AXIS_ORDER",
+    &[
+        "/battery/ocv_soc",
+        "/cycles/*/time_s",
+        "/motors/*/speed_rpm",
+        "/motors/*/torque_nm",
+        "/motors/*/envelope/speed_rpm",
+        "/motors/*/ac_factor/freq_hz",
+    ],
+    "Every axis (OCV SOC points, cycle times, map and envelope speeds and torques, k_AC \
+     frequencies) is strictly increasing.",
+);
+/// Paired lists and tables have matching lengths.
+pub const LENGTH_MISMATCH: CrossRule = CrossRule::invalid(
+    "LENGTH_MISMATCH",
+    &[
+        "/battery/ocv_v",
+        "/cycles/*/speed_kmh",
+        "/cycles/*/speed_mps",
+        "/cycles/*/grade",
+        "/motors/*/envelope/t_max_nm",
+        "/motors/*/ac_factor/k_ac",
+        "/motors/*/efficiency",
+        "/motors/*/efficiency_gen",
+        "/motors/*/loss_w",
+        "/options/desirability_weights",
+    ],
+    "Paired lists have the length of their axis (ocv_v ~ ocv_soc, speeds and grade ~ time_s, \
+     t_max_nm ~ speed_rpm, k_ac ~ freq_hz), map tables are speed_rpm × torque_nm, and \
+     desirability_weights hold one weight per cycle.",
+);
+/// A custom cycle's time steps lie in [1e-3, 60] s.
+pub const TIME_STEP: CrossRule = CrossRule::invalid(
+    "TIME_STEP",
+    &["/cycles/*/time_s"],
+    "Each time step of a custom cycle lies in [0.001, 60] s.",
+);
+/// A built-in cycle name is known.
+pub const UNKNOWN_CYCLE: CrossRule = CrossRule::invalid(
+    "UNKNOWN_CYCLE",
+    &["/cycles/*"],
+    "A built-in cycle is one of manhattan, hwfet, hdudds.",
+);
+/// A cycle drives some distance.
+pub const ZERO_DISTANCE: CrossRule = CrossRule::invalid(
+    "ZERO_DISTANCE",
+    &["/cycles/*"],
+    "Every cycle drives a positive distance (fuel economy is undefined otherwise).",
+);
+/// Cycle names and motor ids are unique.
+pub const DUPLICATE_NAME: CrossRule = CrossRule::invalid(
+    "DUPLICATE_NAME",
+    &["/cycles/*", "/motors/*/id"],
+    "Cycle names are unique among the cycles, motor ids among the motors.",
+);
+/// A tabulated envelope excludes `t_peak_nm`/`p_peak_w`.
+pub const ENVELOPE_CONFLICT: CrossRule = CrossRule::invalid(
+    "ENVELOPE_CONFLICT",
+    &[
+        "/motors/*/envelope",
+        "/motors/*/t_peak_nm",
+        "/motors/*/p_peak_w",
+    ],
+    "A motor gives either envelope or t_peak_nm/p_peak_w, not both.",
+);
+/// The ψ_m implied by a back-EMF measurement lies in its range.
+pub const BACK_EMF_PSI: CrossRule = CrossRule::invalid(
+    "BACK_EMF_PSI",
+    &["/motors/*/back_emf", "/motors/*/pole_pairs"],
+    "ψ_m = v_peak_phase / (pole_pairs·2π·at_rpm/60) lies in (0, 100] Wb.",
+);
+/// L_q ≥ L_d.
+pub const LQ_BELOW_LD: CrossRule = CrossRule::invalid(
+    "LQ_BELOW_LD",
+    &["/motors/*/lq_h", "/motors/*/ld_h"],
+    "An ipmsm has lq_h ≥ ld_h (reluctance torque; MTPA assumes L_q ≥ L_d).",
+);
+/// `stack_scale` needs the Dowell AC model.
+pub const STACK_SCALE_DOWELL: CrossRule = CrossRule::invalid(
+    "STACK_SCALE_NEEDS_DOWELL",
+    &["/motors/*/stack_scale", "/motors/*/ac_factor"],
+    "stack_scale is given only with ac_factor model dowell (its stack/end lengths split the resistance).",
+);
+/// A loss map's signed torque axis contains 0.
+pub const LOSS_AXIS_ZERO: CrossRule = CrossRule::invalid(
+    "LOSS_AXIS_ZERO",
+    &["/motors/*/torque_nm"],
+    "A loss_map motor's signed torque axis contains 0.",
+);
+/// The desirability weights are not all zero.
+pub const DESIRABILITY_ZERO: CrossRule = CrossRule::invalid(
+    "DESIRABILITY_ZERO",
+    &["/options/desirability_weights"],
+    "The desirability weights are not all 0.",
+);
+/// Every cycle's top speed is within every motor's speed limit.
+pub const CYCLE_ABOVE_MOTOR_SPEED: CrossRule = CrossRule::invalid(
+    "CYCLE_ABOVE_MOTOR_SPEED",
+    &["/motors/*/n_max_rpm", "/cycles", "/vehicle"],
+    "The motor speed at every cycle's top speed (through wheel radius and gear ratio) is within \
+     each motor's n_max_rpm (for maps, also their last speed_rpm).",
+);
+/// The simulated intervals stay within the service limit.
+pub const TOO_MANY_SAMPLES: CrossRule = CrossRule::too_large(
+    "TOO_MANY_SAMPLES",
+    &["/options/substeps", "/cycles"],
+    "The intervals of all cycles after sub-stepping number at most 1 000 000.",
+);
+
+/// The rules between fields of `POST /v1/bus-fuel-economy` and the failures of its computation,
+/// as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    BATTERY_MODEL_FIELDS,
+    BATTERY_ECM_REQUIRED,
+    AXIS_ORDER,
+    LENGTH_MISMATCH,
+    TIME_STEP,
+    UNKNOWN_CYCLE,
+    ZERO_DISTANCE,
+    DUPLICATE_NAME,
+    ENVELOPE_CONFLICT,
+    BACK_EMF_PSI,
+    LQ_BELOW_LD,
+    STACK_SCALE_DOWELL,
+    LOSS_AXIS_ZERO,
+    DESIRABILITY_ZERO,
+    CYCLE_ABOVE_MOTOR_SPEED,
+    TOO_MANY_SAMPLES,
+    SHARD_INDEX_BELOW_COUNT,
+    DEADLINE_RULE,
+    SPEED_UNREACHABLE_RULE,
+    HISTOGRAM_TOO_LARGE_RULE,
+    MAP_TOO_LARGE_RULE,
+    RESPONSE_TOO_LARGE_RULE,
+];
+
+/// The rules between fields of `POST /v1/bus-fuel-economy/motor-map` and the failures of its
+/// computation, as the document lists them (the motor's rules apply to `/motor/...` here).
+pub const MOTOR_MAP_RULES: &[CrossRule] = &[
+    AXIS_ORDER,
+    LENGTH_MISMATCH,
+    ENVELOPE_CONFLICT,
+    BACK_EMF_PSI,
+    LQ_BELOW_LD,
+    STACK_SCALE_DOWELL,
+    LOSS_AXIS_ZERO,
+    DEADLINE_RULE,
+    MAP_TOO_LARGE_RULE,
+    RESPONSE_TOO_LARGE_RULE,
+];
+
 /// Most intervals over all cycles after sub-stepping (spec §3.7, §8 item 10).
 pub const MAX_TOTAL_INTERVALS: usize = 1_000_000;
 /// Largest custom-cycle time step \[s\] (spec §3.4).
@@ -41,8 +210,6 @@ pub const MAX_SPEED_MPS: f64 = w::SPEED_MPS.hi;
 pub const MAX_TIME_S: f64 = w::TIME_S.hi;
 /// Relative slack of the cycle-speed vs n_max check (rounding of the rpm conversion).
 const SPEED_CHECK_SLACK: f64 = 1e-12;
-/// Longest id / cycle name.
-const MAX_NAME_LEN: usize = 64;
 
 /// Default envelope of constant / map motors (spec §3.5).
 const DEFAULT_T_PEAK: f64 = 800.0;
@@ -138,60 +305,45 @@ pub struct BusFuelEconomyInput {
     pub shard: Option<crate::calc::common::Shard>,
 }
 
-/// Strictly increasing, finite, ≥ `min_len` points, each in `range` (the first checked against
-/// its lower end, then the order, then every point).
-fn axis(v: &mut Validator, ptr: &str, xs: &[f64], min_len: usize, range: Range) -> bool {
-    if xs.len() < min_len {
-        v.push(
-            ptr,
-            format!("needs at least {min_len} points, got {}", xs.len()),
-        );
-        return false;
-    }
-    if !v.all_finite(ptr, xs) {
-        return false;
-    }
-    if xs[0] < range.lo {
-        v.push(
-            format!("{ptr}/0"),
-            format!("must be ≥ {}, got {}", range.lo, xs[0]),
-        );
-        return false;
-    }
-    if let Some(i) = (1..xs.len()).find(|&i| xs[i] <= xs[i - 1]) {
-        v.push(
-            format!("{ptr}/{i}"),
-            format!(
-                "axis must be strictly increasing: {} after {}",
-                xs[i],
-                xs[i - 1]
-            ),
-        );
-        return false;
-    }
-    v.all_in(ptr, "", xs, range)
+/// An axis strictly increases (its count and range are checked at the door).
+fn axis(v: &mut Validator, ptr: &str, xs: &[f64]) -> bool {
+    let Some(i) = (1..xs.len()).find(|&i| xs[i] <= xs[i - 1]) else {
+        return true;
+    };
+    v.rule(
+        &AXIS_ORDER,
+        format!("{ptr}/{i}"),
+        format!(
+            "axis must be strictly increasing: {} after {}",
+            xs[i],
+            xs[i - 1]
+        ),
+    );
+    false
 }
 
-/// A table `[rows][cols]` of values in `range`.
-fn table(
-    v: &mut Validator,
-    ptr: &str,
-    t: &[Vec<f64>],
-    (rows, cols): (usize, usize),
-    range: Range,
-) -> bool {
+/// A list `ys` at `ptr` has the length of its axis `xs` (named `axis`).
+fn same_length(v: &mut Validator, ptr: &str, ys: &[f64], n: usize, axis: &str) -> bool {
+    v.ensure_rule(ys.len() == n, &LENGTH_MISMATCH, ptr, || {
+        format!("must have {n} values like {axis}, got {}", ys.len())
+    })
+}
+
+/// A table `[rows][cols]` (its values are checked at the door).
+fn table(v: &mut Validator, ptr: &str, t: &[Vec<f64>], (rows, cols): (usize, usize)) -> bool {
     if t.len() != rows {
-        v.push(
+        v.rule(
+            &LENGTH_MISMATCH,
             ptr,
             format!("must have {rows} rows (one per speed), got {}", t.len()),
         );
         return false;
     }
     for (i, row) in t.iter().enumerate() {
-        let p = format!("{ptr}/{i}");
         if row.len() != cols {
-            v.push(
-                p,
+            v.rule(
+                &LENGTH_MISMATCH,
+                format!("{ptr}/{i}"),
                 format!(
                     "must have {cols} values (one per torque), got {}",
                     row.len()
@@ -199,51 +351,12 @@ fn table(
             );
             return false;
         }
-        if !v.all_in(&p, "", row, range) {
-            return false;
-        }
     }
     true
 }
 
-fn name_ok(v: &mut Validator, ptr: &str, name: &str, what: &str) {
-    let n = name.chars().count();
-    if n == 0 || n > MAX_NAME_LEN {
-        v.push(
-            ptr,
-            format!("{what} must have 1..{MAX_NAME_LEN} characters, got {n}"),
-        );
-    }
-}
-
-fn vehicle(v: &mut Validator, s: &VehicleSpec) -> Vehicle {
-    let fields = [
-        ("curb_mass_kg", s.curb_mass_kg, w::CURB_MASS_KG),
-        ("passengers", f64::from(s.passengers), w::PASSENGERS),
-        (
-            "mass_per_passenger_kg",
-            s.mass_per_passenger_kg,
-            w::MASS_PER_PASSENGER_KG,
-        ),
-        ("frontal_area_m2", s.frontal_area_m2, w::FRONTAL_AREA_M2),
-        ("drag_coeff", s.drag_coeff, w::DRAG_COEFF),
-        ("rolling_coeff", s.rolling_coeff, w::ROLLING_COEFF),
-        ("air_density", s.air_density, w::AIR_DENSITY),
-        ("gravity", s.gravity, w::GRAVITY),
-        ("wheel_radius_m", s.wheel_radius_m, w::WHEEL_RADIUS_M),
-        ("gear_ratio", s.gear_ratio, w::GEAR_RATIO),
-        ("gear_efficiency", s.gear_efficiency, w::EFFICIENCY),
-        (
-            "rotational_inertia_factor",
-            s.rotational_inertia_factor,
-            w::FRACTION,
-        ),
-        ("grade", s.grade, w::GRADE),
-        ("aux_power_w", s.aux_power_w, w::AUX_POWER_W),
-    ];
-    for (name, x, range) in fields {
-        v.range(&format!("/vehicle/{name}"), "", x, range);
-    }
+/// The vehicle (every field's range is checked at the door).
+fn vehicle(s: &VehicleSpec) -> Vehicle {
     let mass = f64::from(s.passengers).mul_add(s.mass_per_passenger_kg, s.curb_mass_kg);
     Vehicle {
         mass,
@@ -275,78 +388,62 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
         BatteryModel::Constant => {
             for (name, present) in ecm_fields {
                 if present {
-                    v.push(
+                    v.rule(
+                        &BATTERY_MODEL_FIELDS,
                         format!("/battery/{name}"),
                         "is an ecm_2rc field; not allowed with model \"constant\"".to_owned(),
                     );
                 }
             }
-            let eta = b.efficiency.unwrap_or(1.0);
-            v.range("/battery/efficiency", "", eta, w::EFFICIENCY);
-            Battery::Constant { eta }
+            Battery::Constant {
+                eta: b.efficiency.unwrap_or(1.0),
+            }
         }
         BatteryModel::Ecm2rc => {
             if b.efficiency.is_some() {
-                v.push(
+                v.rule(
+                    &BATTERY_MODEL_FIELDS,
                     "/battery/efficiency",
                     "is a constant-model field; not allowed with model \"ecm_2rc\"".to_owned(),
                 );
             }
-            // Required field in its range; NaN placeholder when missing.
-            let mut need = |name: &str, x: Option<f64>, range: Range| -> f64 {
-                let ptr = format!("/battery/{name}");
-                match x {
-                    None => {
-                        v.push(ptr, "is required for model \"ecm_2rc\"".to_owned());
-                        f64::NAN
-                    }
-                    Some(x) => {
-                        v.range(&ptr, "", x, range);
-                        x
-                    }
-                }
+            // A required field (its range is checked at the door); NaN placeholder when missing.
+            let mut need = |name: &str, x: Option<f64>| -> f64 {
+                x.unwrap_or_else(|| {
+                    v.rule(
+                        &BATTERY_ECM_REQUIRED,
+                        format!("/battery/{name}"),
+                        "is required for model \"ecm_2rc\"".to_owned(),
+                    );
+                    f64::NAN
+                })
             };
-            let soc0 = need("soc_initial", b.soc_initial, w::SOC_INITIAL);
-            let r0 = need("r0_ohm", b.r0_ohm, w::R0_OHM);
-            let r1 = need("r1_ohm", b.r1_ohm, w::RC_OHM);
-            let c1 = need("c1_f", b.c1_f, w::RC_F);
-            let r2 = need("r2_ohm", b.r2_ohm, w::RC_OHM);
-            let c2 = need("c2_f", b.c2_f, w::RC_F);
+            let soc0 = need("soc_initial", b.soc_initial);
+            let r0 = need("r0_ohm", b.r0_ohm);
+            let r1 = need("r1_ohm", b.r1_ohm);
+            let c1 = need("c1_f", b.c1_f);
+            let r2 = need("r2_ohm", b.r2_ohm);
+            let c2 = need("c2_f", b.c2_f);
             let vn = b.nominal_voltage.unwrap_or(360.0);
             let cap = b.capacity_kwh.unwrap_or(256.0);
-            v.range("/battery/nominal_voltage", "", vn, w::NOMINAL_VOLTAGE);
-            v.range("/battery/capacity_kwh", "", cap, w::CAPACITY_KWH);
             let (soc_t, ocv_t) = match (&b.ocv_soc, &b.ocv_v) {
                 (Some(s), Some(o)) => {
-                    let ok_s = axis(v, "/battery/ocv_soc", s, 2, w::FRACTION);
-                    if ok_s && s.last().is_some_and(|&x| x > 1.0) {
-                        v.push(
-                            "/battery/ocv_soc",
-                            "SOC points must lie in [0, 1]".to_owned(),
-                        );
-                    }
-                    if o.len() != s.len() {
-                        v.push(
-                            "/battery/ocv_v",
-                            format!("must have {} values like ocv_soc, got {}", s.len(), o.len()),
-                        );
-                    } else {
-                        v.all_in("/battery/ocv_v", "", o, w::OCV_V);
-                    }
+                    axis(v, "/battery/ocv_soc", s);
+                    same_length(v, "/battery/ocv_v", o, s.len(), "ocv_soc");
                     (s.clone(), o.clone())
                 }
                 _ => {
-                    if b.ocv_soc.is_none() {
-                        v.push(
-                            "/battery/ocv_soc",
-                            "is required for model \"ecm_2rc\"".to_owned(),
-                        );
-                    }
-                    if b.ocv_v.is_none() {
-                        v.push(
-                            "/battery/ocv_v",
-                            "is required for model \"ecm_2rc\"".to_owned(),
-                        );
+                    for (name, given) in [
+                        ("ocv_soc", b.ocv_soc.is_some()),
+                        ("ocv_v", b.ocv_v.is_some()),
+                    ] {
+                        if !given {
+                            v.rule(
+                                &BATTERY_ECM_REQUIRED,
+                                format!("/battery/{name}"),
+                                "is required for model \"ecm_2rc\"".to_owned(),
+                            );
+                        }
                     }
                     (Vec::new(), Vec::new())
                 }
@@ -372,7 +469,8 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
         CycleSpec::Builtin(name) => {
             let cy = cycles::builtin(name);
             if cy.is_none() {
-                v.push(
+                v.rule(
+                    &UNKNOWN_CYCLE,
                     &base,
                     format!("unknown built-in cycle '{name}' (known: manhattan, hwfet, hdudds)"),
                 );
@@ -380,103 +478,38 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
             cy
         }
         CycleSpec::Custom(cc) => {
-            name_ok(v, &format!("{base}/name"), &cc.name, "cycle name");
+            // Sample count, ranges and exactly one of the speed lists: checked at the door.
             let n = cc.time_s.len();
-            let mut ok = true;
-            if !(2..=MAX_CYCLE_SAMPLES).contains(&n) {
-                v.push(
-                    format!("{base}/time_s"),
-                    format!("must have 2..{MAX_CYCLE_SAMPLES} samples, got {n}"),
-                );
-                ok = false;
-            }
             let (speeds, sp_ptr, factor) = match (&cc.speed_kmh, &cc.speed_mps) {
                 (Some(s), None) => (s, format!("{base}/speed_kmh"), 1.0 / 3.6),
                 (None, Some(s)) => (s, format!("{base}/speed_mps"), 1.0),
-                (Some(_), Some(_)) => {
-                    v.push(
-                        &base,
-                        "give exactly one of speed_kmh and speed_mps, not both".to_owned(),
-                    );
-                    return None;
-                }
-                (None, None) => {
-                    v.push(&base, "needs speed_kmh or speed_mps".to_owned());
-                    return None;
-                }
+                _ => return None,
             };
-            if speeds.len() != n {
-                v.push(
-                    &sp_ptr,
-                    format!("must have {n} samples like time_s, got {}", speeds.len()),
-                );
-                ok = false;
-            }
+            let mut ok = same_length(v, &sp_ptr, speeds, n, "time_s");
             let tp = format!("{base}/time_s");
-            ok &= v.all_finite(&tp, &cc.time_s);
-            ok &= v.all_finite(&sp_ptr, speeds);
-            if !ok {
-                return None;
-            }
-            if let Some(i) = cc.time_s.iter().position(|&t| !w::TIME_S.contains(t)) {
-                v.push(
-                    format!("{tp}/{i}"),
-                    format!("|time| must be ≤ {MAX_TIME_S} s, got {}", cc.time_s[i]),
-                );
-                ok = false;
-            }
-            if let Some(i) = (1..n).find(|&i| cc.time_s[i] <= cc.time_s[i - 1]) {
-                v.push(
-                    format!("{tp}/{i}"),
-                    format!(
-                        "time must be strictly increasing: {} after {}",
-                        cc.time_s[i],
-                        cc.time_s[i - 1]
-                    ),
-                );
-                ok = false;
-            } else if let Some(i) = (1..n).find(|&i| {
-                let dt = cc.time_s[i] - cc.time_s[i - 1];
-                // 1e-6 relative slack: 10.001 − 10.0 is 0.000999999… in binary.
-                !(MIN_TIME_STEP_S * (1.0 - 1e-6)..=MAX_TIME_STEP_S).contains(&dt)
-            }) {
-                v.push(
-                    format!("{tp}/{i}"),
-                    format!(
-                        "time step must be in [{MIN_TIME_STEP_S}, {MAX_TIME_STEP_S}] s, got {} s",
-                        cc.time_s[i] - cc.time_s[i - 1]
-                    ),
-                );
-                ok = false;
-            }
-            let mps: Vec<f64> = speeds.iter().map(|s| s * factor).collect();
-            if let Some(i) = mps.iter().position(|&s| !w::SPEED_MPS.contains(s)) {
-                v.push(
-                    format!("{sp_ptr}/{i}"),
-                    format!(
-                        "speed must be in [0, {MAX_SPEED_MPS}] m/s, got {} m/s",
-                        mps[i]
-                    ),
-                );
-                ok = false;
-            }
-            if let Some(g) = &cc.grade {
-                let gp = format!("{base}/grade");
-                if g.len() != n {
-                    v.push(
-                        &gp,
-                        format!("must have {n} samples like time_s, got {}", g.len()),
-                    );
-                    ok = false;
-                } else if !v.all_finite(&gp, g) {
-                    ok = false;
-                } else if let Some(i) = g.iter().position(|&x| !w::GRADE.contains(x)) {
-                    v.push(
-                        format!("{gp}/{i}"),
-                        format!("grade must be in [-0.3, 0.3], got {}", g[i]),
+            if axis(v, &tp, &cc.time_s) {
+                if let Some(i) = (1..n).find(|&i| {
+                    let dt = cc.time_s[i] - cc.time_s[i - 1];
+                    // 1e-6 relative slack: 10.001 − 10.0 is 0.000999999… in binary.
+                    !(MIN_TIME_STEP_S * (1.0 - 1e-6)..=MAX_TIME_STEP_S).contains(&dt)
+                }) {
+                    v.rule(
+                        &TIME_STEP,
+                        format!("{tp}/{i}"),
+                        format!(
+                            "time step must be in [{MIN_TIME_STEP_S}, {MAX_TIME_STEP_S}] s, got {} s",
+                            cc.time_s[i] - cc.time_s[i - 1]
+                        ),
                     );
                     ok = false;
                 }
+            } else {
+                ok = false;
+            }
+            // km/h in [0, 720] is m/s in [0, 200] (the door): the conversion stays in range.
+            let mps: Vec<f64> = speeds.iter().map(|s| s * factor).collect();
+            if let Some(g) = &cc.grade {
+                ok &= same_length(v, &format!("{base}/grade"), g, n, "time_s");
             }
             ok.then(|| Cycle {
                 name: cc.name.clone(),
@@ -488,7 +521,7 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
     }
 }
 
-/// Envelope fields shared by constant and map motors.
+/// Envelope fields shared by constant and map motors (ranges checked at the door).
 fn envelope(
     v: &mut Validator,
     base: &str,
@@ -498,91 +531,52 @@ fn envelope(
     table: Option<&EnvelopeTable>,
 ) -> (Envelope, f64) {
     let n_max = n_max.unwrap_or(DEFAULT_N_MAX);
-    v.range(&format!("{base}/n_max_rpm"), "", n_max, w::N_MAX_RPM);
     let env = match table {
         Some(t) => {
-            if t_peak.is_some() || p_peak.is_some() {
-                v.push(
-                    format!("{base}/envelope"),
-                    "give either envelope or t_peak_nm/p_peak_w, not both".to_owned(),
-                );
-            }
             let p = format!("{base}/envelope");
-            let ok = axis(
-                v,
-                &format!("{p}/speed_rpm"),
-                &t.speed_rpm,
-                2,
-                w::SPEED_AXIS_RPM,
+            v.ensure_rule(
+                t_peak.is_none() && p_peak.is_none(),
+                &ENVELOPE_CONFLICT,
+                &p,
+                || "give either envelope or t_peak_nm/p_peak_w, not both".to_owned(),
             );
-            if t.t_max_nm.len() != t.speed_rpm.len() {
-                v.push(
-                    format!("{p}/t_max_nm"),
-                    format!(
-                        "must have {} values like speed_rpm, got {}",
-                        t.speed_rpm.len(),
-                        t.t_max_nm.len()
-                    ),
-                );
-            } else {
-                v.all_in(&format!("{p}/t_max_nm"), "", &t.t_max_nm, w::TORQUE_NM);
-            }
-            let _ = ok;
+            axis(v, &format!("{p}/speed_rpm"), &t.speed_rpm);
+            same_length(
+                v,
+                &format!("{p}/t_max_nm"),
+                &t.t_max_nm,
+                t.speed_rpm.len(),
+                "speed_rpm",
+            );
             Envelope::Table {
                 speed: t.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
                 t_max: t.t_max_nm.clone(),
             }
         }
-        None => {
-            let tp = t_peak.unwrap_or(DEFAULT_T_PEAK);
-            let pp = p_peak.unwrap_or(DEFAULT_P_PEAK);
-            v.range(&format!("{base}/t_peak_nm"), "", tp, w::TORQUE_NM);
-            v.range(&format!("{base}/p_peak_w"), "", pp, w::POWER_W);
-            Envelope::TorquePower {
-                t_peak: tp,
-                p_peak: pp,
-            }
-        }
+        None => Envelope::TorquePower {
+            t_peak: t_peak.unwrap_or(DEFAULT_T_PEAK),
+            p_peak: p_peak.unwrap_or(DEFAULT_P_PEAK),
+        },
     };
     (env, rpm_to_rad_s(n_max))
 }
 
 /// ψ_m of an IPMSM (`p` = `{base}/`), given directly or from the back-EMF at `pp` pole pairs
-/// (NaN when neither or both are given).
-fn psi_m(v: &mut Validator, base: &str, p: &str, m: &IpmsmMotor, pp: f64) -> f64 {
+/// (exactly one of them: checked at the door; NaN past a skipped door).
+fn psi_m(v: &mut Validator, p: &str, m: &IpmsmMotor, pp: f64) -> f64 {
     match (m.psi_m_wb, &m.back_emf) {
-        (Some(psi), None) => {
-            v.range(&format!("{p}psi_m_wb"), "", psi, w::PSI_M_WB);
-            psi
-        }
+        (Some(psi), None) => psi,
         (None, Some(b)) => {
-            let a = v.range(
-                &format!("{p}back_emf/v_peak_phase"),
-                "",
-                b.v_peak_phase,
-                w::BACK_EMF,
-            );
-            let c = v.range(&format!("{p}back_emf/at_rpm"), "", b.at_rpm, w::BACK_EMF);
             let psi = psi_from_back_emf(b.v_peak_phase, b.at_rpm, pp);
-            if a && c && !w::PSI_M_WB.contains(psi) {
-                v.push(
-                    format!("{p}back_emf"),
-                    format!("implies ψ_m = {psi} Wb, outside {}", w::PSI_M_WB),
-                );
-            }
+            v.ensure_rule(
+                w::PSI_M_WB.contains(psi),
+                &BACK_EMF_PSI,
+                format!("{p}back_emf"),
+                || format!("implies ψ_m = {psi} Wb, outside {}", w::PSI_M_WB),
+            );
             psi
         }
-        (Some(_), Some(_)) => {
-            v.push(
-                base,
-                "give exactly one of psi_m_wb and back_emf, not both".to_owned(),
-            );
-            f64::NAN
-        }
-        (None, None) => {
-            v.push(base, "needs psi_m_wb or back_emf".to_owned());
-            f64::NAN
-        }
+        _ => f64::NAN,
     }
 }
 
@@ -592,155 +586,70 @@ fn ac_factor(v: &mut Validator, p: &str, spec: Option<&AcFactorSpec>) -> AcFacto
     match spec {
         None | Some(AcFactorSpec::NoAc(_)) => AcFactor::None,
         Some(AcFactorSpec::Table(t)) => {
-            axis(v, &format!("{ap}/freq_hz"), &t.freq_hz, 1, w::FREQ_HZ);
-            if t.k_ac.len() != t.freq_hz.len() {
-                v.push(
-                    format!("{ap}/k_ac"),
-                    format!(
-                        "must have {} values like freq_hz, got {}",
-                        t.freq_hz.len(),
-                        t.k_ac.len()
-                    ),
-                );
-            } else {
-                v.all_in(&format!("{ap}/k_ac"), "k_AC", &t.k_ac, w::K_AC);
-            }
+            axis(v, &format!("{ap}/freq_hz"), &t.freq_hz);
+            same_length(
+                v,
+                &format!("{ap}/k_ac"),
+                &t.k_ac,
+                t.freq_hz.len(),
+                "freq_hz",
+            );
             AcFactor::Table {
                 freq_hz: t.freq_hz.clone(),
                 k_ac: t.k_ac.clone(),
             }
         }
-        Some(AcFactorSpec::Dowell(d)) => {
-            let fields = [
-                (
-                    "conductor_height_m",
-                    d.conductor_height_m,
-                    w::CONDUCTOR_HEIGHT_M,
-                ),
-                ("layers", f64::from(d.layers), w::LAYERS),
-                ("porosity", d.porosity, w::POROSITY),
-                ("stack_length_m", d.stack_length_m, w::STACK_LENGTH_M),
-                ("end_length_m", d.end_length_m, w::END_LENGTH_M),
-            ];
-            for (name, x, range) in fields {
-                v.range(&format!("{ap}/{name}"), "", x, range);
-            }
-            AcFactor::Dowell(Dowell {
-                conductor_height_m: d.conductor_height_m,
-                layers: f64::from(d.layers),
-                porosity: d.porosity,
-                stack_length_m: d.stack_length_m,
-                end_length_m: d.end_length_m,
-            })
-        }
+        Some(AcFactorSpec::Dowell(d)) => AcFactor::Dowell(Dowell {
+            conductor_height_m: d.conductor_height_m,
+            layers: f64::from(d.layers),
+            porosity: d.porosity,
+            stack_length_m: d.stack_length_m,
+            end_length_m: d.end_length_m,
+        }),
     }
-}
-
-/// The scalar fields of an IPMSM after ψ_m (`p` = `{base}/`): dq inductances, winding, current
-/// and voltage limits, speed limit; returns the winding temperature and voltage utilization
-/// with their defaults applied.
-fn ipmsm_ratings(v: &mut Validator, p: &str, m: &IpmsmMotor) -> (f64, f64) {
-    let ld_ok = v.range(&format!("{p}ld_h"), "", m.ld_h, w::INDUCTANCE_H);
-    let lq_ok = v.range(&format!("{p}lq_h"), "", m.lq_h, w::INDUCTANCE_H);
-    if ld_ok && lq_ok && m.lq_h < m.ld_h {
-        v.push(
-            format!("{p}lq_h"),
-            format!("must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}", m.ld_h, m.lq_h),
-        );
-    }
-    let temp = m.winding_temp_c.unwrap_or(100.0);
-    let util = m.voltage_utilization.unwrap_or(1.0);
-    let fields = [
-        ("r_phase_20c_ohm", m.r_phase_20c_ohm, w::R_PHASE_OHM),
-        ("winding_temp_c", temp, w::WINDING_TEMP_C),
-        ("i_max_arms", m.i_max_arms, w::ELECTRIC_LIMIT),
-        ("v_dc", m.v_dc, w::ELECTRIC_LIMIT),
-        ("voltage_utilization", util, w::VOLTAGE_UTILIZATION),
-        ("n_max_rpm", m.n_max_rpm, w::N_MAX_RPM),
-    ];
-    for (name, x, range) in fields {
-        v.range(&format!("{p}{name}"), "", x, range);
-    }
-    (temp, util)
-}
-
-/// An optional field of an IPMSM checked against `range` when given; `default` when absent.
-fn optional(v: &mut Validator, ptr: &str, x: Option<f64>, range: Range, default: f64) -> f64 {
-    if let Some(x) = x {
-        v.range(ptr, "", x, range);
-    }
-    x.unwrap_or(default)
 }
 
 fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
     let p = format!("{base}/");
-    v.uint(
-        &format!("{p}pole_pairs"),
-        "",
-        u64::from(m.pole_pairs),
-        w::POLE_PAIRS,
-    );
-    let pp = f64::from(m.pole_pairs).clamp(w::POLE_PAIRS.lo, w::POLE_PAIRS.hi);
-    let psi = psi_m(v, base, &p, m, pp);
-    let (temp, util) = ipmsm_ratings(v, &p, m);
-    let t_cap = optional(
-        v,
-        &format!("{p}t_cap_nm"),
-        m.t_cap_nm,
-        w::TORQUE_NM,
-        f64::INFINITY,
-    );
-    let p_cap = optional(
-        v,
-        &format!("{p}p_cap_w"),
-        m.p_cap_w,
-        w::POWER_W,
-        f64::INFINITY,
-    );
+    let pp = f64::from(m.pole_pairs);
+    let psi = psi_m(v, &p, m, pp);
+    v.ensure_rule(m.lq_h >= m.ld_h, &LQ_BELOW_LD, format!("{p}lq_h"), || {
+        format!(
+            "must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}",
+            m.ld_h, m.lq_h
+        )
+    });
     let ac = ac_factor(v, &p, m.ac_factor.as_ref());
     let iron = m.iron.clone().unwrap_or_default();
     let mech = m.mech.clone().unwrap_or_default();
-    for (name, x) in [
-        ("iron/k_h", iron.k_h),
-        ("iron/k_e", iron.k_e),
-        ("mech/c_fric_nm", mech.c_fric_nm),
-        ("mech/c_wind", mech.c_wind),
-    ] {
-        v.range(&format!("{p}{name}"), "", x, w::LOSS_COEFF);
-    }
-    let scale = optional(
-        v,
-        &format!("{p}stack_scale"),
-        m.stack_scale,
-        w::STACK_SCALE,
-        1.0,
-    );
-    if m.stack_scale.is_some() && !matches!(ac, AcFactor::Dowell(_)) {
-        v.push(
-            format!("{p}stack_scale"),
+    v.ensure_rule(
+        m.stack_scale.is_none() || matches!(ac, AcFactor::Dowell(_)),
+        &STACK_SCALE_DOWELL,
+        format!("{p}stack_scale"),
+        || {
             "needs ac_factor model \"dowell\" (its stack/end lengths split the resistance)"
-                .to_owned(),
-        );
-    }
+                .to_owned()
+        },
+    );
     Ipmsm::new(&IpmsmParams {
         pole_pairs: pp,
         psi_m_wb: psi,
         ld_h: m.ld_h,
         lq_h: m.lq_h,
         r_20_ohm: m.r_phase_20c_ohm,
-        winding_temp_c: temp,
+        winding_temp_c: m.winding_temp_c.unwrap_or(100.0),
         i_max_arms: m.i_max_arms,
         v_dc: m.v_dc,
-        voltage_utilization: util,
+        voltage_utilization: m.voltage_utilization.unwrap_or(1.0),
         n_max_rpm: m.n_max_rpm,
-        t_cap_nm: t_cap,
-        p_cap_w: p_cap,
+        t_cap_nm: m.t_cap_nm.unwrap_or(f64::INFINITY),
+        p_cap_w: m.p_cap_w.unwrap_or(f64::INFINITY),
         ac,
         k_h: iron.k_h,
         k_e: iron.k_e,
         c_fric: mech.c_fric_nm,
         c_wind: mech.c_wind,
-        stack_scale: scale,
+        stack_scale: m.stack_scale.unwrap_or(1.0),
     })
 }
 
@@ -755,22 +664,15 @@ fn map_axis_warning(loss: &Grid2, env: &Envelope, warnings: &mut Vec<String>) {
     }
 }
 
-/// The speed and torque axes of a map motor (`base` = `/motors/{i}`), at least 2 points each:
-/// whether each is valid.
+/// The speed and torque axes of a map motor (`base` = `/motors/{i}`; counts and ranges checked
+/// at the door): whether each increases strictly.
 fn map_axes(
     v: &mut Validator,
     base: &str,
     (speed_rpm, torque_nm): (&[f64], &[f64]),
-    torque_range: Range,
 ) -> (bool, bool) {
-    let ok_s = axis(
-        v,
-        &format!("{base}/speed_rpm"),
-        speed_rpm,
-        2,
-        w::SPEED_AXIS_RPM,
-    );
-    let ok_t = axis(v, &format!("{base}/torque_nm"), torque_nm, 2, torque_range);
+    let ok_s = axis(v, &format!("{base}/speed_rpm"), speed_rpm);
+    let ok_t = axis(v, &format!("{base}/torque_nm"), torque_nm);
     (ok_s, ok_t)
 }
 
@@ -782,25 +684,13 @@ fn efficiency_map(
     env: &Envelope,
     warnings: &mut Vec<String>,
 ) -> Grid2 {
-    let (ok_s, ok_t) = map_axes(v, base, (&m.speed_rpm, &m.torque_nm), w::TORQUE_AXIS_NM);
+    let (ok_s, ok_t) = map_axes(v, base, (&m.speed_rpm, &m.torque_nm));
     let shape = (m.speed_rpm.len(), m.torque_nm.len());
     let mut ok = ok_s && ok_t;
     if ok {
-        ok &= table(
-            v,
-            &format!("{base}/efficiency"),
-            &m.efficiency,
-            shape,
-            w::MAP_EFFICIENCY,
-        );
+        ok &= table(v, &format!("{base}/efficiency"), &m.efficiency, shape);
         if let Some(g) = &m.efficiency_gen {
-            ok &= table(
-                v,
-                &format!("{base}/efficiency_gen"),
-                g,
-                shape,
-                w::MAP_EFFICIENCY,
-            );
+            ok &= table(v, &format!("{base}/efficiency_gen"), g, shape);
         }
     }
     if !ok {
@@ -830,20 +720,16 @@ fn loss_map(
     env: &Envelope,
     warnings: &mut Vec<String>,
 ) -> Grid2 {
-    let (ok_s, ok_t) = map_axes(
-        v,
-        base,
-        (&m.speed_rpm, &m.torque_nm),
-        w::SIGNED_TORQUE_AXIS_NM,
-    );
+    let (ok_s, ok_t) = map_axes(v, base, (&m.speed_rpm, &m.torque_nm));
     if ok_t && !m.torque_nm.iter().any(|&t| t.abs() <= 0.0) {
-        v.push(
+        v.rule(
+            &LOSS_AXIS_ZERO,
             format!("{base}/torque_nm"),
             "signed torque axis must contain 0".to_owned(),
         );
     }
     let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
-    let ok = ok_s && ok_t && table(v, &format!("{base}/loss_w"), &m.loss_w, (ns, nt), w::LOSS_W);
+    let ok = ok_s && ok_t && table(v, &format!("{base}/loss_w"), &m.loss_w, (ns, nt));
     let loss = Grid2 {
         speed: m.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
         torque: m.torque_nm.clone(),
@@ -893,21 +779,12 @@ macro_rules! table_envelope {
 
 fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     let base = format!("/motors/{i}");
-    name_ok(v, &format!("{base}/id"), spec.id(), "motor id");
     let mut warnings = Vec::new();
     let kind = match spec {
-        MotorSpec::Constant(m) => {
-            v.range(
-                &format!("{base}/efficiency"),
-                "",
-                m.efficiency,
-                w::EFFICIENCY,
-            );
-            MotorKind::Constant {
-                eta: m.efficiency,
-                envelope: table_envelope!(v, &base, m),
-            }
-        }
+        MotorSpec::Constant(m) => MotorKind::Constant {
+            eta: m.efficiency,
+            envelope: table_envelope!(v, &base, m),
+        },
         MotorSpec::EfficiencyMap(m) => {
             let envelope = table_envelope!(v, &base, m);
             let loss = efficiency_map(v, &base, m, &envelope, &mut warnings);
@@ -930,59 +807,53 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     }
 }
 
-fn grid(v: &mut Validator, ptr: &str, g: &GridSpec) -> (f64, f64) {
-    v.range(
-        &format!("{ptr}/speed_step_rpm"),
-        "",
-        g.speed_step_rpm,
-        w::SPEED_STEP_RPM,
-    );
-    v.range(
-        &format!("{ptr}/torque_step_nm"),
-        "",
-        g.torque_step_nm,
-        w::TORQUE_STEP_NM,
-    );
+/// A map grid: speed step \[rpm\], torque step [N·m] (ranges checked at the door).
+fn grid(g: &GridSpec) -> (f64, f64) {
     (g.speed_step_rpm, g.torque_step_nm)
 }
 
-/// Validate a motor on its own (motor-map endpoint).
-///
-/// # Errors
-/// Every offending field, as one [`CalcFailure`].
-pub fn validate_motor(
-    spec: &MotorSpec,
-    g: &GridSpec,
-    time_limit_ms: Option<u64>,
-) -> Result<(MotorInput, (f64, f64)), CalcFailure> {
-    let mut v = Validator::new();
-    let _ = crate::calc::common::time_limit(&mut v, time_limit_ms);
-    let m = motor(&mut v, 0, spec);
-    let gr = grid(&mut v, "/grid", g);
-    v.finish().map_err(|mut e| {
-        for issue in &mut e.errors {
-            issue.pointer = issue.pointer.replacen("/motors/0", "/motor", 1);
-        }
-        e.detail = e.detail.replacen("/motors/0", "/motor", 1);
-        e
-    })?;
-    Ok((m, gr))
+/// A validated motor-map request: the motor, the grid and whether to return the components.
+#[derive(Debug, Clone)]
+pub struct MotorMapInput {
+    /// The motor.
+    pub motor: MotorInput,
+    /// Speed step \[rpm\], torque step [N·m].
+    pub grid: (f64, f64),
+    /// Also return the ipmsm loss components and operating modes.
+    pub include_components: bool,
 }
 
-/// The cycles (at most [`MAX_CYCLES`] checked), each valid one with its index; zero distance and
-/// duplicate names are reported.
-fn cycles(v: &mut Validator, specs: &[CycleSpec]) -> Vec<(usize, Cycle)> {
-    if specs.is_empty() || specs.len() > MAX_CYCLES {
-        v.push(
-            "/cycles",
-            format!("must have 1..{MAX_CYCLES} entries, got {}", specs.len()),
-        );
+impl TryFrom<MotorMapRequest> for MotorMapInput {
+    type Error = CalcFailure;
+
+    /// The motor's rules between fields (pointers under `/motor`).
+    fn try_from(req: MotorMapRequest) -> Result<Self, CalcFailure> {
+        let mut v = Validator::new();
+        let m = motor(&mut v, 0, &req.motor);
+        v.finish().map_err(|mut e| {
+            for issue in &mut e.errors {
+                issue.pointer = issue.pointer.replacen("/motors/0", "/motor", 1);
+            }
+            e.detail = e.detail.replacen("/motors/0", "/motor", 1);
+            e
+        })?;
+        Ok(Self {
+            motor: m,
+            grid: grid(&req.grid),
+            include_components: req.include_components,
+        })
     }
+}
+
+/// The cycles (their count is checked at the door), each valid one with its index; zero distance
+/// and duplicate names are reported.
+fn cycles(v: &mut Validator, specs: &[CycleSpec]) -> Vec<(usize, Cycle)> {
     let mut cycles_ok: Vec<(usize, Cycle)> = Vec::new();
     for (j, c) in specs.iter().enumerate().take(MAX_CYCLES) {
         if let Some(cy) = cycle(v, j, c) {
             if cy.distance_m() <= 0.0 {
-                v.push(
+                v.rule(
+                    &ZERO_DISTANCE,
                     format!("/cycles/{j}"),
                     format!(
                         "cycle '{}' has zero distance (fuel economy undefined)",
@@ -990,7 +861,8 @@ fn cycles(v: &mut Validator, specs: &[CycleSpec]) -> Vec<(usize, Cycle)> {
                     ),
                 );
             } else if let Some((k, _)) = cycles_ok.iter().find(|(_, o)| o.name == cy.name) {
-                v.push(
+                v.rule(
+                    &DUPLICATE_NAME,
                     format!("/cycles/{j}"),
                     format!("duplicate cycle name '{}' (also /cycles/{k})", cy.name),
                 );
@@ -1001,18 +873,13 @@ fn cycles(v: &mut Validator, specs: &[CycleSpec]) -> Vec<(usize, Cycle)> {
     cycles_ok
 }
 
-/// The motors (at most [`MAX_MOTORS`] checked), with duplicate ids reported.
+/// The motors (their count is checked at the door), with duplicate ids reported.
 fn motors(v: &mut Validator, specs: &[MotorSpec]) -> Vec<MotorInput> {
-    if specs.is_empty() || specs.len() > MAX_MOTORS {
-        v.push(
-            "/motors",
-            format!("must have 1..{MAX_MOTORS} entries, got {}", specs.len()),
-        );
-    }
     let mut motors = Vec::new();
     for (i, m) in specs.iter().enumerate().take(MAX_MOTORS) {
         if let Some(k) = specs[..i].iter().position(|o| o.id() == m.id()) {
-            v.push(
+            v.rule(
+                &DUPLICATE_NAME,
                 format!("/motors/{i}/id"),
                 format!("duplicate motor id '{}' (also /motors/{k})", m.id()),
             );
@@ -1023,7 +890,7 @@ fn motors(v: &mut Validator, specs: &[MotorSpec]) -> Vec<MotorInput> {
 }
 
 /// The desirability weights of `n_cycles` cycles, normalised (equal weights when absent or
-/// invalid).
+/// invalid; their range is checked at the door).
 fn desirability(v: &mut Validator, weights: Option<&[f64]>, n_cycles: usize) -> Vec<f64> {
     let n_cyc = n_cycles.max(1);
     let equal = vec![1.0 / n_cyc as f64; n_cyc];
@@ -1031,47 +898,25 @@ fn desirability(v: &mut Validator, weights: Option<&[f64]>, n_cycles: usize) -> 
         return equal;
     };
     let p = "/options/desirability_weights";
-    if w.len() != n_cycles {
-        v.push(
-            p,
-            format!(
-                "must have one weight per cycle ({n_cycles}), got {}",
-                w.len()
-            ),
-        );
-        return equal;
-    }
-    if !v.all_in(p, "", w, w::DESIRABILITY_WEIGHT) {
+    if !v.ensure_rule(w.len() == n_cycles, &LENGTH_MISMATCH, p, || {
+        format!(
+            "must have one weight per cycle ({n_cycles}), got {}",
+            w.len()
+        )
+    }) {
         return equal;
     }
     let s: f64 = w.iter().sum();
     if s > 0.0 {
         w.iter().map(|x| x / s).collect()
     } else {
-        v.push(p, "weights must not all be 0".to_owned());
+        v.rule(
+            &DESIRABILITY_ZERO,
+            p,
+            "weights must not all be 0".to_owned(),
+        );
         equal
     }
-}
-
-/// The options: substeps, loss-map grid, histogram bins and desirability weights; returns the
-/// grid and the normalised weights.
-fn options(v: &mut Validator, o: &OptionsSpec, n_cycles: usize) -> ((f64, f64), Vec<f64>) {
-    v.uint("/options/substeps", "", u64::from(o.substeps), w::SUBSTEPS);
-    let gr = grid(v, "/options/loss_map_grid", &o.loss_map_grid);
-    v.range(
-        "/options/op_histogram/speed_bin_rpm",
-        "",
-        o.op_histogram.speed_bin_rpm,
-        w::SPEED_BIN_RPM,
-    );
-    v.range(
-        "/options/op_histogram/torque_bin_nm",
-        "",
-        o.op_histogram.torque_bin_nm,
-        w::TORQUE_BIN_NM,
-    );
-    let weights = desirability(v, o.desirability_weights.as_deref(), n_cycles);
-    (gr, weights)
 }
 
 /// Every cycle's top speed within every motor's speed limit (spec §3.7, §8 item 4).
@@ -1091,7 +936,8 @@ fn speed_limits(
                     }
                     _ => "n_max_rpm",
                 };
-                v.push(
+                v.rule(
+                    &CYCLE_ABOVE_MOTOR_SPEED,
                     format!("/motors/{i}/n_max_rpm"),
                     format!(
                         "cycle '{}' (/cycles/{j}) needs {:.1} rpm at its top speed {:.3} km/h, above the motor's {field} {:.1} rpm",
@@ -1111,29 +957,29 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
 
     fn try_from(req: &BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
-        let shard = crate::calc::common::shard(&mut v, req.shard);
-        let veh = vehicle(&mut v, &req.vehicle);
-        v.range(
-            "/inverter/efficiency",
-            "",
-            req.inverter.efficiency,
-            w::EFFICIENCY,
-        );
+        let shard = crate::calc::common::shard_rule(&mut v, req.shard);
+        let veh = vehicle(&req.vehicle);
         let bat = battery(&mut v, &req.battery);
         let cycles_ok = cycles(&mut v, &req.cycles);
         let motors = motors(&mut v, &req.motors);
-        let (gr, weights) = options(&mut v, &req.options, req.cycles.len());
+        let weights = desirability(
+            &mut v,
+            req.options.desirability_weights.as_deref(),
+            req.cycles.len(),
+        );
         speed_limits(&mut v, &veh, (&motors, &req.motors), &cycles_ok);
         v.finish()?;
+        // `finish` succeeded: every cycle converted (exactly one speed list: the door).
+        if cycles_ok.len() != req.cycles.len() {
+            return Err(crate::calc::rules::door_skipped("/cycles"));
+        }
 
         let o = &req.options;
+        // substeps ∈ [1, 32] (the door).
         let substeps = usize::try_from(o.substeps).unwrap_or(1);
         let total: usize = cycles_ok.iter().map(|(_, c)| c.intervals(substeps)).sum();
         if total > MAX_TOTAL_INTERVALS {
-            return Err(CalcFailure::field(
-                ProblemClass::TooLarge,
-                "TOO_MANY_SAMPLES",
+            return Err(TOO_MANY_SAMPLES.fail(
                 "/options/substeps",
                 format!(
                     "{total} intervals after sub-stepping exceed the limit {MAX_TOTAL_INTERVALS}"
@@ -1155,7 +1001,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
                 regen: o.regen,
                 regen_limit: o.regen_limit,
                 motor_eval: o.motor_eval.map_or(MotorEval::LossMap, MotorEval::from),
-                grid: gr,
+                grid: grid(&o.loss_map_grid),
                 breakdown: has(OutputKind::LossBreakdown),
                 histogram: has(OutputKind::OpHistogram),
                 traces: has(OutputKind::Traces),
@@ -1165,5 +1011,13 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
             },
             shard,
         })
+    }
+}
+
+impl TryFrom<BusFuelEconomyRequest> for BusFuelEconomyInput {
+    type Error = CalcFailure;
+
+    fn try_from(req: BusFuelEconomyRequest) -> Result<Self, CalcFailure> {
+        Self::try_from(&req)
     }
 }

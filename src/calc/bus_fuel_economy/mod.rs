@@ -71,41 +71,67 @@ pub use output::merged_comparison;
 pub use wire::{BusFuelEconomyRequest, BusFuelEconomyResponse, MotorMapRequest, MotorMapResponse};
 
 use self::compute::{compute, motor_map};
-use self::input::{BusFuelEconomyInput, validate_motor};
+pub use self::input::{BusFuelEconomyInput, MotorMapInput};
 use crate::calc::CalcFailure;
 use crate::numerics::Budget;
 
-/// `POST /v1/bus-fuel-economy`: validate, simulate every motor over every cycle, build the response.
+/// What runs in the job of `POST /v1/bus-fuel-economy`, on a request that passed the door: the
+/// answer's size, the simulation of every motor over every cycle, the response.
 ///
 /// # Errors
-/// A [`CalcFailure`] listing every invalid field, or the computation's failure (unreachable motor
-/// speed, oversized map or histogram, exhausted time budget).
+/// The computation's failure (unreachable motor speed, oversized map or histogram or answer,
+/// exhausted time budget).
+pub fn run_valid(
+    input: &BusFuelEconomyInput,
+    budget: &Budget,
+) -> Result<BusFuelEconomyResponse, CalcFailure> {
+    output::response_size(input).check(budget)?;
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, out, budget))
+}
+
+/// `POST /v1/bus-fuel-economy` without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
+///
+/// # Errors
+/// As the endpoint: every offending field with its JSON pointer, or the computation's failure.
 pub fn run(
     req: BusFuelEconomyRequest,
     budget: &Budget,
 ) -> Result<BusFuelEconomyResponse, CalcFailure> {
-    let input = BusFuelEconomyInput::try_from(&req)?;
-    output::response_size(&input).check(budget)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, out, budget))
+    crate::calc::rules::check(&req)?;
+    run_valid(&BusFuelEconomyInput::try_from(&req)?, budget)
 }
 
-/// `POST /v1/bus-fuel-economy/motor-map`: envelope, loss and efficiency maps of one motor.
+/// What runs in the job of `POST /v1/bus-fuel-economy/motor-map`: the answer's size, the maps.
 ///
 /// # Errors
-/// A [`CalcFailure`] listing every invalid field, an oversized grid or an exhausted budget.
-pub fn run_motor_map(
-    req: MotorMapRequest,
+/// An oversized grid or answer, or an exhausted budget.
+pub fn run_motor_map_valid(
+    input: &MotorMapInput,
     budget: &Budget,
 ) -> Result<MotorMapResponse, CalcFailure> {
-    let (m, grid) = validate_motor(&req.motor, &req.grid, req.time_limit_ms)?;
-    output::motor_map_size(&m, grid, req.include_components).check(budget)?;
-    let data = motor_map(&m, grid, req.include_components, budget).map_err(|e| {
+    let (m, grid) = (&input.motor, input.grid);
+    output::motor_map_size(m, grid, input.include_components).check(budget)?;
+    let data = motor_map(m, grid, input.include_components, budget).map_err(|e| {
         let mut f = CalcFailure::from(e);
         for issue in &mut f.errors {
             issue.pointer = "/grid".to_owned();
         }
         f
     })?;
-    Ok(output::respond_motor_map(&m, data, budget))
+    Ok(output::respond_motor_map(m, data, budget))
+}
+
+/// `POST /v1/bus-fuel-economy/motor-map` without HTTP: the per-field rules, the motor's rules
+/// between fields, then [`run_motor_map_valid`].
+///
+/// # Errors
+/// Every offending field, an oversized grid or an exhausted budget.
+pub fn run_motor_map(
+    req: MotorMapRequest,
+    budget: &Budget,
+) -> Result<MotorMapResponse, CalcFailure> {
+    crate::calc::rules::check(&req)?;
+    run_motor_map_valid(&MotorMapInput::try_from(req)?, budget)
 }

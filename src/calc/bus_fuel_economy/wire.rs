@@ -33,8 +33,10 @@ pub struct BusFuelEconomyRequest {
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub battery: BatterySpec,
     /// Drive cycles: built-in names `manhattan`, `hwfet`, `hdudds` or custom traces (1..16).
+    #[rule(min_items = 1, max_items = MAX_CYCLES)]
     pub cycles: Vec<CycleSpec>,
     /// Traction motors to compare (1..8); the first is the reference of `fe_change_pct`.
+    #[rule(min_items = 1, max_items = MAX_MOTORS)]
     pub motors: Vec<MotorSpec>,
     /// Simulation options.
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
@@ -48,6 +50,7 @@ pub struct BusFuelEconomyRequest {
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 2000)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     pub time_limit_ms: Option<u64>,
 }
 
@@ -61,49 +64,76 @@ impl crate::calc::common::TimeLimited for BusFuelEconomyRequest {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::VehicleSpec)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct VehicleSpec {
     /// Curb mass \[kg\].
     #[schema(example = 12500.0)]
+    #[rule(range = CURB_MASS_KG)]
+    #[serde(deserialize_with = "null_vehicle_curb_mass_kg")]
     pub curb_mass_kg: f64,
     /// Number of passengers [-] (0..500).
     #[schema(example = 40)]
+    #[rule(range = PASSENGERS)]
+    #[serde(deserialize_with = "null_vehicle_passengers")]
     pub passengers: u32,
     /// Mass per passenger \[kg\].
     #[schema(example = 65.0)]
+    #[rule(range = MASS_PER_PASSENGER_KG)]
+    #[serde(deserialize_with = "null_vehicle_mass_per_passenger_kg")]
     pub mass_per_passenger_kg: f64,
     /// Frontal area A_F \[m²\].
     #[schema(example = 6.72)]
+    #[rule(range = FRONTAL_AREA_M2)]
+    #[serde(deserialize_with = "null_vehicle_frontal_area_m2")]
     pub frontal_area_m2: f64,
     /// Aerodynamic drag coefficient C_d [-].
     #[schema(example = 0.7)]
+    #[rule(range = DRAG_COEFF)]
+    #[serde(deserialize_with = "null_vehicle_drag_coeff")]
     pub drag_coeff: f64,
     /// Rolling resistance coefficient f_R [-].
     #[schema(example = 0.007)]
+    #[rule(range = ROLLING_COEFF)]
+    #[serde(deserialize_with = "null_vehicle_rolling_coeff")]
     pub rolling_coeff: f64,
     /// Air density ρ_air [kg/m³].
     #[schema(example = 1.28)]
+    #[rule(range = AIR_DENSITY)]
+    #[serde(deserialize_with = "null_vehicle_air_density")]
     pub air_density: f64,
     /// Gravitational acceleration g [m/s²].
     #[schema(example = 9.81)]
+    #[rule(range = GRAVITY)]
+    #[serde(deserialize_with = "null_vehicle_gravity")]
     pub gravity: f64,
     /// Wheel radius r \[m\].
     #[schema(example = 0.48)]
+    #[rule(range = WHEEL_RADIUS_M)]
+    #[serde(deserialize_with = "null_vehicle_wheel_radius_m")]
     pub wheel_radius_m: f64,
     /// Single fixed reduction ratio i_g [-] (service minimum 0.01).
     #[schema(example = 9.5)]
+    #[rule(range = GEAR_RATIO)]
+    #[serde(deserialize_with = "null_vehicle_gear_ratio")]
     pub gear_ratio: f64,
     /// Gear efficiency η_T [-], applied in both power directions (service minimum 0.01).
     #[schema(example = 0.95)]
+    #[rule(range = EFFICIENCY)]
+    #[serde(deserialize_with = "null_vehicle_gear_efficiency")]
     pub gear_efficiency: f64,
     /// Rotational inertia factor δ [-]: effective mass m(1+δ).
     #[schema(example = 0.0)]
+    #[rule(range = FRACTION)]
+    #[serde(deserialize_with = "null_vehicle_rotational_inertia_factor")]
     pub rotational_inertia_factor: f64,
     /// Constant road slope tanθ [-] (a custom cycle's own `grade` array replaces it).
     #[schema(example = 0.0)]
+    #[rule(range = GRADE)]
+    #[serde(deserialize_with = "null_vehicle_grade")]
     pub grade: f64,
     /// Constant auxiliary DC load \[W\].
     #[schema(example = 0.0)]
+    #[rule(range = AUX_POWER_W)]
+    #[serde(deserialize_with = "null_vehicle_aux_power_w")]
     pub aux_power_w: f64,
 }
 
@@ -132,10 +162,11 @@ impl Default for VehicleSpec {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::InverterSpec)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct InverterSpec {
     /// Inverter efficiency η_Inv [-], applied in both power directions (service minimum 0.01).
     #[schema(example = 0.95)]
+    #[rule(range = EFFICIENCY)]
+    #[serde(deserialize_with = "null_inverter_efficiency")]
     pub efficiency: f64,
 }
 
@@ -170,34 +201,45 @@ pub struct BatterySpec {
     pub model: BatteryModel,
     /// constant: battery efficiency η_Bat [-] (default 1.0, service minimum 0.01).
     #[schema(example = 1.0)]
+    #[rule(range = EFFICIENCY)]
     pub efficiency: Option<f64>,
     /// ecm_2rc: nominal voltage \[V\] (default 360), used for the charge capacity Q.
     #[schema(example = 360.0)]
+    #[rule(range = NOMINAL_VOLTAGE)]
     pub nominal_voltage: Option<f64>,
     /// ecm_2rc: energy capacity \[kWh\] (default 256).
     #[schema(example = 256.0)]
+    #[rule(range = CAPACITY_KWH)]
     pub capacity_kwh: Option<f64>,
     /// ecm_2rc: initial state of charge (0, 1] [-].
     #[schema(example = 0.9)]
+    #[rule(range = SOC_INITIAL)]
     pub soc_initial: Option<f64>,
     /// ecm_2rc: SOC points of the open-circuit-voltage table, strictly increasing in [0, 1].
+    #[rule(items = FRACTION, min_items = 2)]
     pub ocv_soc: Option<Vec<f64>>,
     /// ecm_2rc: open-circuit voltage at `ocv_soc` \[V\] (> 0).
+    #[rule(items = OCV_V)]
     pub ocv_v: Option<Vec<f64>>,
     /// ecm_2rc: series resistance R0 \[Ω\] (> 0).
     #[schema(example = 0.03)]
+    #[rule(range = R0_OHM)]
     pub r0_ohm: Option<f64>,
     /// ecm_2rc: first RC branch resistance R1 \[Ω\] (≥ 0).
     #[schema(example = 0.01)]
+    #[rule(range = RC_OHM)]
     pub r1_ohm: Option<f64>,
     /// ecm_2rc: first RC branch capacitance C1 \[F\] (> 0).
     #[schema(example = 3000.0)]
+    #[rule(range = RC_F)]
     pub c1_f: Option<f64>,
     /// ecm_2rc: second RC branch resistance R2 \[Ω\] (≥ 0).
     #[schema(example = 0.01)]
+    #[rule(range = RC_OHM)]
     pub r2_ohm: Option<f64>,
     /// ecm_2rc: second RC branch capacitance C2 \[F\] (> 0).
     #[schema(example = 30000.0)]
+    #[rule(range = RC_F)]
     pub c2_f: Option<f64>,
 }
 
@@ -217,16 +259,22 @@ pub enum CycleSpec {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::CustomCycle)]
 #[serde(deny_unknown_fields)]
+#[rules(one_of("speed_kmh", "speed_mps"))]
 pub struct CustomCycle {
     /// Cycle name (unique in the request, 1..64 characters).
+    #[rule(min_length = 1, max_length = MAX_NAME_LEN)]
     pub name: String,
     /// Sample times \[s\].
+    #[rule(items = TIME_S, min_items = 2, max_items = MAX_CYCLE_SAMPLES)]
     pub time_s: Vec<f64>,
     /// Sample speeds [km/h].
+    #[rule(items = SPEED_KMH)]
     pub speed_kmh: Option<Vec<f64>>,
     /// Sample speeds [m/s].
+    #[rule(items = SPEED_MPS)]
     pub speed_mps: Option<Vec<f64>>,
     /// Road slope tanθ per sample [-] in [-0.3, 0.3] (replaces the vehicle's `grade`).
+    #[rule(items = GRADE)]
     pub grade: Option<Vec<f64>>,
 }
 
@@ -236,8 +284,10 @@ pub struct CustomCycle {
 #[serde(deny_unknown_fields)]
 pub struct EnvelopeTable {
     /// Speeds \[rpm\], strictly increasing, first ≥ 0.
+    #[rule(items = SPEED_AXIS_RPM, min_items = 2)]
     pub speed_rpm: Vec<f64>,
     /// Maximum motor torque at `speed_rpm` [N·m] (> 0).
+    #[rule(items = TORQUE_NM)]
     pub t_max_nm: Vec<f64>,
 }
 
@@ -275,18 +325,23 @@ impl MotorSpec {
 #[serde(deny_unknown_fields)]
 pub struct ConstantMotor {
     /// Motor name (unique in the request, 1..64 characters).
+    #[rule(min_length = 1, max_length = MAX_NAME_LEN)]
     pub id: String,
     /// Motor efficiency η_M [-], both directions (service minimum 0.01).
     #[schema(example = 0.93)]
+    #[rule(range = EFFICIENCY)]
     pub efficiency: f64,
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
     #[schema(example = 800.0)]
+    #[rule(range = TORQUE_NM)]
     pub t_peak_nm: Option<f64>,
     /// Peak power \[W\] (default 130 000; ignored when `envelope` is given).
     #[schema(example = 130000.0)]
+    #[rule(range = POWER_W)]
     pub p_peak_w: Option<f64>,
     /// Maximum speed \[rpm\] (default 5200); a cycle needing more is rejected.
     #[schema(example = 5200.0)]
+    #[rule(range = N_MAX_RPM)]
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope (replaces `t_peak_nm` / `p_peak_w`).
     #[schema(nullable = false)]
@@ -299,20 +354,28 @@ pub struct ConstantMotor {
 #[serde(deny_unknown_fields)]
 pub struct EfficiencyMapMotor {
     /// Motor name (unique in the request, 1..64 characters).
+    #[rule(min_length = 1, max_length = MAX_NAME_LEN)]
     pub id: String,
     /// Speed axis \[rpm\]: strictly increasing, ≥ 2 points, first ≥ 0.
+    #[rule(items = SPEED_AXIS_RPM, min_items = 2)]
     pub speed_rpm: Vec<f64>,
     /// Torque axis [N·m]: strictly increasing, ≥ 2 points, first ≥ 0.
+    #[rule(items = TORQUE_AXIS_NM, min_items = 2)]
     pub torque_nm: Vec<f64>,
     /// Efficiency η\[speed\]\[torque\] in [1e-6, 1] (motoring).
+    #[rule(items_items = MAP_EFFICIENCY)]
     pub efficiency: Vec<Vec<f64>>,
     /// Generating efficiency at −torque_nm, same shape (default: mirror of `efficiency`).
+    #[rule(items_items = MAP_EFFICIENCY)]
     pub efficiency_gen: Option<Vec<Vec<f64>>>,
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
+    #[rule(range = TORQUE_NM)]
     pub t_peak_nm: Option<f64>,
     /// Peak power \[W\] (default 130 000; ignored when `envelope` is given).
+    #[rule(range = POWER_W)]
     pub p_peak_w: Option<f64>,
     /// Maximum speed \[rpm\] (default 5200).
+    #[rule(range = N_MAX_RPM)]
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope.
     #[schema(nullable = false)]
@@ -325,18 +388,25 @@ pub struct EfficiencyMapMotor {
 #[serde(deny_unknown_fields)]
 pub struct LossMapMotor {
     /// Motor name (unique in the request, 1..64 characters).
+    #[rule(min_length = 1, max_length = MAX_NAME_LEN)]
     pub id: String,
     /// Speed axis \[rpm\]: strictly increasing, ≥ 2 points, first ≥ 0.
+    #[rule(items = SPEED_AXIS_RPM, min_items = 2)]
     pub speed_rpm: Vec<f64>,
     /// Signed torque axis [N·m]: strictly increasing, ≥ 2 points, must contain 0.
+    #[rule(items = SIGNED_TORQUE_AXIS_NM, min_items = 2)]
     pub torque_nm: Vec<f64>,
     /// Total motor loss P_loss\[speed\]\[torque\] \[W\] (≥ 0).
+    #[rule(items_items = LOSS_W)]
     pub loss_w: Vec<Vec<f64>>,
     /// Peak torque [N·m] (default 800; ignored when `envelope` is given).
+    #[rule(range = TORQUE_NM)]
     pub t_peak_nm: Option<f64>,
     /// Peak power \[W\] (default 130 000; ignored when `envelope` is given).
+    #[rule(range = POWER_W)]
     pub p_peak_w: Option<f64>,
     /// Maximum speed \[rpm\] (default 5200).
+    #[rule(range = N_MAX_RPM)]
     pub n_max_rpm: Option<f64>,
     /// Explicit torque envelope.
     #[schema(nullable = false)]
@@ -350,9 +420,11 @@ pub struct LossMapMotor {
 pub struct BackEmf {
     /// Peak phase back-EMF \[V\].
     #[schema(example = 83.3)]
+    #[rule(range = BACK_EMF)]
     pub v_peak_phase: f64,
     /// Speed of the measurement \[rpm\].
     #[schema(example = 1000.0)]
+    #[rule(range = BACK_EMF)]
     pub at_rpm: f64,
 }
 
@@ -382,8 +454,10 @@ pub struct NoAcFactor {}
 #[serde(deny_unknown_fields)]
 pub struct AcFactorTable {
     /// Electrical frequencies \[Hz\], strictly increasing, ≥ 0.
+    #[rule(items = FREQ_HZ, min_items = 1)]
     pub freq_hz: Vec<f64>,
     /// k_AC at `freq_hz` [-] (≥ 1).
+    #[rule(items = K_AC)]
     pub k_ac: Vec<f64>,
 }
 
@@ -394,18 +468,23 @@ pub struct AcFactorTable {
 pub struct DowellSpec {
     /// Conductor height h in the slot-depth direction \[m\].
     #[schema(example = 0.0035)]
+    #[rule(range = CONDUCTOR_HEIGHT_M)]
     pub conductor_height_m: f64,
     /// Number of conductor layers m in the slot [-] (1..100).
     #[schema(example = 6)]
+    #[rule(range = LAYERS)]
     pub layers: u32,
     /// Layer porosity factor (0, 1] [-].
     #[schema(example = 0.9)]
+    #[rule(range = POROSITY)]
     pub porosity: f64,
     /// Active (slot) length of the winding per side L_stack \[m\].
     #[schema(example = 0.083)]
+    #[rule(range = STACK_LENGTH_M)]
     pub stack_length_m: f64,
     /// End-winding length per side L_end \[m\] (≥ 0).
     #[schema(example = 0.05)]
+    #[rule(range = END_LENGTH_M)]
     pub end_length_m: f64,
 }
 
@@ -413,13 +492,16 @@ pub struct DowellSpec {
 #[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::IronSpec)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct IronSpec {
     /// Hysteresis coefficient k_h [W/(Wb²·rad/s)] (≥ 0).
     #[schema(example = 3.0)]
+    #[rule(range = LOSS_COEFF)]
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub k_h: f64,
     /// Eddy-current coefficient k_e [W/(Wb²·(rad/s)²)] (≥ 0).
     #[schema(example = 0.03)]
+    #[rule(range = LOSS_COEFF)]
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub k_e: f64,
 }
 
@@ -427,13 +509,16 @@ pub struct IronSpec {
 #[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::MechSpec)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct MechSpec {
     /// Friction torque [N·m] (≥ 0).
     #[schema(example = 0.0)]
+    #[rule(range = LOSS_COEFF)]
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub c_fric_nm: f64,
     /// Windage coefficient [W·s³/rad³] (≥ 0).
     #[schema(example = 0.0)]
+    #[rule(range = LOSS_COEFF)]
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub c_wind: f64,
 }
 
@@ -441,47 +526,61 @@ pub struct MechSpec {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::IpmsmMotor)]
 #[serde(deny_unknown_fields)]
+#[rules(one_of("psi_m_wb", "back_emf"))]
 pub struct IpmsmMotor {
     /// Motor name (unique in the request, 1..64 characters).
+    #[rule(min_length = 1, max_length = MAX_NAME_LEN)]
     pub id: String,
     /// Pole pairs p (1..32).
     #[schema(example = 4)]
+    #[rule(range = POLE_PAIRS)]
     pub pole_pairs: u32,
     /// Peak phase PM flux linkage ψ_m \[Wb\] (give this or `back_emf`).
     #[schema(example = 0.198864)]
+    #[rule(range = PSI_M_WB)]
     pub psi_m_wb: Option<f64>,
     /// Back-EMF from which ψ_m is derived (give this or `psi_m_wb`).
     #[schema(nullable = false)]
     pub back_emf: Option<BackEmf>,
     /// d-axis inductance L_d \[H\] (> 0).
     #[schema(example = 0.00035)]
+    #[rule(range = INDUCTANCE_H)]
     pub ld_h: f64,
     /// q-axis inductance L_q \[H\] (≥ L_d).
     #[schema(example = 0.00055)]
+    #[rule(range = INDUCTANCE_H)]
     pub lq_h: f64,
     /// Phase resistance at 20 °C R_20 \[Ω\] (> 0).
     #[schema(example = 0.006)]
+    #[rule(range = R_PHASE_OHM)]
     pub r_phase_20c_ohm: f64,
     /// Winding temperature T_w [°C] (default 100).
     #[schema(example = 100.0)]
+    #[rule(range = WINDING_TEMP_C)]
     pub winding_temp_c: Option<f64>,
     /// Current limit [A rms] (I_pk = √2·i_max_arms).
     #[schema(example = 500.0)]
+    #[rule(range = ELECTRIC_LIMIT)]
     pub i_max_arms: f64,
     /// DC-link voltage V_dc \[V\].
     #[schema(example = 360.0)]
+    #[rule(range = ELECTRIC_LIMIT)]
     pub v_dc: f64,
     /// Voltage utilisation (0, 1.155] [-] (default 1.0 → V_max = V_dc/√3).
     #[schema(example = 1.0)]
+    #[rule(range = VOLTAGE_UTILIZATION)]
     pub voltage_utilization: Option<f64>,
     /// Maximum speed \[rpm\]; a cycle needing more is rejected.
     #[schema(example = 5200.0)]
+    #[rule(range = N_MAX_RPM)]
     pub n_max_rpm: f64,
     /// Torque cap [N·m] (default none).
     #[schema(example = 800.0)]
+    #[rule(range = TORQUE_NM)]
     pub t_cap_nm: Option<f64>,
     /// Power cap \[W\] (default none).
     #[schema(example = 130000.0)]
+    #[rule(range = POWER_W)]
     pub p_cap_w: Option<f64>,
     /// AC resistance factor model (default `none`).
     #[schema(nullable = false)]
@@ -495,6 +594,7 @@ pub struct IpmsmMotor {
     /// Stack-length scale s (paper §3.2; needs the `dowell` AC model for the slot/end split).
     /// Not validated against data.
     #[schema(example = 1.0)]
+    #[rule(range = STACK_SCALE)]
     pub stack_scale: Option<f64>,
 }
 
@@ -565,9 +665,11 @@ pub enum OutputKind {
 pub struct GridSpec {
     /// Speed step \[rpm\].
     #[schema(example = 250.0)]
+    #[rule(range = SPEED_STEP_RPM)]
     pub speed_step_rpm: f64,
     /// Torque step [N·m].
     #[schema(example = 50.0)]
+    #[rule(range = TORQUE_STEP_NM)]
     pub torque_step_nm: f64,
 }
 
@@ -587,9 +689,11 @@ impl Default for GridSpec {
 pub struct HistogramSpec {
     /// Speed bin width \[rpm\].
     #[schema(example = 500.0)]
+    #[rule(range = SPEED_BIN_RPM)]
     pub speed_bin_rpm: f64,
     /// Torque bin width [N·m].
     #[schema(example = 100.0)]
+    #[rule(range = TORQUE_BIN_NM)]
     pub torque_bin_nm: f64,
 }
 
@@ -606,7 +710,6 @@ impl Default for HistogramSpec {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bus_fuel_economy::OptionsSpec)]
 #[serde(deny_unknown_fields)]
-#[rules(legacy_nulls)]
 pub struct OptionsSpec {
     /// Envelope policy: `backward` (default), `clip` or `forward`.
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
@@ -615,14 +718,21 @@ pub struct OptionsSpec {
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub power_convention: PowerConvention,
     /// Split each cycle interval into k equal pieces (1..32; accuracy knob; default 1).
-    #[serde(default = "default_substeps")]
+    #[serde(default = "default_substeps", deserialize_with = "null_substeps")]
+    #[rule(range = SUBSTEPS)]
     #[schema(example = 1)]
     pub substeps: u32,
     /// Allow regenerative braking (default true).
-    #[serde(default = "default_true")]
+    #[serde(
+        default = "default_true",
+        deserialize_with = "crate::calc::rules::null_true"
+    )]
     pub regen: bool,
     /// Clip generating torque to −T_max(ω); the rest goes to the friction brakes (default true).
-    #[serde(default = "default_true")]
+    #[serde(
+        default = "default_true",
+        deserialize_with = "crate::calc::rules::null_true"
+    )]
     pub regen_limit: bool,
     /// `direct` or `loss_map` (default) evaluation of `ipmsm` motors.
     #[serde(default)]
@@ -630,16 +740,17 @@ pub struct OptionsSpec {
     pub motor_eval: Option<MotorEval>,
     /// Grid of the precomputed ipmsm loss map and of the `efficiency_map` output
     /// (default 250 rpm × 50 N·m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub loss_map_grid: GridSpec,
     /// Optional outputs: `loss_breakdown`, `op_histogram`, `traces`, `efficiency_map`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: Vec<OutputKind>,
     /// Bins of the `op_histogram` output (default 500 rpm × 100 N·m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub op_histogram: HistogramSpec,
     /// Desirability weights per cycle (≥ 0, normalised; default equal, paper w1 = w2 = w3).
     #[serde(default)]
+    #[rule(items = DESIRABILITY_WEIGHT)]
     pub desirability_weights: Option<Vec<f64>>,
 }
 
@@ -649,6 +760,40 @@ fn default_substeps() -> u32 {
 
 fn default_true() -> bool {
     true
+}
+
+/// `null` for `options.substeps` reads as its default 1, exactly as absent.
+fn null_substeps<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    Ok(Option::<u32>::deserialize(d)?.unwrap_or_else(default_substeps))
+}
+
+/// `deserialize_with` readers of fields whose default is not their type's: `null` reads as the
+/// field's default (the struct's `Default`), exactly as absent.
+macro_rules! null_reads_default {
+    ($($name:ident: $ty:ty = $owner:ident.$field:ident;)*) => {$(
+        #[doc = concat!("`null` for `", stringify!($field), "` reads as its default.")]
+        fn $name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+            Ok(Option::<$ty>::deserialize(d)?.unwrap_or_else(|| $owner::default().$field))
+        }
+    )*};
+}
+
+null_reads_default! {
+    null_vehicle_curb_mass_kg: f64 = VehicleSpec.curb_mass_kg;
+    null_vehicle_passengers: u32 = VehicleSpec.passengers;
+    null_vehicle_mass_per_passenger_kg: f64 = VehicleSpec.mass_per_passenger_kg;
+    null_vehicle_frontal_area_m2: f64 = VehicleSpec.frontal_area_m2;
+    null_vehicle_drag_coeff: f64 = VehicleSpec.drag_coeff;
+    null_vehicle_rolling_coeff: f64 = VehicleSpec.rolling_coeff;
+    null_vehicle_air_density: f64 = VehicleSpec.air_density;
+    null_vehicle_gravity: f64 = VehicleSpec.gravity;
+    null_vehicle_wheel_radius_m: f64 = VehicleSpec.wheel_radius_m;
+    null_vehicle_gear_ratio: f64 = VehicleSpec.gear_ratio;
+    null_vehicle_gear_efficiency: f64 = VehicleSpec.gear_efficiency;
+    null_vehicle_rotational_inertia_factor: f64 = VehicleSpec.rotational_inertia_factor;
+    null_vehicle_grade: f64 = VehicleSpec.grade;
+    null_vehicle_aux_power_w: f64 = VehicleSpec.aux_power_w;
+    null_inverter_efficiency: f64 = InverterSpec.efficiency;
 }
 
 impl Default for OptionsSpec {
@@ -940,6 +1085,7 @@ pub struct MotorMapRequest {
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 2000)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     pub time_limit_ms: Option<u64>,
 }
 
@@ -1107,133 +1253,11 @@ pub const SPEED_MPS: Range = Range::closed(0.0, 200.0);
 /// Custom-cycle speed [km/h] (the same limit as [`SPEED_MPS`]).
 pub const SPEED_KMH: Range = Range::closed(0.0, 720.0);
 
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
-crate::schema_bounds! {
-    BusFuelEconomyRequest {
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    MotorMapRequest {
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    VehicleSpec {
-        curb_mass_kg: CURB_MASS_KG,
-        passengers: PASSENGERS,
-        mass_per_passenger_kg: MASS_PER_PASSENGER_KG,
-        frontal_area_m2: FRONTAL_AREA_M2,
-        drag_coeff: DRAG_COEFF,
-        rolling_coeff: ROLLING_COEFF,
-        air_density: AIR_DENSITY,
-        gravity: GRAVITY,
-        wheel_radius_m: WHEEL_RADIUS_M,
-        gear_ratio: GEAR_RATIO,
-        gear_efficiency: EFFICIENCY,
-        rotational_inertia_factor: FRACTION,
-        grade: GRADE,
-        aux_power_w: AUX_POWER_W,
-    },
-    InverterSpec {
-        efficiency: EFFICIENCY,
-    },
-    BatterySpec {
-        efficiency: EFFICIENCY,
-        nominal_voltage: NOMINAL_VOLTAGE,
-        capacity_kwh: CAPACITY_KWH,
-        soc_initial: SOC_INITIAL,
-        r0_ohm: R0_OHM,
-        r1_ohm: RC_OHM,
-        c1_f: RC_F,
-        r2_ohm: RC_OHM,
-        c2_f: RC_F,
-        ocv_soc @items: FRACTION,
-        ocv_v @items: OCV_V,
-    },
-    CustomCycle {
-        time_s @items: TIME_S,
-        speed_kmh @items: SPEED_KMH,
-        speed_mps @items: SPEED_MPS,
-        grade @items: GRADE,
-    },
-    EnvelopeTable {
-        speed_rpm @items: SPEED_AXIS_RPM,
-        t_max_nm @items: TORQUE_NM,
-    },
-    EfficiencyMapMotor {
-        speed_rpm @items: SPEED_AXIS_RPM,
-        torque_nm @items: TORQUE_AXIS_NM,
-    },
-    LossMapMotor {
-        speed_rpm @items: SPEED_AXIS_RPM,
-        torque_nm @items: SIGNED_TORQUE_AXIS_NM,
-    },
-    AcFactorTable {
-        freq_hz @items: FREQ_HZ,
-        k_ac @items: K_AC,
-    },
-    ConstantMotor {
-        efficiency: EFFICIENCY,
-        t_peak_nm: TORQUE_NM,
-        p_peak_w: POWER_W,
-        n_max_rpm: N_MAX_RPM,
-    },
-    BackEmf {
-        v_peak_phase: BACK_EMF,
-        at_rpm: BACK_EMF,
-    },
-    DowellSpec {
-        conductor_height_m: CONDUCTOR_HEIGHT_M,
-        layers: LAYERS,
-        porosity: POROSITY,
-        stack_length_m: STACK_LENGTH_M,
-        end_length_m: END_LENGTH_M,
-    },
-    IronSpec {
-        k_h: LOSS_COEFF,
-        k_e: LOSS_COEFF,
-    },
-    MechSpec {
-        c_fric_nm: LOSS_COEFF,
-        c_wind: LOSS_COEFF,
-    },
-    IpmsmMotor {
-        pole_pairs: POLE_PAIRS,
-        psi_m_wb: PSI_M_WB,
-        ld_h: INDUCTANCE_H,
-        lq_h: INDUCTANCE_H,
-        r_phase_20c_ohm: R_PHASE_OHM,
-        winding_temp_c: WINDING_TEMP_C,
-        i_max_arms: ELECTRIC_LIMIT,
-        v_dc: ELECTRIC_LIMIT,
-        voltage_utilization: VOLTAGE_UTILIZATION,
-        n_max_rpm: N_MAX_RPM,
-        t_cap_nm: TORQUE_NM,
-        p_cap_w: POWER_W,
-        stack_scale: STACK_SCALE,
-    },
-    GridSpec {
-        speed_step_rpm: SPEED_STEP_RPM,
-        torque_step_nm: TORQUE_STEP_NM,
-    },
-    HistogramSpec {
-        speed_bin_rpm: SPEED_BIN_RPM,
-        torque_bin_nm: TORQUE_BIN_NM,
-    },
-    OptionsSpec {
-        substeps: SUBSTEPS,
-        desirability_weights @items: DESIRABILITY_WEIGHT,
-    },
-}
-
-/// Bounds of the values of the two-dimensional map tables (items of items, rendered inline).
-#[must_use]
-pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
-    use crate::calc::SchemaBound;
-    vec![
-        SchemaBound::at::<EfficiencyMapMotor>("/properties/efficiency/items/items", MAP_EFFICIENCY),
-        SchemaBound::at::<EfficiencyMapMotor>(
-            "/properties/efficiency_gen/items/items",
-            MAP_EFFICIENCY,
-        ),
-        SchemaBound::at::<LossMapMotor>("/properties/loss_w/items/items", LOSS_W),
-    ]
-}
+/// Most motors per request (spec §3.5).
+pub const MAX_MOTORS: usize = 8;
+/// Most cycles per request (spec §3.4).
+pub const MAX_CYCLES: usize = 16;
+/// Most samples of one custom cycle (spec §3.4).
+pub const MAX_CYCLE_SAMPLES: usize = 200_000;
+/// Longest motor id / cycle name, in characters.
+pub const MAX_NAME_LEN: usize = 64;

@@ -1,6 +1,6 @@
 //! Failures of the component-importance computation (after validation).
 
-use crate::calc::{CalcFailure, FieldIssue, ProblemClass};
+use crate::calc::{CalcFailure, CrossRule};
 use crate::numerics::{Budget, StopReason};
 
 /// Why a valid request could not be answered.
@@ -82,52 +82,64 @@ pub enum ComponentImportanceError {
     },
 }
 
+/// All-simple-path betweenness on a cyclic graph stays within `max_simple_paths`.
+pub const SIMPLE_PATH_BUDGET_RULE: CrossRule = CrossRule::too_large(
+    "SIMPLE_PATH_BUDGET_EXCEEDED",
+    &[
+        "/options/betweenness",
+        "/options/max_simple_paths",
+        "/edges",
+    ],
+    "On a graph with cycles, all-simple-path betweenness enumerates at most max_simple_paths \
+     simple paths (else use betweenness \"shortest_paths\").",
+);
+/// The exact propagation sum on a cyclic graph with K > 3 stays within `max_simple_paths`.
+pub const PROPAGATION_PATH_BUDGET_RULE: CrossRule = CrossRule::too_large(
+    "PROPAGATION_PATH_BUDGET_EXCEEDED",
+    &[
+        "/options/path_method",
+        "/options/path_cap",
+        "/options/max_simple_paths",
+        "/edges",
+    ],
+    "On a graph with cycles, the exact propagation sum over simple paths of length <= path_cap \
+     enumerates at most max_simple_paths paths (else use path_method \"walks\" or path_cap <= 3).",
+);
+/// The work fits the request's time and evaluation budget.
+pub const BUDGET_RULE: CrossRule = CrossRule::too_large(
+    "BUDGET_EXHAUSTED",
+    &["/time_limit_ms"],
+    "The calculation finishes within the request's time_limit_ms (capped by the service).",
+);
+/// Every hazard rate and failure-mode risk stays within f64.
+pub const HAZARD_RATE_RULE: CrossRule = CrossRule::invalid(
+    "HAZARD_RATE_OVERFLOW",
+    &["/components/*/weibull", "/times_h/*"],
+    "The Weibull hazard rate λ(t) and the risk RI = λ·Σα·impact of every component stay finite \
+     in f64 at every requested time.",
+);
+/// Every reported number is finite and consistent.
+pub const NUMERICAL_RULE: CrossRule = CrossRule::infeasible(
+    "NUMERICAL_FAILURE",
+    &[],
+    "Every reported number is finite and the indices are consistent (a final check).",
+);
+
 impl From<ComponentImportanceError> for CalcFailure {
     fn from(e: ComponentImportanceError) -> Self {
         let detail = e.to_string();
-        let (class, code, pointer) = match &e {
-            ComponentImportanceError::SimplePathBudget { .. } => (
-                ProblemClass::TooLarge,
-                "SIMPLE_PATH_BUDGET_EXCEEDED",
-                Some("/options/betweenness"),
-            ),
-            ComponentImportanceError::PropagationPathBudget { .. } => (
-                ProblemClass::TooLarge,
-                "PROPAGATION_PATH_BUDGET_EXCEEDED",
-                Some("/options/path_method"),
-            ),
+        match &e {
+            ComponentImportanceError::SimplePathBudget { .. } => {
+                SIMPLE_PATH_BUDGET_RULE.fail("/options/betweenness", detail)
+            }
+            ComponentImportanceError::PropagationPathBudget { .. } => {
+                PROPAGATION_PATH_BUDGET_RULE.fail("/options/path_method", detail)
+            }
             ComponentImportanceError::RateOverflow { component, .. } => {
-                let p = format!("/components/{component}/weibull");
-                return Self {
-                    class: ProblemClass::InvalidInput,
-                    code: "HAZARD_RATE_OVERFLOW",
-                    errors: vec![FieldIssue {
-                        pointer: p,
-                        detail: detail.clone(),
-                    }],
-                    detail,
-                };
+                HAZARD_RATE_RULE.fail(format!("/components/{component}/weibull"), detail)
             }
-            ComponentImportanceError::Stopped { .. } => {
-                (ProblemClass::TooLarge, "BUDGET_EXHAUSTED", None)
-            }
-            ComponentImportanceError::Inconsistent { .. } => {
-                (ProblemClass::Infeasible, "NUMERICAL_FAILURE", None)
-            }
-        };
-        let errors = pointer
-            .map(|p| {
-                vec![FieldIssue {
-                    pointer: p.to_owned(),
-                    detail: detail.clone(),
-                }]
-            })
-            .unwrap_or_default();
-        Self {
-            class,
-            code,
-            detail,
-            errors,
+            ComponentImportanceError::Stopped { .. } => BUDGET_RULE.fail_general(detail),
+            ComponentImportanceError::Inconsistent { .. } => NUMERICAL_RULE.fail_general(detail),
         }
     }
 }

@@ -1,26 +1,135 @@
-//! Validation of a [`ComponentImportanceRequest`] into a [`ComponentImportanceInput`]
-//! (spec §2): every offending field is collected with its JSON pointer, then the request fails
-//! once. Units stay as on the wire (hours, 1/h): the method is not unit-invariant (spec §6 H4).
+//! The rules between fields of a [`ComponentImportanceRequest`] (spec §2), turning it into a
+//! [`ComponentImportanceInput`]. Every per-field rule (counts, id lengths, ranges of times, Weibull
+//! data, shares, options) is declared on the wire types and checked at the door; what is left here
+//! is what JSON Schema cannot state (ids unique and known, edges, override times, sums), each rule
+//! with its own code ([`CROSS_FIELD_RULES`]). Units stay as on the wire (hours, 1/h): the method is
+//! not unit-invariant (spec §6 H4).
 
 use std::collections::{BTreeMap, HashMap};
 
-use super::graph::Digraph;
+use super::error::{
+    BUDGET_RULE, HAZARD_RATE_RULE, NUMERICAL_RULE, PROPAGATION_PATH_BUDGET_RULE,
+    SIMPLE_PATH_BUDGET_RULE,
+};
+use super::graph::{Digraph, GraphError};
 use super::structure::LevelMode;
 use super::wire::{
-    BETA, BetweennessMode, ComponentImportanceRequest, ComponentSpec, ConstantWeights, ETA_H,
-    FailureMode, LEVEL, LevelsMode, MAX_SIMPLE_PATHS, NON_NEGATIVE, Options, Outputs, PATH_CAP,
-    PROBABILITY, PathMethod, TIME_H, WEIGHT,
+    BetweennessMode, ComponentImportanceRequest, ComponentSpec, ConstantWeights,
+    DEFAULT_MAX_SIMPLE_PATHS, DEFAULT_O_OUT, DEFAULT_PATH_CAP, DEFAULT_Q_IN, FailureMode,
+    LevelsMode, Options, Outputs, PathMethod,
 };
-use crate::calc::{CalcFailure, Range, Validator};
+pub use super::wire::{MAX_COMPONENTS, MAX_ID_CHARS, MAX_TIMES, MIN_COMPONENTS};
+use crate::calc::{CalcFailure, CrossRule, Validator};
 
-/// Minimum number of components (one edge needs two).
-pub const MIN_COMPONENTS: usize = 2;
-/// Maximum number of components (spec §2).
-pub const MAX_COMPONENTS: usize = 2000;
-/// Maximum id length in characters (spec §2).
-pub const MAX_ID_CHARS: usize = 64;
-/// Maximum number of evaluation times (spec §2).
-pub const MAX_TIMES: usize = 1000;
+/// Component ids are unique.
+pub const DUPLICATE_ID: CrossRule = CrossRule::invalid(
+    "DUPLICATE_ID",
+    &["/components/*/id"],
+    "Component ids are unique.",
+);
+/// Every id an edge or an override names is a component id.
+pub const UNKNOWN_ID: CrossRule = CrossRule::invalid(
+    "UNKNOWN_COMPONENT_ID",
+    &[
+        "/edges/*/0",
+        "/edges/*/1",
+        "/overrides/*/F/*",
+        "/overrides/*/RI/*",
+    ],
+    "Every id named by an edge or an override key is the id of a component.",
+);
+/// No edge joins a component to itself.
+pub const SELF_LOOP: CrossRule = CrossRule::invalid(
+    "SELF_LOOP",
+    &["/edges/*"],
+    "No edge joins a component to itself (a component cannot propagate to itself).",
+);
+/// No edge is given twice.
+pub const DUPLICATE_EDGE: CrossRule = CrossRule::invalid(
+    "DUPLICATE_EDGE",
+    &["/edges/*"],
+    "No edge [from, to] is given twice (its weight would be ambiguous).",
+);
+/// Each override's time is one of the requested times, at most one override per time.
+pub const OVERRIDE_TIME: CrossRule = CrossRule::invalid(
+    "OVERRIDE_TIME",
+    &["/overrides/*/time_h", "/times_h"],
+    "Each override's time_h is one of times_h (within 1e-12 relative), and no two overrides \
+     name the same time.",
+);
+/// A component has Weibull data unless overrides give both F and RI at every time.
+pub const WEIBULL_REQUIRED: CrossRule = CrossRule::invalid(
+    "WEIBULL_REQUIRED",
+    &["/components/*/weibull", "/overrides"],
+    "A component has weibull data unless the overrides give both its F and its RI at every time.",
+);
+/// A component has failure modes or a mode sum unless overrides give RI at every time.
+pub const MODE_DATA_REQUIRED: CrossRule = CrossRule::invalid(
+    "MODE_DATA_REQUIRED",
+    &[
+        "/components/*/failure_modes",
+        "/components/*/mode_sum",
+        "/overrides",
+    ],
+    "A component has failure_modes or mode_sum unless the overrides give its RI at every time.",
+);
+/// `failure_modes` and `mode_sum` exclude each other.
+pub const MODE_DATA_CONFLICT: CrossRule = CrossRule::invalid(
+    "MODE_DATA_CONFLICT",
+    &["/components/*/failure_modes", "/components/*/mode_sum"],
+    "A component gives failure_modes or mode_sum, not both.",
+);
+/// Σ α·impact of a component stays within f64.
+pub const MODE_SUM_OVERFLOW: CrossRule = CrossRule::invalid(
+    "MODE_SUM_OVERFLOW",
+    &["/components/*/failure_modes"],
+    "The sum of alpha·impact over a component's failure modes is finite in f64.",
+);
+/// Q + O = 1.
+pub const Q_PLUS_O: CrossRule = CrossRule::invalid(
+    "Q_PLUS_O",
+    &["/options/q_in", "/options/o_out"],
+    "q_in + o_out = 1 within 1e-9 (defaults 0.25 and 0.75).",
+);
+/// The two constant weights sum to 1.
+pub const WEIGHT_SUM: CrossRule = CrossRule::invalid(
+    "WEIGHT_SUM",
+    &[
+        "/options/constant_weights",
+        "/options/constant_weights/subjective",
+    ],
+    "The two constant (or subjective) weights sum to 1 within 1e-9.",
+);
+/// The entropy time is one of the requested times.
+pub const ENTROPY_TIME: CrossRule = CrossRule::invalid(
+    "ENTROPY_TIME",
+    &["/options/constant_weights/entropy_at_h", "/times_h"],
+    "constant_weights.entropy_at_h is one of times_h (within 1e-12 relative).",
+);
+
+/// The rules between fields of `POST /v1/component-importance` and the failures of its
+/// computation, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    DUPLICATE_ID,
+    UNKNOWN_ID,
+    SELF_LOOP,
+    DUPLICATE_EDGE,
+    OVERRIDE_TIME,
+    WEIBULL_REQUIRED,
+    MODE_DATA_REQUIRED,
+    MODE_DATA_CONFLICT,
+    MODE_SUM_OVERFLOW,
+    Q_PLUS_O,
+    WEIGHT_SUM,
+    ENTROPY_TIME,
+    SIMPLE_PATH_BUDGET_RULE,
+    PROPAGATION_PATH_BUDGET_RULE,
+    BUDGET_RULE,
+    HAZARD_RATE_RULE,
+    NUMERICAL_RULE,
+    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
+];
+
 /// Q + O = 1 and Σω_c = 1 are checked to this absolute tolerance (spec §2).
 pub const SUM_TOL: f64 = 1e-9;
 /// Σα of a component may differ from 1 by this much before a warning (spec §2).
@@ -150,35 +259,16 @@ fn times_match(a: f64, b: f64) -> bool {
     (a - b).abs() <= TIME_MATCH_REL_TOL * a.abs().max(b.abs())
 }
 
+/// The pair's sum (each weight positive and the count 2: checked at the door).
 fn weight_pair(v: &mut Validator, pointer: &str, w: &[f64]) -> Option<[f64; 2]> {
-    if w.len() != 2 {
-        v.push(
-            pointer,
-            format!(
-                "constant weights must be 2 numbers (probability, risk), got {}",
-                w.len()
-            ),
-        );
-        return None;
-    }
-    let mut ok = true;
-    for (k, &x) in w.iter().enumerate() {
-        let p = format!("{pointer}/{k}");
-        ok &= v.range(&p, "weight", x, WEIGHT);
-    }
-    if ok && (w[0] + w[1] - 1.0).abs() > SUM_TOL {
-        v.push(
-            pointer,
-            format!(
-                "weights must sum to 1 (±{SUM_TOL:e}), got {} + {} = {}",
-                w[0],
-                w[1],
-                w[0] + w[1]
-            ),
-        );
-        ok = false;
-    }
-    ok.then(|| [w[0], w[1]])
+    let &[a, b] = w else { return None };
+    v.ensure_rule((a + b - 1.0).abs() <= SUM_TOL, &WEIGHT_SUM, pointer, || {
+        format!(
+            "weights must sum to 1 (±{SUM_TOL:e}), got {a} + {b} = {}",
+            a + b
+        )
+    })
+    .then_some([a, b])
 }
 
 /// Per time: the overrides of one quantity (F or RI) per component (`None` for times without
@@ -210,26 +300,14 @@ fn all_times(ov: &[Option<Vec<Option<f64>>>], i: usize) -> bool {
         .all(|t| t.as_ref().is_some_and(|row| row[i].is_some()))
 }
 
-/// The component count and the ids; returns the index of every valid first occurrence.
+/// The ids (count and lengths checked at the door); returns the index of every first occurrence.
 fn ids<'a>(v: &mut Validator, components: &'a [ComponentSpec]) -> HashMap<&'a str, usize> {
-    let n = components.len();
-    v.ensure(
-        (MIN_COMPONENTS..=MAX_COMPONENTS).contains(&n),
-        "/components",
-        || format!("needs {MIN_COMPONENTS} to {MAX_COMPONENTS} components, got {n}"),
-    );
-    let mut index_of: HashMap<&str, usize> = HashMap::with_capacity(n);
+    let mut index_of: HashMap<&str, usize> = HashMap::with_capacity(components.len());
     for (i, c) in components.iter().enumerate() {
-        let p = format!("/components/{i}/id");
-        let len = c.id.chars().count();
-        if len == 0 || len > MAX_ID_CHARS {
-            v.push(
-                &p,
-                format!("id must have 1 to {MAX_ID_CHARS} characters, got {len}"),
-            );
-        } else if let Some(&j) = index_of.get(c.id.as_str()) {
-            v.push(
-                &p,
+        if let Some(&j) = index_of.get(c.id.as_str()) {
+            v.rule(
+                &DUPLICATE_ID,
+                format!("/components/{i}/id"),
                 format!("duplicate id \"{}\" (first at /components/{j}/id)", c.id),
             );
         } else {
@@ -239,37 +317,24 @@ fn ids<'a>(v: &mut Validator, components: &'a [ComponentSpec]) -> HashMap<&'a st
     index_of
 }
 
-/// The evaluation times.
-fn times(v: &mut Validator, times_h: &[f64]) {
-    let nt = times_h.len();
-    v.ensure((1..=MAX_TIMES).contains(&nt), "/times_h", || {
-        format!("needs 1 to {MAX_TIMES} times, got {nt}")
-    });
-    for (k, &t) in times_h.iter().enumerate() {
-        // t = 0 makes F = 0 (every index 0) and λ infinite for β < 1 (spec §6 H1).
-        v.range(&format!("/times_h/{k}"), "", t, TIME_H);
-    }
-}
-
-/// One quantity of an override (`ptr` = `/overrides/{k}/F` or `/overrides/{k}/RI`): the valid
-/// values per component of `n`.
+/// One quantity of an override (`ptr` = `/overrides/{k}/F` or `/overrides/{k}/RI`; the values'
+/// ranges are checked at the door): the values per component of `n`.
 fn override_values(
     v: &mut Validator,
-    (ptr, name, range): (&str, &str, Range),
+    ptr: &str,
     values: &BTreeMap<String, f64>,
     index_of: &HashMap<&str, usize>,
     n: usize,
 ) -> Vec<Option<f64>> {
     let mut out = vec![None; n];
     for (id, &x) in values {
-        let p = format!("{ptr}/{}", pointer_token(id));
         match index_of.get(id.as_str()) {
-            None => v.push(p, format!("unknown component id \"{id}\"")),
-            Some(&i) => {
-                if v.range(&p, name, x, range) {
-                    out[i] = Some(x);
-                }
-            }
+            None => v.rule(
+                &UNKNOWN_ID,
+                format!("{ptr}/{}", pointer_token(id)),
+                format!("unknown component id \"{id}\""),
+            ),
+            Some(&i) => out[i] = Some(x),
         }
     }
     out
@@ -287,19 +352,18 @@ fn overrides(
     let mut override_of_time: Vec<Option<usize>> = vec![None; nt];
     for (k, o) in req.overrides.iter().enumerate() {
         let pt = format!("/overrides/{k}/time_h");
-        if !v.finite(&pt, o.time_h) {
-            continue;
-        }
         let ts = find_time(&req.times_h, o.time_h);
         if ts.is_empty() {
-            v.push(
+            v.rule(
+                &OVERRIDE_TIME,
                 &pt,
                 format!("override time {} h is not one of times_h", o.time_h),
             );
             continue;
         }
         if let Some(prev) = override_of_time[ts[0]] {
-            v.push(
+            v.rule(
+                &OVERRIDE_TIME,
                 &pt,
                 format!(
                     "second override for time {} h (first at /overrides/{prev})",
@@ -308,10 +372,8 @@ fn overrides(
             );
             continue;
         }
-        let pf = format!("/overrides/{k}/F");
-        let fo = override_values(v, (&pf, "F", PROBABILITY), &o.f, index_of, n);
-        let pr = format!("/overrides/{k}/RI");
-        let ro = override_values(v, (&pr, "RI [1/h]", NON_NEGATIVE), &o.ri, index_of, n);
+        let fo = override_values(v, &format!("/overrides/{k}/F"), &o.f, index_of, n);
+        let ro = override_values(v, &format!("/overrides/{k}/RI"), &o.ri, index_of, n);
         for &t in &ts {
             override_of_time[t] = Some(k);
             f_override[t] = Some(fo.clone());
@@ -321,31 +383,29 @@ fn overrides(
     (f_override, ri_override)
 }
 
-/// The Weibull data of component `c` (`base` = `/components/{i}`); `covered`: the overrides give
-/// both F and RI at every time, so the data may be absent.
+/// The Weibull data of component `c` (`base` = `/components/{i}`; ranges checked at the door);
+/// `covered`: the overrides give both F and RI at every time, so the data may be absent.
 fn weibull(v: &mut Validator, base: &str, c: &ComponentSpec, covered: bool) -> Option<(f64, f64)> {
-    match c.weibull {
-        Some(w) => {
-            let ok_eta = v.range(&format!("{base}/weibull/eta_h"), "", w.eta_h, ETA_H);
-            let ok_beta = v.range(&format!("{base}/weibull/beta"), "", w.beta, BETA);
-            (ok_eta && ok_beta).then_some((w.eta_h, w.beta))
-        }
-        None if covered => None,
-        None => {
-            v.push(
-                format!("{base}/weibull"),
-                format!(
-                    "component \"{}\" needs Weibull data (eta_h, beta) unless overrides give \
-                     both F and RI at every time",
-                    c.id
-                ),
-            );
-            None
-        }
+    if let Some(w) = c.weibull {
+        return Some((w.eta_h, w.beta));
     }
+    v.ensure_rule(
+        covered,
+        &WEIBULL_REQUIRED,
+        format!("{base}/weibull"),
+        || {
+            format!(
+                "component \"{}\" needs Weibull data (eta_h, beta) unless overrides give \
+             both F and RI at every time",
+                c.id
+            )
+        },
+    );
+    None
 }
 
-/// S = Σ α·impact of the failure modes of component `id` at `p` (warns when Σα is not 1).
+/// S = Σ α·impact of the failure modes of component `id` at `p` (warns when Σα is not 1; the
+/// count and the ranges are checked at the door).
 fn failure_modes(
     v: &mut Validator,
     p: String,
@@ -353,23 +413,14 @@ fn failure_modes(
     id: &str,
     warnings: &mut Vec<Finding>,
 ) -> Option<f64> {
-    if modes.is_empty() {
-        v.push(&p, "needs at least one failure mode".to_owned());
-    }
-    let mut ok = !modes.is_empty();
-    let (mut sum_alpha, mut s) = (0.0, 0.0);
-    for (m, fm) in modes.iter().enumerate() {
-        ok &= v.range(&format!("{p}/{m}/alpha"), "", fm.alpha, PROBABILITY);
-        let pi = format!("{p}/{m}/impact");
-        ok &= v.range(&pi, "impact", fm.impact, NON_NEGATIVE);
-        sum_alpha += fm.alpha;
-        s += fm.alpha * fm.impact;
-    }
-    if ok && !s.is_finite() {
-        v.push(&p, "sum of alpha·impact exceeds the f64 range".to_owned());
-        ok = false;
-    }
-    if !ok {
+    let sum_alpha: f64 = modes.iter().map(|m| m.alpha).sum();
+    let s: f64 = modes.iter().map(|m| m.alpha * m.impact).sum();
+    if !s.is_finite() {
+        v.rule(
+            &MODE_SUM_OVERFLOW,
+            &p,
+            "sum of alpha·impact exceeds the f64 range".to_owned(),
+        );
         return None;
     }
     if (sum_alpha - 1.0).abs() > ALPHA_SUM_WARN_TOL {
@@ -393,28 +444,29 @@ fn mode_sum(
 ) -> Option<f64> {
     match (&c.failure_modes, c.mode_sum) {
         (Some(_), Some(_)) => {
-            v.push(
+            v.rule(
+                &MODE_DATA_CONFLICT,
                 format!("{base}/mode_sum"),
                 "give either failure_modes or mode_sum, not both".to_owned(),
             );
             None
         }
-        (None, Some(s)) => {
-            let p = format!("{base}/mode_sum");
-            v.range(&p, "mode_sum", s, NON_NEGATIVE).then_some(s)
-        }
+        (None, Some(s)) => Some(s),
         (Some(modes), None) => {
             failure_modes(v, format!("{base}/failure_modes"), modes, &c.id, warnings)
         }
-        (None, None) if ri_all => None,
         (None, None) => {
-            v.push(
+            v.ensure_rule(
+                ri_all,
+                &MODE_DATA_REQUIRED,
                 format!("{base}/failure_modes"),
-                format!(
-                    "component \"{}\" needs failure_modes or mode_sum (RI = λ·Σα·impact) \
-                     unless overrides give RI at every time",
-                    c.id
-                ),
+                || {
+                    format!(
+                        "component \"{}\" needs failure_modes or mode_sum (RI = λ·Σα·impact) \
+                         unless overrides give RI at every time",
+                        c.id
+                    )
+                },
             );
             None
         }
@@ -431,8 +483,8 @@ fn components(
     let mut d = ComponentData {
         weibull: vec![None; n],
         mode_sum: vec![None; n],
-        efficiency_override: vec![None; n],
-        level_override: vec![None; n],
+        efficiency_override: components.iter().map(|c| c.efficiency_override).collect(),
+        level_override: components.iter().map(|c| c.level_override).collect(),
         warnings: Vec::new(),
     };
     for (i, c) in components.iter().enumerate() {
@@ -441,35 +493,17 @@ fn components(
         let ri_all = all_times(ri_override, i);
         d.weibull[i] = weibull(v, &base, c, f_all && ri_all);
         d.mode_sum[i] = mode_sum(v, &base, c, ri_all, &mut d.warnings);
-        if let Some(x) = c.efficiency_override {
-            let p = format!("{base}/efficiency_override");
-            if v.range(&p, "efficiency_override", x, NON_NEGATIVE) {
-                d.efficiency_override[i] = Some(x);
-            }
-        }
-        if let Some(h) = c.level_override
-            && v.uint(
-                &format!("{base}/level_override"),
-                "level_override",
-                u64::from(h),
-                LEVEL,
-            )
-        {
-            d.level_override[i] = Some(h);
-        }
     }
     d
 }
 
-/// The edges as component index pairs; `None` when any edge is invalid.
+/// The edges as component index pairs (at least one: checked at the door); `None` when any edge
+/// is invalid.
 fn edges(
     v: &mut Validator,
     req_edges: &[[String; 2]],
     index_of: &HashMap<&str, usize>,
 ) -> Option<Vec<(usize, usize)>> {
-    v.ensure(!req_edges.is_empty(), "/edges", || {
-        "needs at least one edge (without edges every index is 0)".to_owned()
-    });
     let mut edges: Vec<(usize, usize)> = Vec::with_capacity(req_edges.len());
     let mut edges_ok = true;
     let mut seen: HashMap<(usize, usize), usize> = HashMap::with_capacity(req_edges.len());
@@ -478,7 +512,8 @@ fn edges(
         let ib = index_of.get(b.as_str()).copied();
         for (end, id, index) in [(0, a, ia), (1, b, ib)] {
             if index.is_none() {
-                v.push(
+                v.rule(
+                    &UNKNOWN_ID,
                     format!("/edges/{k}/{end}"),
                     format!("unknown component id \"{id}\""),
                 );
@@ -489,7 +524,8 @@ fn edges(
             continue;
         };
         if ia == ib {
-            v.push(
+            v.rule(
+                &SELF_LOOP,
                 format!("/edges/{k}"),
                 format!("self-loop \"{a}\" -> \"{a}\": a component cannot propagate to itself"),
             );
@@ -497,7 +533,8 @@ fn edges(
             continue;
         }
         if let Some(&first) = seen.get(&(ia, ib)) {
-            v.push(
+            v.rule(
+                &DUPLICATE_EDGE,
                 format!("/edges/{k}"),
                 format!("duplicate edge \"{a}\" -> \"{b}\" (first at /edges/{first})"),
             );
@@ -518,19 +555,14 @@ fn weights(v: &mut Validator, w: &ConstantWeights, times_h: &[f64]) -> Option<We
         }
         ConstantWeights::Entropy(e) => {
             let s = weight_pair(v, "/options/constant_weights/subjective", &e.subjective);
-            let p = "/options/constant_weights/entropy_at_h";
-            let t = if v.finite(p, e.entropy_at_h) {
-                let ts = find_time(times_h, e.entropy_at_h);
-                if ts.is_empty() {
-                    v.push(
-                        p,
-                        format!("entropy time {} h is not one of times_h", e.entropy_at_h),
-                    );
-                }
-                ts.first().copied()
-            } else {
-                None
-            };
+            let t = find_time(times_h, e.entropy_at_h).first().copied();
+            if t.is_none() {
+                v.rule(
+                    &ENTROPY_TIME,
+                    "/options/constant_weights/entropy_at_h",
+                    format!("entropy time {} h is not one of times_h", e.entropy_at_h),
+                );
+            }
             s.zip(t)
                 .map(|(subjective, time_index)| WeightSpec::Entropy {
                     subjective,
@@ -540,35 +572,39 @@ fn weights(v: &mut Validator, w: &ConstantWeights, times_h: &[f64]) -> Option<We
     }
 }
 
-/// The options: Q and O, the constant weights, K and the enumeration budget; returns the weights.
+/// The options with their defaults: Q and O (their sum), the constant weights; returns the
+/// weights. (Each option's range is checked at the door.)
 fn options(v: &mut Validator, o: &Options, times_h: &[f64]) -> Option<WeightSpec> {
-    let ok_q = v.range("/options/q_in", "", o.q_in, PROBABILITY);
-    let ok_o = v.range("/options/o_out", "", o.o_out, PROBABILITY);
-    if ok_q && ok_o && (o.q_in + o.o_out - 1.0).abs() > SUM_TOL {
-        v.push(
-            "/options/o_out",
+    let q = o.q_in.unwrap_or(DEFAULT_Q_IN);
+    let out = o.o_out.unwrap_or(DEFAULT_O_OUT);
+    v.ensure_rule(
+        (q + out - 1.0).abs() <= SUM_TOL,
+        &Q_PLUS_O,
+        "/options/o_out",
+        || {
             format!(
-                "Q + O must equal 1 (±{SUM_TOL:e}), got {} + {} = {}",
-                o.q_in,
-                o.o_out,
-                o.q_in + o.o_out
-            ),
-        );
+                "Q + O must equal 1 (±{SUM_TOL:e}), got {q} + {out} = {}",
+                q + out
+            )
+        },
+    );
+    weights(v, &o.constant_weights, times_h)
+}
+
+/// The failure of a graph the edge rules above admitted (unreachable: the same rules).
+fn graph_failure(e: &GraphError) -> CalcFailure {
+    match *e {
+        GraphError::OutOfRange { index } => {
+            UNKNOWN_ID.fail(format!("/edges/{index}"), "edge names an unknown component")
+        }
+        GraphError::SelfLoop { index } => {
+            SELF_LOOP.fail(format!("/edges/{index}"), "self-loop edge")
+        }
+        GraphError::Duplicate { index, first } => DUPLICATE_EDGE.fail(
+            format!("/edges/{index}"),
+            format!("duplicate edge (first at /edges/{first})"),
+        ),
     }
-    let weights = weights(v, &o.constant_weights, times_h);
-    v.uint(
-        "/options/path_cap",
-        "path_cap K",
-        u64::from(o.path_cap),
-        PATH_CAP,
-    );
-    v.range(
-        "/options/max_simple_paths",
-        "",
-        o.max_simple_paths,
-        MAX_SIMPLE_PATHS,
-    );
-    weights
 }
 
 impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
@@ -576,32 +612,27 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
 
     fn try_from(req: ComponentImportanceRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
         let index_of = ids(&mut v, &req.components);
-        times(&mut v, &req.times_h);
         let (f_override, ri_override) = overrides(&mut v, &req, &index_of);
         let data = components(&mut v, &req.components, (&f_override, &ri_override));
         let edges = edges(&mut v, &req.edges, &index_of);
         let weights = options(&mut v, &req.options, &req.times_h);
         v.finish()?;
-        // Everything below was validated above; the fallbacks are unreachable.
+        // `finish` succeeded: the weights and edges were admitted by the rules above (the pair
+        // of weights holds two numbers when the door was passed).
         let (Some(weights), Some(edges)) = (weights, edges) else {
-            return Err(CalcFailure::general(
-                crate::calc::ProblemClass::InvalidInput,
-                "INVALID_INPUT",
-                "invalid options",
+            return Err(crate::calc::rules::door_skipped(
+                "/options/constant_weights",
             ));
         };
-        let (graph, edge_csr) = Digraph::from_edges(req.components.len(), &edges).map_err(|e| {
-            CalcFailure::general(
-                crate::calc::ProblemClass::InvalidInput,
-                "INVALID_INPUT",
-                format!("invalid edge list: {e:?}"),
-            )
-        })?;
+        let (graph, edge_csr) =
+            Digraph::from_edges(req.components.len(), &edges).map_err(|e| graph_failure(&e))?;
         let o = &req.options;
-        // max_simple_paths ∈ [1e3, 1e8] (validated): the cast is exact after rounding down.
-        let max_simple_paths = o.max_simple_paths.floor() as u64;
+        // max_simple_paths ∈ [1e3, 1e8] (the door): the cast is exact after rounding down.
+        let max_simple_paths = o
+            .max_simple_paths
+            .unwrap_or(DEFAULT_MAX_SIMPLE_PATHS)
+            .floor() as u64;
         Ok(Self {
             ids: req.components.into_iter().map(|c| c.id).collect(),
             graph,
@@ -613,10 +644,10 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
             times_h: req.times_h,
             f_override,
             ri_override,
-            q_in: o.q_in,
-            o_out: o.o_out,
+            q_in: o.q_in.unwrap_or(DEFAULT_Q_IN),
+            o_out: o.o_out.unwrap_or(DEFAULT_O_OUT),
             weights,
-            path_cap: o.path_cap as usize,
+            path_cap: o.path_cap.unwrap_or(DEFAULT_PATH_CAP) as usize,
             path_method: match o.path_method {
                 PathMethod::Exact => Paths::Exact,
                 PathMethod::Walks => Paths::Walks,

@@ -80,17 +80,29 @@ pub use wire::{ComponentImportanceRequest, ComponentImportanceResponse};
 use crate::calc::CalcFailure;
 use crate::numerics::Budget;
 
-/// Validate, compute and build the wire response (the HTTP layer calls this on the blocking pool).
+/// What runs in the job of `POST /v1/component-importance`, on a request that passed the door:
+/// compute and build the wire response.
 ///
 /// # Errors
-/// [`CalcFailure`] with every invalid field, or the computation's failure
-/// ([`ComponentImportanceError`] converted).
+/// The computation's failure ([`ComponentImportanceError`] converted).
+pub fn run_valid(
+    input: &ComponentImportanceInput,
+    budget: &Budget,
+) -> Result<ComponentImportanceResponse, CalcFailure> {
+    let started = Instant::now();
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, out, started))
+}
+
+/// The whole path of a request without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
+///
+/// # Errors
+/// As the endpoint: every offending field with its JSON pointer, or the computation's failure.
 pub fn run(
     req: ComponentImportanceRequest,
     budget: &Budget,
 ) -> Result<ComponentImportanceResponse, CalcFailure> {
-    let started = Instant::now();
-    let input = ComponentImportanceInput::try_from(req)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, out, started))
+    crate::calc::rules::check(&req)?;
+    run_valid(&ComponentImportanceInput::try_from(req)?, budget)
 }

@@ -33,11 +33,14 @@ use crate::numerics::SolverReport;
 }))]
 pub struct ComponentImportanceRequest {
     /// Components in output order (also the tie-break order of the ranking); 2–2000 entries.
+    #[rule(min_items = MIN_COMPONENTS, max_items = MAX_COMPONENTS)]
     pub components: Vec<ComponentSpec>,
     /// Directed fault-propagation edges `[from_id, to_id]`: a fault of `from` directly causes a
     /// fault of `to` (paper adjacency A). At least one; no self-loops, no duplicates.
+    #[rule(min_items = 1)]
     pub edges: Vec<[String; 2]>,
     /// Operating ages t at which the importance is evaluated \[h\]; 1–1000 values, each > 0.
+    #[rule(items = TIME_H, min_items = 1, max_items = MAX_TIMES)]
     pub times_h: Vec<f64>,
     /// Per-time replacements of the Weibull-derived F_i(t) and RI_i(t) (reproduce paper inputs).
     #[serde(
@@ -54,6 +57,7 @@ pub struct ComponentImportanceRequest {
     pub outputs: Outputs,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
 }
@@ -70,6 +74,7 @@ impl crate::calc::common::TimeLimited for ComponentImportanceRequest {
 #[serde(deny_unknown_fields)]
 pub struct ComponentSpec {
     /// Unique label, 1–64 characters.
+    #[rule(min_length = 1, max_length = MAX_ID_CHARS)]
     #[schema(example = "S")]
     pub id: String,
     /// Two-parameter Weibull life distribution (paper Table 4). Required unless `overrides`
@@ -80,16 +85,20 @@ pub struct ComponentSpec {
     /// Failure modes {α, impact} (paper Table 5). Required unless `mode_sum` is given (or RI is
     /// overridden at every time).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(min_items = 1)]
     pub failure_modes: Option<Vec<FailureMode>>,
     /// S_i = Σ α·impact given directly [–]; replaces `failure_modes`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = NON_NEGATIVE)]
     pub mode_sum: Option<f64>,
     /// Replaces the computed node efficiency I_i (Eq. 1) [–]; needed to reproduce the paper
     /// (it uses 0.20 for D and G, spec §3.11-2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = NON_NEGATIVE)]
     pub efficiency_override: Option<f64>,
     /// Replaces the hierarchy number h_i (1 = most upstream) [–].
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = LEVEL)]
     pub level_override: Option<u32>,
 }
 
@@ -99,9 +108,11 @@ pub struct ComponentSpec {
 #[serde(deny_unknown_fields)]
 pub struct Weibull {
     /// Scale η \[h\] (same unit as `times_h`); finite, > 0.
+    #[rule(range = ETA_H)]
     #[schema(example = 7832.7)]
     pub eta_h: f64,
     /// Shape β [–]; 0.05 ≤ β ≤ 20.
+    #[rule(range = BETA)]
     #[schema(example = 0.6414)]
     pub beta: f64,
 }
@@ -112,9 +123,11 @@ pub struct Weibull {
 #[serde(deny_unknown_fields)]
 pub struct FailureMode {
     /// α: share of this mode among the component's faults [–], in [0, 1].
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.142857)]
     pub alpha: f64,
     /// ANP influence degree of the mode [–], ≥ 0.
+    #[rule(range = NON_NEGATIVE)]
     #[schema(example = 0.07288)]
     pub impact: f64,
 }
@@ -133,6 +146,7 @@ pub struct TimeOverride {
         deserialize_with = "crate::calc::rules::null_default",
         skip_serializing_if = "BTreeMap::is_empty"
     )]
+    #[rule(values = PROBABILITY)]
     pub f: BTreeMap<String, f64>,
     /// Failure-mode risk RI_i(t) [1/h] per id, ≥ 0.
     #[serde(
@@ -141,6 +155,7 @@ pub struct TimeOverride {
         deserialize_with = "crate::calc::rules::null_default",
         skip_serializing_if = "BTreeMap::is_empty"
     )]
+    #[rule(values = NON_NEGATIVE)]
     pub ri: BTreeMap<String, f64>,
 }
 
@@ -151,6 +166,7 @@ pub struct TimeOverride {
 #[serde(untagged)]
 pub enum ConstantWeights {
     /// `[ω_c¹, ω_c²]`, each > 0, sum 1.
+    #[rule(items = WEIGHT, min_items = 2, max_items = 2)]
     Fixed(Vec<f64>),
     /// Average of subjective weights and entropy weights at one of the requested times.
     Entropy(EntropyWeights),
@@ -168,6 +184,7 @@ impl Default for ConstantWeights {
 #[serde(deny_unknown_fields)]
 pub struct EntropyWeights {
     /// Subjective (e.g. Delphi) weights `[w1, w2]`, each > 0, sum 1.
+    #[rule(items = WEIGHT, min_items = 2, max_items = 2)]
     pub subjective: Vec<f64>,
     /// The time t0 \[h\] whose normalized indices define the entropy weights; one of `times_h`.
     pub entropy_at_h: f64,
@@ -215,83 +232,71 @@ pub enum BetweennessMode {
     ShortestPaths,
 }
 
-/// Method options. Every field is optional; the defaults reproduce the paper.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
+/// Method options. Every field is optional (`null` = absent); the defaults reproduce the paper.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::Options)]
 #[serde(deny_unknown_fields)]
-#[rules(legacy_nulls)]
 pub struct Options {
     /// In-degree coefficient Q [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.25.
-    #[serde(default = "default_q_in")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.25, default = 0.25)]
-    pub q_in: f64,
+    pub q_in: Option<f64>,
     /// Out-degree coefficient O [–] (Eq. 4), in [0, 1]; Q + O = 1. Default 0.75.
-    #[serde(default = "default_o_out")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.75, default = 0.75)]
-    pub o_out: f64,
+    pub o_out: Option<f64>,
     /// Constant weights ω_c (probability, risk); default the paper's [0.520614, 0.479386].
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub constant_weights: ConstantWeights,
     /// K: maximal path length (edges) in the propagation sum, 1–8. Default 3.
-    #[serde(default = "default_path_cap")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = PATH_CAP)]
     #[schema(example = 3, default = 3)]
-    pub path_cap: u32,
+    pub path_cap: Option<u32>,
     /// Simple paths (`exact`, default) or walks.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub path_method: PathMethod,
     /// Hierarchy level mode (default `paper`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub levels: LevelsMode,
     /// Edge betweenness definition (default `all_simple_paths`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub betweenness: BetweennessMode,
     /// Enumeration budget (number of simple paths) on graphs with cycles, 1e3–1e8. Default 2e6.
-    #[serde(default = "default_max_simple_paths")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = MAX_SIMPLE_PATHS)]
     #[schema(example = 2_000_000.0, default = 2_000_000.0)]
-    pub max_simple_paths: f64,
+    pub max_simple_paths: Option<f64>,
 }
 
-fn default_q_in() -> f64 {
-    0.25
-}
-fn default_o_out() -> f64 {
-    0.75
-}
-fn default_path_cap() -> u32 {
-    3
-}
-fn default_max_simple_paths() -> f64 {
-    2e6
-}
+/// Default in-degree coefficient Q (paper).
+pub const DEFAULT_Q_IN: f64 = 0.25;
+/// Default out-degree coefficient O (paper).
+pub const DEFAULT_O_OUT: f64 = 0.75;
+/// Default path cap K (paper).
+pub const DEFAULT_PATH_CAP: u32 = 3;
+/// Default enumeration budget of simple paths.
+pub const DEFAULT_MAX_SIMPLE_PATHS: f64 = 2e6;
 
-impl Default for Options {
-    fn default() -> Self {
-        Self {
-            q_in: default_q_in(),
-            o_out: default_o_out(),
-            constant_weights: ConstantWeights::default(),
-            path_cap: default_path_cap(),
-            path_method: PathMethod::Exact,
-            levels: LevelsMode::Paper,
-            betweenness: BetweennessMode::AllSimplePaths,
-            max_simple_paths: default_max_simple_paths(),
-        }
-    }
-}
-
-/// Optional outputs (off by default except the cheap indices).
+/// Optional outputs (off by default except the cheap indices); `null` = absent.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = component_importance::Outputs)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct Outputs {
     /// Return the time-independent structure (B, I, levels, T, Hc, HE): O(n + m) payload.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub matrices: bool,
-    /// Return raw and normalized indices, variable weights and truncation bounds per time.
+    /// Return raw and normalized indices, variable weights and truncation bounds per time
+    /// (default true).
+    #[serde(deserialize_with = "crate::calc::rules::null_true")]
     pub indices: bool,
     /// Return F, λ and RI per time.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub reliability: bool,
     /// Compute standard centralities and Kendall τ_b against CI (extra O(n·m) work).
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub centralities: bool,
 }
 
@@ -507,8 +512,15 @@ pub struct KendallTau {
     pub pagerank_reversed: Option<f64>,
 }
 
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
+// The per-field rules of this module's wire types (`#[rule]` on the fields read these).
+/// Minimum number of components (one edge needs two).
+pub const MIN_COMPONENTS: usize = 2;
+/// Maximum number of components (spec §2).
+pub const MAX_COMPONENTS: usize = 2000;
+/// Maximum id length in characters (spec §2).
+pub const MAX_ID_CHARS: usize = 64;
+/// Maximum number of evaluation times (spec §2).
+pub const MAX_TIMES: usize = 1000;
 /// An operating time \[h\]: positive (t = 0 makes every index 0, spec §6 H1).
 pub const TIME_H: Range = Range::FINITE.gt(0.0);
 /// A constant weight of the probability/risk pair: positive (the pair sums to 1).
@@ -528,43 +540,3 @@ pub const LEVEL: Range = Range::INTEGER.min(1.0);
 pub const PATH_CAP: Range = Range::int(1, 8);
 /// Enumeration budget of simple paths [–] (spec §2).
 pub const MAX_SIMPLE_PATHS: Range = Range::closed(1e3, 1e8);
-
-crate::schema_bounds! {
-    ComponentImportanceRequest {
-        times_h @items: TIME_H,
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    Options {
-        max_simple_paths: MAX_SIMPLE_PATHS,
-    },
-    ComponentSpec {
-        mode_sum: NON_NEGATIVE,
-        efficiency_override: NON_NEGATIVE,
-        level_override: LEVEL,
-    },
-    Weibull {
-        eta_h: ETA_H,
-        beta: BETA,
-    },
-    FailureMode {
-        alpha: PROBABILITY,
-        impact: NON_NEGATIVE,
-    },
-    Options {
-        q_in: PROBABILITY,
-        o_out: PROBABILITY,
-        path_cap: PATH_CAP,
-    },
-}
-
-/// Bounds inside the untagged constant-weights alternatives and the per-id override maps
-/// (rendered inline).
-#[must_use]
-pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
-    use crate::calc::SchemaBound;
-    vec![
-        SchemaBound::at::<ConstantWeights>("/oneOf/0/items", WEIGHT),
-        SchemaBound::at::<TimeOverride>("/properties/F/additionalProperties", PROBABILITY),
-        SchemaBound::at::<TimeOverride>("/properties/RI/additionalProperties", NON_NEGATIVE),
-    ]
-}
