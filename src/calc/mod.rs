@@ -63,8 +63,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         cognates::wire::variant_bounds(),
         component_importance::wire::schema_bounds(),
         component_importance::wire::variant_bounds(),
-        continuum_workspace::wire::schema_bounds(),
-        continuum_workspace::wire::nested_bounds(),
         irefc::wire::schema_bounds(),
         irefc::stress::wire::schema_bounds(),
         irefc::efficiency::wire::schema_bounds(),
