@@ -45,6 +45,7 @@ pub fn document_rules() -> rules::DocRules {
         .of::<machining_size::TrainRequest>()
         .of::<machining_size::PredictRequest>()
         .of::<machining_size::AnalyzeRequest>()
+        .of::<machining_size::wire::GbdtModel>()
         .of::<spatial_coupling::SpatialCouplingRequest>()
         .of::<vibration_absorber::VibrationAbsorberRequest>()
 }
@@ -66,7 +67,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         irefc::wire::schema_bounds(),
         irefc::stress::wire::schema_bounds(),
         irefc::efficiency::wire::schema_bounds(),
-        machining_size::schema_bounds(),
         spatial_coupling::wire::schema_bounds(),
         spatial_coupling::wire::nested_bounds(),
         vibration_absorber::wire::schema_bounds(),

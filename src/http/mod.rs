@@ -175,6 +175,18 @@ pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRul
             "/v1/continuum-workspace",
             calc::continuum_workspace::input::CROSS_FIELD_RULES,
         ),
+        (
+            "/v1/machining-size/analyze",
+            calc::machining_size::input::ANALYZE_RULES,
+        ),
+        (
+            "/v1/machining-size/predict",
+            calc::machining_size::input::PREDICT_RULES,
+        ),
+        (
+            "/v1/machining-size/train",
+            calc::machining_size::input::TRAIN_RULES,
+        ),
     ]
 }
 
