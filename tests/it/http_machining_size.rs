@@ -552,8 +552,8 @@ fn cross_rule_cases() -> Vec<(&'static str, &'static str, Value, &'static str)> 
             PREDICT,
             "MODEL_INVALID",
             predict(&|b| {
-                b["model"]["xgboost_json"]["learner"]["gradient_booster"]["model"]["trees"][1]
-                    ["right_children"][0] = json!(999);
+                b["model"]["xgboost_json"]["learner"]["gradient_booster"]["model"]["trees"][1]["right_children"]
+                    [0] = json!(999);
             }),
             "/model/xgboost_json/learner/gradient_booster/model/trees/1/right_children/0",
         ),
