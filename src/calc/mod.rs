@@ -45,6 +45,7 @@ pub fn document_rules() -> rules::DocRules {
         .of::<machining_size::TrainRequest>()
         .of::<machining_size::PredictRequest>()
         .of::<machining_size::AnalyzeRequest>()
+        .of::<machining_size::wire::GbdtModel>()
         .of::<spatial_coupling::SpatialCouplingRequest>()
         .of::<vibration_absorber::VibrationAbsorberRequest>()
 }
@@ -59,12 +60,9 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         cam_law_fit::wire::schema_bounds(),
         cognates::wire::schema_bounds(),
         cognates::wire::variant_bounds(),
-        continuum_workspace::wire::schema_bounds(),
-        continuum_workspace::wire::nested_bounds(),
         irefc::wire::schema_bounds(),
         irefc::stress::wire::schema_bounds(),
         irefc::efficiency::wire::schema_bounds(),
-        machining_size::schema_bounds(),
         spatial_coupling::wire::schema_bounds(),
         spatial_coupling::wire::nested_bounds(),
         vibration_absorber::wire::schema_bounds(),

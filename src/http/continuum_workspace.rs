@@ -4,9 +4,9 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
 use crate::calc::continuum_workspace::{
-    self, ContinuumWorkspaceRequest, ContinuumWorkspaceResponse,
+    self, ContinuumWorkspaceRequest, ContinuumWorkspaceResponse, Input,
 };
 
 /// Forward kinematics and workspace of a planar parallel continuum manipulator.
@@ -37,11 +37,10 @@ use crate::calc::continuum_workspace::{
 )]
 pub async fn solve(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<ContinuumWorkspaceRequest>,
+    Valid { input, limit, .. }: Valid<ContinuumWorkspaceRequest, Input>,
 ) -> Result<Response, ApiError> {
-    let limit = continuum_workspace::time_limit(&req);
     run_calc(&state, limit, move |budget| {
-        continuum_workspace::run(req, budget)
+        continuum_workspace::run_valid(&input, budget)
     })
     .await
 }

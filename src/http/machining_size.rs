@@ -4,11 +4,10 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::common::TimeLimited;
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
 use crate::calc::machining_size::{
-    self, AnalyzeRequest, AnalyzeResponse, PredictRequest, PredictResponse, TrainRequest,
-    TrainResponse,
+    self, AnalyzeInput, AnalyzeRequest, AnalyzeResponse, PredictInput, PredictRequest,
+    PredictResponse, TrainInput, TrainRequest, TrainResponse,
 };
 
 /// Train a gradient-boosted tree model of a machined dimension.
@@ -32,11 +31,10 @@ use crate::calc::machining_size::{
 )]
 pub async fn train(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<TrainRequest>,
+    Valid { input, limit, .. }: Valid<TrainRequest, TrainInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        machining_size::run_train(req, budget)
+        machining_size::run_train_valid(&input, budget)
     })
     .await
 }
@@ -60,11 +58,10 @@ pub async fn train(
 )]
 pub async fn predict(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<PredictRequest>,
+    Valid { input, limit, .. }: Valid<PredictRequest, PredictInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        machining_size::run_predict(req, budget)
+        machining_size::run_predict_valid(&input, budget)
     })
     .await
 }
@@ -86,11 +83,10 @@ pub async fn predict(
 )]
 pub async fn analyze(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<AnalyzeRequest>,
+    Valid { input, limit, .. }: Valid<AnalyzeRequest, AnalyzeInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        machining_size::run_analyze(req, budget)
+        machining_size::run_analyze_valid(&input, budget)
     })
     .await
 }

@@ -422,3 +422,484 @@ async fn analyze_rules() {
         .sum();
     assert!((rates - 100.0).abs() < 1e-9);
 }
+
+/// `(endpoint, code, request, pointer)`: a request the schema accepts (the door passes it) that
+/// breaks one rule between fields.
+#[expect(clippy::too_many_lines, reason = "one table of cases, one rule each")]
+fn cross_rule_cases() -> Vec<(&'static str, &'static str, Value, &'static str)> {
+    let train = |patch: &dyn Fn(&mut Value)| {
+        let mut b = small_train();
+        patch(&mut b);
+        b
+    };
+    let smogn = |relevance: Value| {
+        train(&|b: &mut Value| {
+            b["preprocessing"] = json!({"smogn": {"relevance": relevance.clone()}});
+        })
+    };
+    let predict = |patch: &dyn Fn(&mut Value)| {
+        let mut b = example("predict_xgboost.json");
+        patch(&mut b);
+        b
+    };
+    let analyze = |patch: &dyn Fn(&mut Value)| {
+        let mut b = example("analyze_synthetic.json");
+        patch(&mut b);
+        b
+    };
+    let five = |n: usize| json!(vec![json!([1.0, 2.0, 3.0, 4.0, 5.0]); n]);
+    vec![
+        (
+            TRAIN,
+            "FEATURE_NAME_EMPTY",
+            train(&|b| b["feature_names"] = json!(["a", " "])),
+            "/feature_names/1",
+        ),
+        (
+            TRAIN,
+            "FEATURE_NAME_DUPLICATE",
+            train(&|b| b["feature_names"] = json!(["a", "a"])),
+            "/feature_names/1",
+        ),
+        (
+            TRAIN,
+            "ROW_WIDTH",
+            train(&|b| b["rows"][3] = json!([1.0])),
+            "/rows/3",
+        ),
+        (
+            TRAIN,
+            "TARGET_LENGTH",
+            train(&|b| b["target"] = json!([1.0, 2.0])),
+            "/target",
+        ),
+        (
+            TRAIN,
+            "CONSTANT_TARGET",
+            train(&|b| b["target"] = json!(vec![3.5; 30])),
+            "/target",
+        ),
+        (
+            TRAIN,
+            "REG_LAMBDA_ZERO",
+            train(&|b| {
+                b["params"]["reg_lambda"] = json!(0.0);
+                b["params"]["min_child_weight"] = json!(0.0);
+            }),
+            "/params/reg_lambda",
+        ),
+        (
+            TRAIN,
+            "TRAINING_ROWS",
+            train(&|b| b["params"]["min_child_weight"] = json!(20.0)),
+            "/params/min_child_weight",
+        ),
+        (
+            TRAIN,
+            "FOLD_ROWS",
+            train(&|b| {
+                b["params"]["min_child_weight"] = json!(8.0);
+                b["validation"]["k_fold"] = json!(2);
+            }),
+            "/validation/k_fold",
+        ),
+        (
+            TRAIN,
+            "ALL_FEATURES_CONSTANT",
+            train(&|b| b["rows"] = json!(vec![json!([1.0, 2.0]); 30])),
+            "/rows",
+        ),
+        (
+            TRAIN,
+            "COLSAMPLE_NO_FEATURE",
+            train(&|b| b["params"]["colsample_bytree"] = json!(0.4)),
+            "/params/colsample_bytree",
+        ),
+        (
+            TRAIN,
+            "SHARD_INDEX_BELOW_COUNT",
+            train(&|b| {
+                b["validation"]["k_fold"] = json!(3);
+                b["shard"] = json!({"index": 3, "count": 2});
+            }),
+            "/shard/index",
+        ),
+        (
+            TRAIN,
+            "SHARD_NOT_APPLICABLE",
+            train(&|b| b["shard"] = json!({"index": 0, "count": 2})),
+            "/shard",
+        ),
+        (
+            TRAIN,
+            "RELEVANCE_PHI",
+            smogn(json!([[0.0, 0.0], [1.0, 1.5]])),
+            "/preprocessing/smogn/relevance/1/1",
+        ),
+        (
+            TRAIN,
+            "RELEVANCE_ORDER",
+            smogn(json!([[1.0, 0.0], [0.5, 1.0]])),
+            "/preprocessing/smogn/relevance/1/0",
+        ),
+        (
+            TRAIN,
+            "SMOGN_DEGENERATE_RELEVANCE",
+            smogn(json!([[-10.0, 1.0], [10.0, 1.0]])),
+            "/preprocessing/smogn/relevance",
+        ),
+        (
+            PREDICT,
+            "MODEL_INVALID",
+            predict(&|b| {
+                b["model"]["xgboost_json"]["learner"]["gradient_booster"]["model"]["trees"][1]["right_children"]
+                    [0] = json!(999);
+            }),
+            "/model/xgboost_json/learner/gradient_booster/model/trees/1/right_children/0",
+        ),
+        (
+            PREDICT,
+            "UNSUPPORTED_MODEL",
+            predict(&|b| {
+                b["model"]["xgboost_json"]["learner"]["objective"]["name"] =
+                    json!("reg:pseudohubererror");
+            }),
+            "/model/xgboost_json/learner/objective/name",
+        ),
+        (
+            PREDICT,
+            "ROW_WIDTH",
+            predict(&|b| b["rows"][1] = json!([1.0, 2.0])),
+            "/rows/1",
+        ),
+        (
+            PREDICT,
+            "ROW_WIDTH",
+            predict(&|b| {
+                b["shap"] = json!("interventional");
+                b["background"] = json!([[1.0, 2.0]]);
+            }),
+            "/background/0",
+        ),
+        (
+            PREDICT,
+            "FEATURE_NAMES_MISMATCH",
+            predict(&|b| b["feature_names"][0] = json!("overhang")),
+            "/feature_names/0",
+        ),
+        (
+            PREDICT,
+            "BACKGROUND_REQUIRED",
+            predict(&|b| b["shap"] = json!("interventional")),
+            "/background",
+        ),
+        (
+            PREDICT,
+            "TOO_LARGE",
+            predict(&|b| {
+                b["rows"] = five(1001);
+                b["interactions"] = json!(true);
+            }),
+            "/interactions",
+        ),
+        (
+            ANALYZE,
+            "FEATURE_NAME_EMPTY",
+            analyze(&|b| b["feature_names"][2] = json!("")),
+            "/feature_names/2",
+        ),
+        (
+            ANALYZE,
+            "FEATURE_NAME_DUPLICATE",
+            analyze(&|b| b["feature_names"][2] = b["feature_names"][0].clone()),
+            "/feature_names/2",
+        ),
+        (
+            ANALYZE,
+            "ROW_WIDTH",
+            analyze(&|b| b["rows"][5] = json!([1.0])),
+            "/rows/5",
+        ),
+        (
+            ANALYZE,
+            "TARGET_LENGTH",
+            analyze(&|b| b["target"] = json!([1.0])),
+            "/target",
+        ),
+        (
+            ANALYZE,
+            "RELEVANCE_PHI",
+            analyze(&|b| b["smogn"]["relevance"][0][1] = json!(-0.5)),
+            "/smogn/relevance/0/1",
+        ),
+        (
+            ANALYZE,
+            "RELEVANCE_ORDER",
+            analyze(&|b| {
+                let y0 = b["smogn"]["relevance"][0][0].clone();
+                b["smogn"]["relevance"][1][0] = y0;
+            }),
+            "/smogn/relevance/1/0",
+        ),
+        (
+            ANALYZE,
+            "SMOGN_DEGENERATE_RELEVANCE",
+            analyze(&|b| {
+                b["smogn"]["relevance"] = json!([[-1e9, 1.0], [1e9, 1.0]]);
+            }),
+            "/smogn/relevance",
+        ),
+        (
+            ANALYZE,
+            "GRA_ZERO_MEAN",
+            analyze(&|b| {
+                let n = b["rows"].as_array().map_or(0, Vec::len);
+                for (i, r) in b["rows"]
+                    .as_array_mut()
+                    .expect("rows")
+                    .iter_mut()
+                    .enumerate()
+                {
+                    r[0] = json!(if i < n / 2 { -1.0 } else { 1.0 });
+                }
+            }),
+            "/gra/normalise",
+        ),
+    ]
+}
+
+/// Every code each machining-size operation lists under `x-cross-field-rules` is reachable: a
+/// request the schema accepts (the door passes it) that breaks the rule gets a 422 with that
+/// code, pointing at the field the rule names. The work limits that need large bodies or a
+/// spent budget are reached through the same conversion without HTTP.
+#[tokio::test]
+async fn every_listed_cross_field_rule_is_reachable() {
+    use mechcalc::calc::machining_size::{
+        self as ms, AnalyzeRequest, PredictRequest, TrainRequest,
+    };
+    use mechcalc::numerics::Budget;
+    use std::collections::{BTreeMap, BTreeSet};
+    let listed = |path: &str| -> BTreeSet<String> {
+        mechcalc::http::openapi::document()["paths"][path]["post"]["x-cross-field-rules"]
+            .as_array()
+            .expect("the operation lists its cross-field rules")
+            .iter()
+            .filter_map(|r| r["code"].as_str().map(str::to_owned))
+            .collect()
+    };
+    let mut reached: BTreeMap<&str, BTreeSet<String>> = BTreeMap::new();
+    for (path, code, body, pointer) in cross_rule_cases() {
+        let r = post_json(path, &body).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], code, "{path}: {p}");
+        assert!(listed(path).contains(code), "{path}: {code} is not listed");
+        assert!(
+            r.pointers().iter().any(|q| q == pointer),
+            "{path} {code}: {pointer} missing from {:?}",
+            r.pointers()
+        );
+        reached.entry(path).or_default().insert(code.to_owned());
+    }
+    // The SHAP cells and interventional pairs of /predict, the PCA score cells of /analyze.
+    let mut b = example("predict_xgboost.json");
+    b["rows"] = json!(vec![json!([1.0, 2.0, 3.0, 4.0, 5.0]); 2000]);
+    b["shap"] = json!("interventional");
+    b["background"] = json!(vec![json!([1.0, 2.0, 3.0, 4.0, 5.0]); 501]);
+    rejects(PREDICT, &b, "/background", Some("TOO_LARGE")).await;
+    let mut b: AnalyzeRequest =
+        serde_json::from_value(example("analyze_synthetic.json")).expect("request");
+    b.rows = vec![b.rows[0].clone(); 100_000];
+    b.target = (0..100_000).map(f64::from).collect();
+    b.pca = serde_json::from_value(json!({"components": 41, "scores": true})).expect("pca");
+    let e = ms::run_analyze(b, &Budget::unlimited()).expect_err("too many scores");
+    assert_eq!(
+        (e.code, e.errors[0].pointer.as_str()),
+        ("TOO_LARGE", "/pca/scores")
+    );
+    // A spent budget before answers that cannot be partial.
+    let spent = Budget::new(std::time::Duration::from_micros(1));
+    std::thread::sleep(std::time::Duration::from_millis(2));
+    let mut t = small_train();
+    t["preprocessing"] =
+        json!({"smogn": {"relevance": [[0.0, 0.0], [1.0, 1.0]], "threshold": 0.6}});
+    let t: TrainRequest = serde_json::from_value(t).expect("request");
+    let e = ms::run_train(t, &spent).expect_err("SMOGN cannot be partial");
+    assert_eq!(e.code, "DEADLINE_EXCEEDED", "{e}");
+    let p: PredictRequest =
+        serde_json::from_value(example("predict_xgboost.json")).expect("request");
+    let e = ms::run_predict(p, &spent).expect_err("SHAP cannot be partial");
+    assert_eq!(e.code, "DEADLINE_EXCEEDED", "{e}");
+    let a: AnalyzeRequest =
+        serde_json::from_value(example("analyze_synthetic.json")).expect("request");
+    let e = ms::run_analyze(a, &spent).expect_err("an analysis cannot be partial");
+    assert_eq!(e.code, "DEADLINE_EXCEEDED", "{e}");
+    for path in [TRAIN, PREDICT, ANALYZE] {
+        let set = reached.entry(path).or_default();
+        set.insert("DEADLINE_EXCEEDED".to_owned());
+        if path != TRAIN {
+            set.insert("TOO_LARGE".to_owned());
+        }
+    }
+    // Answers over the service's --max-response-bytes.
+    let small = mechcalc::AppState::new(mechcalc::config::ServiceConfig {
+        max_response_bytes: 600,
+        ..common::config()
+    });
+    for (path, body) in [
+        (TRAIN, small_train()),
+        (PREDICT, example("predict_xgboost.json")),
+        (ANALYZE, example("analyze_synthetic.json")),
+    ] {
+        let r = common::post_json_to(small.clone(), path, &body).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], "RESPONSE_TOO_LARGE", "{path}: {p}");
+        reached
+            .entry(path)
+            .or_default()
+            .insert("RESPONSE_TOO_LARGE".to_owned());
+    }
+    for path in [TRAIN, PREDICT, ANALYZE] {
+        let missing: Vec<String> = listed(path).difference(&reached[path]).cloned().collect();
+        assert!(
+            missing.is_empty(),
+            "{path}: listed but not reached: {missing:?}"
+        );
+    }
+}
+
+/// The answer without the fields that measure time.
+fn untimed(mut v: Value) -> Value {
+    fn strip(v: &mut Value) {
+        match v {
+            Value::Object(o) => {
+                o.remove("elapsed_ms");
+                o.remove("timing_ms");
+                o.values_mut().for_each(strip);
+            }
+            Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
+
+/// Sets each `(parent pointer, key)` the request does not give to `null`.
+fn with_nulls(mut b: Value, fields: &[(&str, &[&str])]) -> Value {
+    for (parent, keys) in fields {
+        let o = b
+            .pointer_mut(parent)
+            .and_then(Value::as_object_mut)
+            .expect("object");
+        for k in *keys {
+            assert!(!o.contains_key(*k), "{parent}/{k} is given");
+            o.insert((*k).to_owned(), Value::Null);
+        }
+    }
+    b
+}
+
+/// `null` for an optional field means absent, at every depth: each endpoint's example (and a
+/// small training request whose optional objects are absent) with every optional field it
+/// omits sent as `null` gives exactly the answer of the plain request.
+#[tokio::test]
+async fn null_optional_fields_read_as_absent() {
+    let params: &[&str] = &[
+        "reg_lambda",
+        "reg_alpha",
+        "gamma",
+        "min_child_weight",
+        "subsample",
+        "base_score",
+        "max_bin",
+    ];
+    let cases = [
+        (
+            TRAIN,
+            example("train_synthetic.json"),
+            vec![
+                ("", &["shard"][..]),
+                ("/params", params),
+                ("/preprocessing", &["smogn"][..]),
+            ],
+        ),
+        (
+            TRAIN,
+            small_train(),
+            vec![
+                (
+                    "",
+                    &["preprocessing", "outputs", "time_limit_ms", "shard"][..],
+                ),
+                (
+                    "/params",
+                    &[
+                        "reg_lambda",
+                        "gamma",
+                        "min_child_weight",
+                        "subsample",
+                        "seed",
+                        "base_score",
+                        "tree_method",
+                        "max_bin",
+                    ][..],
+                ),
+                ("/validation", &["k_fold", "seed"][..]),
+            ],
+        ),
+        (
+            PREDICT,
+            example("predict_xgboost.json"),
+            vec![("", &["background", "interactions", "time_limit_ms"][..])],
+        ),
+        (
+            ANALYZE,
+            example("analyze_synthetic.json"),
+            vec![
+                ("", &["time_limit_ms"][..]),
+                ("/pca", &["scores"][..]),
+                ("/smogn", &["include_data"][..]),
+            ],
+        ),
+    ];
+    for (path, plain, fields) in cases {
+        let nulls = with_nulls(plain.clone(), &fields);
+        let (a, b) = (post_json(path, &plain).await, post_json(path, &nulls).await);
+        assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+        assert_eq!(b.status, 200, "{}", String::from_utf8_lossy(&b.bytes));
+        assert_eq!(untimed(a.json()), untimed(b.json()), "{path}");
+    }
+    // Optional objects and their fields with struct defaults, sent as null.
+    let mut plain = small_train();
+    plain.as_object_mut().map(|o| o.remove("params"));
+    let mut nulls = plain.clone();
+    nulls["params"] = Value::Null;
+    nulls["validation"] = json!({"test_fraction": null, "k_fold": null, "seed": null});
+    plain["validation"] = json!({});
+    let (a, b) = (
+        post_json(TRAIN, &plain).await,
+        post_json(TRAIN, &nulls).await,
+    );
+    assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+    assert_eq!(untimed(a.json()), untimed(b.json()));
+    let mut analyze = example("analyze_synthetic.json");
+    analyze["gra"] = json!({});
+    analyze["smogn"] = json!({"relevance": analyze["smogn"]["relevance"].clone()});
+    let mut nulls = analyze.clone();
+    nulls["gra"] = json!({"rho": null, "normalise": null});
+    nulls["pca"] = json!({"components": null, "scores": null});
+    analyze["pca"] = json!({});
+    for k in ["threshold", "k", "perturbation", "seed", "include_data"] {
+        nulls["smogn"][k] = Value::Null;
+    }
+    let (a, b) = (
+        post_json(ANALYZE, &analyze).await,
+        post_json(ANALYZE, &nulls).await,
+    );
+    assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+    assert_eq!(untimed(a.json()), untimed(b.json()));
+    // A required field stays required: null is a 422 naming it.
+    let mut b = small_train();
+    b["target"] = Value::Null;
+    post_json(TRAIN, &b).await.assert_422_at(&["/target"]);
+}

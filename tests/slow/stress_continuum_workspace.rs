@@ -381,10 +381,18 @@ fn degenerate_designs_are_rejected_with_pointers() {
         w.iter()
             .any(|x| x.as_str().is_some_and(|s| s.starts_with("slender_rod")))
     );
-    // Every issue at once.
+    // Every issue at once: the per-field rules in one failure, then the rules between fields
+    // in one failure.
     let mut d = d1();
     d["rods"][0]["length_m"] = json!(-1.0);
     d["rods"][1]["youngs_modulus_pa"] = json!(0.0);
+    d["rods"][2]["diameter_m"] = json!(-0.004);
+    d["actuators"][0]["stroke_m"] = json!([1.0, 0.0]);
+    let e = call(fk(d)).expect_err("invalid");
+    assert!(e.errors.len() >= 3, "{:?}", e.errors);
+    let mut d = d1();
+    d["rods"][0]["diameter_m"] = json!(0.5);
+    d["rods"][2]["actuator"] = json!(3);
     d["actuators"][0]["stroke_m"] = json!([1.0, 0.0]);
     let e = call(fk(d)).expect_err("invalid");
     assert!(e.errors.len() >= 3, "{:?}", e.errors);

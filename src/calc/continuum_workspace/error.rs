@@ -2,6 +2,9 @@
 
 use crate::calc::{CalcFailure, ProblemClass};
 
+/// Code of an assembly mode index beyond the modes the search found.
+pub const ASSEMBLY_MODE_NOT_FOUND: &str = "ASSEMBLY_MODE_NOT_FOUND";
+
 /// Errors of [`super::compute::compute`].
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ContinuumError {
@@ -24,7 +27,7 @@ impl From<ContinuumError> for CalcFailure {
         match &e {
             ContinuumError::AssemblyModeNotFound { pointer, .. } => CalcFailure::field(
                 ProblemClass::NotConverged,
-                "ASSEMBLY_MODE_NOT_FOUND",
+                ASSEMBLY_MODE_NOT_FOUND,
                 *pointer,
                 format!("{e}; raise assembly_modes.n_grid or tol, or pick a lower index"),
             ),

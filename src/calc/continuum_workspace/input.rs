@@ -1,4 +1,7 @@
-//! Validation of the request into the SI domain input (spec 3), collecting every offending field.
+//! The rules between fields of a [`ContinuumWorkspaceRequest`] (spec 3), turning it into the SI
+//! domain [`Input`]. Every per-field rule (ranges, list lengths, the 4-or-8 neighbours, the
+//! power-of-two sub-steps) is declared on the wire types and checked at the door; what is left
+//! here is what JSON Schema cannot state, each rule with its own code ([`CROSS_FIELD_RULES`]).
 
 use std::time::Duration;
 
@@ -14,16 +17,189 @@ use super::wire::{
     StartRequest, WorkspaceRequest,
 };
 use crate::calc::common::{self, Shard};
-use crate::calc::{CalcFailure, ProblemClass, Validator};
+use crate::calc::{CalcFailure, CrossRule, Validator};
 
-use super::wire::{
-    ASSEMBLY_MODES_TOL, CELL, COND_MAX, CONTINUATION_STEPS, COORDINATE_M, DIAMETER_M, EI_NM2,
-    GRID_SIDE, JUMP_LIMITS_ANGLE_DEG, JUMP_LIMITS_POSITION_FACTOR, LENGTH_M, MAX_ACTUATORS,
-    MAX_REFINE, MAX_SUBSTEPS, MAX_TRIES, N_GRID, QUASI_TRANSLATIONAL_DEG, RK4_STEPS,
-    ROD_SHAPE_POINTS, SIGMA_ALLOW_PA, SOLVER_MAX_ITER, SOLVER_TOL, STABILITY_SEGMENTS,
-    SUBSTEP_MAX_ITER, YOUNGS_MODULUS_PA,
-};
-use crate::calc::Range;
+/// A design is either `preset` alone or explicit `actuators` and `rods`.
+pub const DESIGN_SOURCE: CrossRule = CrossRule::invalid(
+    "DESIGN_SOURCE",
+    &[
+        "/design/preset",
+        "/design/actuators",
+        "/design/rods",
+        "/design/home_inputs_m",
+    ],
+    "Give either design.preset (with at most sigma_allow_pa) or both design.actuators and \
+     design.rods (home_inputs_m only with an explicit design).",
+);
+/// A guide direction can be normalised.
+pub const DIRECTION_NORM: CrossRule = CrossRule::invalid(
+    "DIRECTION_NORM",
+    &["/design/actuators/*/direction"],
+    "The norm of each guide direction exceeds 1e-12.",
+);
+/// A stroke is an interval.
+pub const STROKE_ORDER: CrossRule = CrossRule::invalid(
+    "STROKE_ORDER",
+    &["/design/actuators/*/stroke_m"],
+    "Each stroke_m is [min, max] with min < max.",
+);
+/// A rod's actuator exists.
+pub const UNKNOWN_ACTUATOR: CrossRule = CrossRule::invalid(
+    "UNKNOWN_ACTUATOR",
+    &["/design/rods/*/actuator", "/design/actuators"],
+    "Each rod's actuator is an index of design.actuators.",
+);
+/// Every actuator moves some rod.
+pub const ACTUATOR_WITHOUT_ROD: CrossRule = CrossRule::invalid(
+    "ACTUATOR_WITHOUT_ROD",
+    &["/design/actuators/*", "/design/rods/*/actuator"],
+    "Every actuator carries at least one rod (else its input is undetermined).",
+);
+/// A rod's bending stiffness is known.
+pub const ROD_STIFFNESS: CrossRule = CrossRule::invalid(
+    "ROD_STIFFNESS",
+    &["/design/rods/*/diameter_m", "/design/rods/*/ei_nm2"],
+    "Each rod gives diameter_m or ei_nm2 (or both).",
+);
+/// A rod is slender enough for the rod model.
+pub const SLENDERNESS: CrossRule = CrossRule::invalid(
+    "SLENDERNESS",
+    &["/design/rods/*/diameter_m", "/design/rods/*/length_m"],
+    "Each rod's slenderness length_m / diameter_m is at least 5 (below 20 it is warned).",
+);
+/// The platform rotation is determined.
+pub const COINCIDENT_ATTACHMENTS: CrossRule = CrossRule::invalid(
+    "COINCIDENT_ATTACHMENTS",
+    &["/design/rods"],
+    "The rods' attachment points attach_m do not all coincide (spread above 1e-9 L_ref).",
+);
+/// One home input per actuator.
+pub const HOME_INPUTS_COUNT: CrossRule = CrossRule::invalid(
+    "HOME_INPUTS_COUNT",
+    &["/design/home_inputs_m", "/design/actuators"],
+    "design.home_inputs_m has one entry per actuator.",
+);
+/// Given home inputs really are the stress-free home.
+pub const HOME_NOT_STRESS_FREE: CrossRule = CrossRule::invalid(
+    "HOME_NOT_STRESS_FREE",
+    &["/design/home_inputs_m"],
+    "At design.home_inputs_m every rod is straight and unloaded with theta_EE = 0 (closure \
+     residual at most 1e-6 L_ref).",
+);
+/// Axial compliance needs the section.
+pub const EXTENSIBILITY_NEEDS_DIAMETER: CrossRule = CrossRule::invalid(
+    "EXTENSIBILITY_NEEDS_DIAMETER",
+    &["/solver/axial_extensibility", "/design/rods/*/diameter_m"],
+    "solver.axial_extensibility needs diameter_m on every rod (EA = E pi d^2/4).",
+);
+/// The load is within the design's own scale.
+pub const LOAD_LIMIT: CrossRule = CrossRule::invalid(
+    "LOAD_LIMIT",
+    &["/load/force_n", "/load/moment_nm"],
+    "|load.force_n| <= 1e4 EI_ref/L_ref^2 and |load.moment_nm| <= 1e4 EI_ref/L_ref (EI_ref, \
+     L_ref: the rods' mean bending stiffness and length).",
+);
+/// Modes `fk` and `assembly_modes` need the inputs.
+pub const INPUTS_REQUIRED: CrossRule = CrossRule::invalid(
+    "INPUTS_REQUIRED",
+    &["/inputs_m", "/mode"],
+    "inputs_m is given for mode fk and assembly_modes.",
+);
+/// One input per actuator.
+pub const INPUTS_COUNT: CrossRule = CrossRule::invalid(
+    "INPUTS_COUNT",
+    &["/inputs_m", "/design/actuators"],
+    "inputs_m (mode fk and assembly_modes) has one entry per actuator.",
+);
+/// Each input inside its stroke.
+pub const INPUT_OUTSIDE_STROKE: CrossRule = CrossRule::invalid(
+    "INPUT_OUTSIDE_STROKE",
+    &["/inputs_m/*", "/design/actuators/*/stroke_m"],
+    "Each input of inputs_m (mode fk and assembly_modes) lies inside its actuator's stroke_m.",
+);
+/// A warm start needs its state.
+pub const STATE_REQUIRED: CrossRule = CrossRule::invalid(
+    "STATE_REQUIRED",
+    &[
+        "/start/state",
+        "/start/kind",
+        "/workspace/seed/state",
+        "/workspace/seed/kind",
+    ],
+    "start.state (seed.state) is given when start.kind (seed.kind) is guess.",
+);
+/// A solver state fits the design.
+pub const STATE_LENGTH: CrossRule = CrossRule::invalid(
+    "STATE_LENGTH",
+    &["/start/state/v", "/workspace/seed/state/v", "/design/rods"],
+    "A solver state v has 3N+3 entries for N rods.",
+);
+/// A sweep runs over two inputs.
+pub const WORKSPACE_ACTUATORS: CrossRule = CrossRule::invalid(
+    "WORKSPACE_ACTUATORS",
+    &["/design/actuators", "/mode"],
+    "Mode workspace needs exactly 2 actuators (a 2-D input grid).",
+);
+/// A sweep's input ranges are intervals.
+pub const RANGE_ORDER: CrossRule = CrossRule::invalid(
+    "RANGE_ORDER",
+    &["/workspace/ranges_m/*"],
+    "Each workspace.ranges_m entry is [min, max] with min < max.",
+);
+/// A sweep's grid is within the node limit.
+pub const GRID_TOO_LARGE: CrossRule = CrossRule::too_large(
+    "GRID_TOO_LARGE",
+    &["/workspace/grid"],
+    "workspace.grid has n1 * n2 <= 40401 nodes (split the ranges into tiles, which can run in \
+     parallel).",
+);
+/// The assembly-mode search is within its combination limit.
+pub const SEARCH_TOO_LARGE: CrossRule = CrossRule::too_large(
+    "SEARCH_TOO_LARGE",
+    &["/assembly_modes/n_grid", "/design/rods"],
+    "When the assembly-mode search runs, (2 N_grid)^(2N) <= 1e8 grid combinations for N rods.",
+);
+/// Only a workspace sweep can be sharded.
+pub const SHARD_NOT_APPLICABLE: CrossRule = CrossRule::invalid(
+    "SHARD_NOT_APPLICABLE",
+    &["/shard", "/mode"],
+    "shard is given only with mode workspace (modes fk and assembly_modes are one job).",
+);
+/// The search found the requested assembly mode (found while computing).
+pub const ASSEMBLY_MODE_NOT_FOUND: CrossRule = CrossRule::not_converged(
+    super::error::ASSEMBLY_MODE_NOT_FOUND,
+    &["/start/index", "/workspace/seed/index"],
+    "The (non-certified) assembly-mode search finds more solutions than the requested index.",
+);
+
+/// The rules between fields of `POST /v1/continuum-workspace`, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    DESIGN_SOURCE,
+    DIRECTION_NORM,
+    STROKE_ORDER,
+    UNKNOWN_ACTUATOR,
+    ACTUATOR_WITHOUT_ROD,
+    ROD_STIFFNESS,
+    SLENDERNESS,
+    COINCIDENT_ATTACHMENTS,
+    HOME_INPUTS_COUNT,
+    HOME_NOT_STRESS_FREE,
+    EXTENSIBILITY_NEEDS_DIAMETER,
+    LOAD_LIMIT,
+    INPUTS_REQUIRED,
+    INPUTS_COUNT,
+    INPUT_OUTSIDE_STROKE,
+    STATE_REQUIRED,
+    STATE_LENGTH,
+    WORKSPACE_ACTUATORS,
+    RANGE_ORDER,
+    GRID_TOO_LARGE,
+    SEARCH_TOO_LARGE,
+    common::SHARD_INDEX_BELOW_COUNT,
+    SHARD_NOT_APPLICABLE,
+    ASSEMBLY_MODE_NOT_FOUND,
+    common::RESPONSE_TOO_LARGE_RULE,
+];
 
 /// Default Young's modulus (steel) [Pa] (spec 3.1).
 const DEFAULT_E: f64 = 2.1e11;
@@ -41,7 +217,8 @@ const MAX_LOAD_REL: f64 = 1e4;
 const MAX_GRID_NODES: u64 = 40_401;
 /// Largest number of closed-form grid combinations (spec 4.6).
 const MAX_COMBINATIONS: f64 = 1e8;
-/// Service-side ceiling of a request's own time limit \[ms\].
+/// Service-side ceiling of a request's own time limit \[ms\] (the upper end of
+/// [`common::TIME_LIMIT_MS`]).
 pub const MAX_TIME_LIMIT_MS: u64 = 600_000;
 /// Default stability segments in sweeps (spec 8 targets use M = 20; the sign is what matters).
 const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
@@ -189,29 +366,6 @@ fn preset_of(p: PresetName) -> Preset {
     }
 }
 
-/// An optional integer in `range` (the default when absent or out of range, which is reported).
-fn u32_in(v: &mut Validator, ptr: &str, x: Option<u32>, range: Range, default: u32) -> u32 {
-    match x {
-        Some(x) if !v.uint(ptr, "", u64::from(x), range) => default,
-        Some(x) => x,
-        None => default,
-    }
-}
-
-/// An optional number in `range` (the default when absent or out of range, which is reported).
-fn f64_in(v: &mut Validator, ptr: &str, x: Option<f64>, range: Range, default: f64) -> f64 {
-    match x {
-        Some(x) if v.range(ptr, "", x, range) => x,
-        Some(_) => default,
-        None => default,
-    }
-}
-
-/// Require every element finite and within [`COORDINATE_M`].
-fn coords(v: &mut Validator, ptr: &str, values: &[f64]) -> bool {
-    v.all_in(ptr, "", values, COORDINATE_M)
-}
-
 fn usize_of(x: u32) -> usize {
     usize::try_from(x).unwrap_or(usize::MAX)
 }
@@ -224,7 +378,8 @@ fn preset_design(v: &mut Validator, d: &DesignRequest, p: PresetName) -> (Design
         (d.home_inputs_m.is_some(), "home_inputs_m"),
     ] {
         if present {
-            v.push(
+            v.rule(
+                &DESIGN_SOURCE,
                 format!("/design/{name}"),
                 "must be absent when design.preset is given (presets fix the geometry)",
             );
@@ -233,37 +388,33 @@ fn preset_design(v: &mut Validator, d: &DesignRequest, p: PresetName) -> (Design
     let preset = preset_of(p);
     let mut design = preset.design();
     design.sigma_allow = d.sigma_allow_pa;
-    if let Some(s) = d.sigma_allow_pa {
-        v.range("/design/sigma_allow_pa", "", s, SIGMA_ALLOW_PA);
-    }
     (design, Some(preset))
 }
 
-/// Actuator `j`: origin, guide direction (normalised; `[1, 0]` when invalid) and stroke.
+/// Actuator `j`: origin, guide direction (normalised; `[1, 0]` when it cannot be) and stroke.
 fn actuator(v: &mut Validator, j: usize, a: &ActuatorRequest) -> Actuator {
     let p = format!("/design/actuators/{j}");
-    coords(v, &format!("{p}/origin_m"), &a.origin_m);
     let mut dir = [1.0, 0.0];
-    if v.all_finite(&format!("{p}/direction"), &a.direction) {
-        let nrm = a.direction[0].hypot(a.direction[1]);
-        if nrm > MIN_DIRECTION_NORM {
-            dir = [a.direction[0] / nrm, a.direction[1] / nrm];
-        } else {
-            v.push(
-                format!("{p}/direction"),
-                format!("norm must be > {MIN_DIRECTION_NORM}, got {nrm}"),
-            );
-        }
+    let nrm = a.direction[0].hypot(a.direction[1]);
+    if v.ensure_rule(
+        nrm > MIN_DIRECTION_NORM,
+        &DIRECTION_NORM,
+        format!("{p}/direction"),
+        || format!("norm must be > {MIN_DIRECTION_NORM}, got {nrm}"),
+    ) {
+        dir = [a.direction[0] / nrm, a.direction[1] / nrm];
     }
-    if coords(v, &format!("{p}/stroke_m"), &a.stroke_m) && a.stroke_m[0] >= a.stroke_m[1] {
-        v.push(
-            format!("{p}/stroke_m"),
+    v.ensure_rule(
+        a.stroke_m[0] < a.stroke_m[1],
+        &STROKE_ORDER,
+        format!("{p}/stroke_m"),
+        || {
             format!(
                 "min must be < max, got [{}, {}]",
                 a.stroke_m[0], a.stroke_m[1]
-            ),
-        );
-    }
+            )
+        },
+    );
     Actuator {
         origin: a.origin_m,
         dir,
@@ -271,51 +422,43 @@ fn actuator(v: &mut Validator, j: usize, a: &ActuatorRequest) -> Actuator {
     }
 }
 
-/// The actuators of an explicit design.
+/// The actuators of an explicit design (1..4 of them: checked at the door).
 fn actuators(v: &mut Validator, acts: Option<&[ActuatorRequest]>) -> Vec<Actuator> {
     let Some(acts) = acts else {
-        v.push("/design/actuators", "required (or give design.preset)");
+        v.rule(
+            &DESIGN_SOURCE,
+            "/design/actuators",
+            "required (or give design.preset)",
+        );
         return Vec::new();
     };
-    if acts.is_empty() || acts.len() > MAX_ACTUATORS {
-        v.push(
-            "/design/actuators",
-            format!("must list 1..{MAX_ACTUATORS} actuators, got {}", acts.len()),
-        );
-    }
     acts.iter()
         .enumerate()
         .map(|(j, a)| actuator(v, j, a))
         .collect()
 }
 
-/// The diameter of rod `i` (`p` = `/design/rods/{i}`) if given and valid, with its slenderness
-/// checked when the length is valid (`len_ok`).
+/// The diameter of rod `i` (`p` = `/design/rods/{i}`) if given, with its slenderness checked.
 fn rod_diameter(
     v: &mut Validator,
     (i, p): (usize, &str),
     r: &RodRequest,
-    len_ok: bool,
     warnings: &mut Vec<String>,
 ) -> Option<f64> {
     let dm = r.diameter_m?;
-    if !v.range(&format!("{p}/diameter_m"), "", dm, DIAMETER_M) {
-        return None;
-    }
-    if len_ok {
-        let slender = r.length_m / dm;
-        if slender < MIN_SLENDERNESS {
-            v.push(
-                format!("{p}/diameter_m"),
-                format!(
-                    "slenderness L/d = {slender:.3} is below {MIN_SLENDERNESS}: the rod model does not apply"
-                ),
-            );
-        } else if slender < WARN_SLENDERNESS {
-            warnings.push(format!(
-                "slender_rod {i}: L/d = {slender:.2} < {WARN_SLENDERNESS}, slender-rod (Kirchhoff) theory is inaccurate"
-            ));
-        }
+    let slender = r.length_m / dm;
+    if slender < MIN_SLENDERNESS {
+        v.rule(
+            &SLENDERNESS,
+            format!("{p}/diameter_m"),
+            format!(
+                "slenderness L/d = {slender:.3} is below {MIN_SLENDERNESS}: the rod model does not apply"
+            ),
+        );
+    } else if slender < WARN_SLENDERNESS {
+        warnings.push(format!(
+            "slender_rod {i}: L/d = {slender:.2} < {WARN_SLENDERNESS}, slender-rod (Kirchhoff) theory is inaccurate"
+        ));
     }
     Some(dm)
 }
@@ -329,43 +472,37 @@ fn rod(
     warnings: &mut Vec<String>,
 ) -> Rod {
     let p = format!("/design/rods/{i}");
-    if r.actuator >= n_act {
-        v.push(
-            format!("{p}/actuator"),
+    v.ensure_rule(
+        r.actuator < n_act,
+        &UNKNOWN_ACTUATOR,
+        format!("{p}/actuator"),
+        || {
             format!(
                 "unknown actuator index {} (design has {n_act} actuators)",
                 r.actuator
-            ),
-        );
-    }
+            )
+        },
+    );
     let offset = r.offset_m.unwrap_or([0.0, 0.0]);
-    coords(v, &format!("{p}/offset_m"), &offset);
-    v.finite(&format!("{p}/clamp_angle_deg"), r.clamp_angle_deg);
-    let len_ok = v.range(&format!("{p}/length_m"), "", r.length_m, LENGTH_M);
-    coords(v, &format!("{p}/attach_m"), &r.attach_m);
     let e = r.youngs_modulus_pa.unwrap_or(DEFAULT_E);
-    let e_ok = v.range(&format!("{p}/youngs_modulus_pa"), "", e, YOUNGS_MODULUS_PA);
-    let diameter = rod_diameter(v, (i, &p), r, len_ok, warnings);
-    if let Some(ei) = r.ei_nm2 {
-        v.range(&format!("{p}/ei_nm2"), "", ei, EI_NM2);
-    }
-    if r.diameter_m.is_none() && r.ei_nm2.is_none() {
-        v.push(format!("{p}/diameter_m"), "required unless ei_nm2 is given");
-    }
+    let diameter = rod_diameter(v, (i, &p), r, warnings);
+    v.ensure_rule(
+        r.diameter_m.is_some() || r.ei_nm2.is_some(),
+        &ROD_STIFFNESS,
+        format!("{p}/diameter_m"),
+        || "required unless ei_nm2 is given".to_owned(),
+    );
     let ei = match (r.ei_nm2, diameter) {
         (Some(ei), _) => ei,
         (None, Some(dm)) => e * std::f64::consts::PI * dm.powi(4) / 64.0,
         _ => 1.0,
     };
-    let ea = match (diameter, e_ok) {
-        (Some(dm), true) => Some(e * std::f64::consts::PI * dm * dm / 4.0),
-        _ => None,
-    };
+    let ea = diameter.map(|dm| e * std::f64::consts::PI * dm * dm / 4.0);
     Rod {
         actuator: r.actuator.min(n_act.saturating_sub(1)),
         offset,
         clamp: r.clamp_angle_deg.to_radians(),
-        length: if len_ok { r.length_m } else { 1.0 },
+        length: r.length_m,
         ei: if ei.is_finite() && ei > 0.0 { ei } else { 1.0 },
         ea,
         diameter,
@@ -373,8 +510,9 @@ fn rod(
     }
 }
 
-/// The rods of an explicit design with `n_act` actuators; then every actuator must carry a rod
-/// and, when everything so far is valid, the attachment points must not all coincide.
+/// The rods of an explicit design with `n_act` actuators (2..8 of them: checked at the door);
+/// then every actuator must carry a rod and, when everything so far is valid, the attachment
+/// points must not all coincide.
 fn rods(
     v: &mut Validator,
     rs: Option<&[RodRequest]>,
@@ -382,27 +520,25 @@ fn rods(
     warnings: &mut Vec<String>,
 ) -> Vec<Rod> {
     let Some(rs) = rs else {
-        v.push("/design/rods", "required (or give design.preset)");
+        v.rule(
+            &DESIGN_SOURCE,
+            "/design/rods",
+            "required (or give design.preset)",
+        );
         return Vec::new();
     };
-    if rs.len() < 2 || rs.len() > 8 {
-        v.push(
-            "/design/rods",
-            format!("must list 2..8 rods, got {}", rs.len()),
-        );
-    }
     let rods: Vec<Rod> = rs
         .iter()
         .enumerate()
         .map(|(i, r)| rod(v, i, r, n_act, warnings))
         .collect();
     for j in 0..n_act {
-        if !rs.iter().any(|r| r.actuator == j) {
-            v.push(
-                format!("/design/actuators/{j}"),
-                "carries no rod: its input would be undetermined",
-            );
-        }
+        v.ensure_rule(
+            rs.iter().any(|r| r.actuator == j),
+            &ACTUATOR_WITHOUT_ROD,
+            format!("/design/actuators/{j}"),
+            || "carries no rod: its input would be undetermined".to_owned(),
+        );
     }
     if rods.len() >= 2 && v.is_clean() {
         let l_ref = rods.iter().map(|r| r.length).sum::<f64>() / rods.len() as f64;
@@ -410,17 +546,20 @@ fn rods(
         let spread = rods.iter().fold(0.0f64, |m, r| {
             m.max((r.attach[0] - r0[0]).hypot(r.attach[1] - r0[1]))
         });
-        if spread <= COINCIDENT_REL * l_ref {
-            v.push(
-                "/design/rods",
-                "all attachment points attach_m coincide: the platform rotation is undetermined",
-            );
-        }
+        v.ensure_rule(
+            spread > COINCIDENT_REL * l_ref,
+            &COINCIDENT_ATTACHMENTS,
+            "/design/rods",
+            || {
+                "all attachment points attach_m coincide: the platform rotation is undetermined"
+                    .to_owned()
+            },
+        );
     }
     rods
 }
 
-/// Validate the design part; returns the design (possibly partial when invalid).
+/// The design part; returns the design (possibly partial when invalid).
 fn design_of(
     req: &ContinuumWorkspaceRequest,
     v: &mut Validator,
@@ -433,21 +572,18 @@ fn design_of(
     let actuators = actuators(v, d.actuators.as_deref());
     let n_act = actuators.len();
     let rods = rods(v, d.rods.as_deref(), n_act, warnings);
-    if let Some(s) = d.sigma_allow_pa {
-        v.range("/design/sigma_allow_pa", "", s, SIGMA_ALLOW_PA);
-    }
     if let Some(h) = &d.home_inputs_m {
-        if h.len() != n_act {
-            v.push(
-                "/design/home_inputs_m",
+        v.ensure_rule(
+            h.len() == n_act,
+            &HOME_INPUTS_COUNT,
+            "/design/home_inputs_m",
+            || {
                 format!(
                     "must have {n_act} entries (one per actuator), got {}",
                     h.len()
-                ),
-            );
-        } else {
-            coords(v, "/design/home_inputs_m", h);
-        }
+                )
+            },
+        );
     }
     let design = Design {
         actuators,
@@ -465,16 +601,16 @@ fn solver(
     design: &Design,
 ) -> (u32, f64, u32, bool) {
     let solver = req.solver.clone().unwrap_or_default();
-    let base_steps = u32_in(v, "/solver/rk4_steps", solver.rk4_steps, RK4_STEPS, 32);
-    let tol = f64_in(v, "/solver/tol", solver.tol, SOLVER_TOL, 1e-10);
-    let max_iter = u32_in(v, "/solver/max_iter", solver.max_iter, SOLVER_MAX_ITER, 50);
+    let base_steps = solver.rk4_steps.unwrap_or(32);
+    let tol = solver.tol.unwrap_or(1e-10);
+    let max_iter = solver.max_iter.unwrap_or(50);
     let extensible = solver.axial_extensibility.unwrap_or(false);
-    if extensible && design.rods.iter().any(|r| r.ea.is_none()) {
-        v.push(
-            "/solver/axial_extensibility",
-            "needs diameter_m (and youngs_modulus_pa) on every rod to compute EA",
-        );
-    }
+    v.ensure_rule(
+        !(extensible && design.rods.iter().any(|r| r.ea.is_none())),
+        &EXTENSIBILITY_NEEDS_DIAMETER,
+        "/solver/axial_extensibility",
+        || "needs diameter_m (and youngs_modulus_pa) on every rod to compute EA".to_owned(),
+    );
     (base_steps, tol, max_iter, extensible)
 }
 
@@ -485,7 +621,8 @@ fn home(v: &mut Validator, model: &Model, preset: Option<Preset>) {
     };
     let fit = fk::home_fit(model, Some(h));
     if fit.residual.is_nan() || fit.residual > HOME_REL_TOL * model.l_ref {
-        v.push(
+        v.rule(
+            &HOME_NOT_STRESS_FREE,
             "/design/home_inputs_m",
             format!(
                 "rods are not straight and unloaded with theta_EE = 0 at these inputs (closure residual {:.3e} m > {:.1e} L_ref)",
@@ -500,28 +637,18 @@ fn load(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> ([
     let load = req.load.clone().unwrap_or_default();
     let force = load.force_n.unwrap_or([0.0, 0.0]);
     let moment = load.moment_nm.unwrap_or(0.0);
-    if v.all_finite("/load/force_n", &force) {
-        let fmax = MAX_LOAD_REL * model.f_ref;
-        let fnorm = force[0].hypot(force[1]);
-        if fnorm > fmax {
-            v.push(
-                "/load/force_n",
-                format!("|F| = {fnorm} N exceeds 1e4 EI_ref/L_ref^2 = {fmax} N"),
-            );
-        }
-    }
-    if v.finite("/load/moment_nm", moment) {
-        let mmax = MAX_LOAD_REL * model.f_ref * model.l_ref;
-        if moment.abs() > mmax {
-            v.push(
-                "/load/moment_nm",
-                format!(
-                    "|M| = {} N m exceeds 1e4 EI_ref/L_ref = {mmax} N m",
-                    moment.abs()
-                ),
-            );
-        }
-    }
+    let fmax = MAX_LOAD_REL * model.f_ref;
+    let fnorm = force[0].hypot(force[1]);
+    v.ensure_rule(fnorm <= fmax, &LOAD_LIMIT, "/load/force_n", || {
+        format!("|F| = {fnorm} N exceeds 1e4 EI_ref/L_ref^2 = {fmax} N")
+    });
+    let mmax = MAX_LOAD_REL * model.f_ref * model.l_ref;
+    v.ensure_rule(moment.abs() <= mmax, &LOAD_LIMIT, "/load/moment_nm", || {
+        format!(
+            "|M| = {} N m exceeds 1e4 EI_ref/L_ref = {mmax} N m",
+            moment.abs()
+        )
+    });
     (force, moment)
 }
 
@@ -534,9 +661,14 @@ fn inputs(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> 
         return lambda;
     }
     match &req.inputs_m {
-        None => v.push("/inputs_m", "required for mode fk and assembly_modes"),
+        None => v.rule(
+            &INPUTS_REQUIRED,
+            "/inputs_m",
+            "required for mode fk and assembly_modes",
+        ),
         Some(l) if l.len() != n_act => {
-            v.push(
+            v.rule(
+                &INPUTS_COUNT,
                 "/inputs_m",
                 format!(
                     "must have {n_act} entries (one per actuator), got {}",
@@ -546,7 +678,13 @@ fn inputs(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> 
         }
         Some(l) => {
             for (j, (&x, a)) in l.iter().zip(&model.design.actuators).enumerate() {
-                v.in_range(&format!("/inputs_m/{j}"), x, a.stroke[0], a.stroke[1]);
+                let [lo, hi] = a.stroke;
+                v.ensure_rule(
+                    (lo..=hi).contains(&x),
+                    &INPUT_OUTSIDE_STROKE,
+                    format!("/inputs_m/{j}"),
+                    || format!("inputs_m[{j}] [m] must be in [{lo}, {hi}] (the stroke of actuator {j}), got {x}"),
+                );
             }
             lambda.clone_from(l);
         }
@@ -554,20 +692,15 @@ fn inputs(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> 
     lambda
 }
 
-/// A solver state `st` at `ptr` (`…/state/v`): 3N+3 finite numbers for `nr` rods.
+/// A solver state `st` at `ptr` (`…/state/v`): 3N+3 numbers for `nr` rods.
 fn state(v: &mut Validator, ptr: &str, st: &SolverState, nr: usize) -> Vec<f64> {
-    if st.v.len() != 3 * nr + 3 {
-        v.push(
-            ptr,
-            format!(
-                "must have 3N+3 = {} entries, got {}",
-                3 * nr + 3,
-                st.v.len()
-            ),
-        );
-    } else {
-        v.all_finite(ptr, &st.v);
-    }
+    v.ensure_rule(st.v.len() == 3 * nr + 3, &STATE_LENGTH, ptr, || {
+        format!(
+            "must have 3N+3 = {} entries, got {}",
+            3 * nr + 3,
+            st.v.len()
+        )
+    });
     st.v.clone()
 }
 
@@ -584,22 +717,18 @@ fn start(
             StartKind::AssemblyMode => Start::AssemblyMode(s.index.unwrap_or(0)),
             StartKind::Guess => match &s.state {
                 None => {
-                    v.push("/start/state", "required when start.kind = guess");
+                    v.rule(
+                        &STATE_REQUIRED,
+                        "/start/state",
+                        "required when start.kind = guess",
+                    );
                     Start::Home
                 }
                 Some(st) => Start::Guess(state(v, "/start/state/v", st, nr)),
             },
         },
     };
-    let continuation_steps = start_req.and_then(|s| s.continuation_steps).map(|k| {
-        usize_of(u32_in(
-            v,
-            "/start/continuation_steps",
-            Some(k),
-            CONTINUATION_STEPS,
-            30,
-        ))
-    });
+    let continuation_steps = start_req.and_then(|s| s.continuation_steps).map(usize_of);
     let stepping = match start_req.and_then(|s| s.continuation) {
         Some(ContinuationKind::Fixed) => Stepping::Fixed,
         Some(ContinuationKind::Adaptive) | None => Stepping::Adaptive,
@@ -608,58 +737,24 @@ fn start(
 }
 
 /// The outputs: stability test on or off, its segments, shape points per rod.
-fn outputs(v: &mut Validator, req: &ContinuumWorkspaceRequest) -> (bool, u32, u32) {
+fn outputs(req: &ContinuumWorkspaceRequest) -> (bool, u32, u32) {
     let outputs = req.outputs.clone().unwrap_or_default();
     let stability = outputs.stability.unwrap_or(true);
-    let segments = u32_in(
-        v,
-        "/outputs/stability_segments",
-        outputs.stability_segments,
-        STABILITY_SEGMENTS,
-        40,
-    );
-    let shape_points = u32_in(
-        v,
-        "/outputs/rod_shape_points",
-        outputs.rod_shape_points,
-        ROD_SHAPE_POINTS,
-        0,
-    );
+    let segments = outputs.stability_segments.unwrap_or(40);
+    let shape_points = outputs.rod_shape_points.unwrap_or(0);
     (stability, segments, shape_points)
 }
 
 /// The mode search settings for `nr` rods, and those of the home fallback.
-fn mode_search(
-    v: &mut Validator,
-    req: &ContinuumWorkspaceRequest,
-    nr: usize,
-) -> (ModeSearch, ModeSearch) {
+fn mode_search(req: &ContinuumWorkspaceRequest, nr: usize) -> (ModeSearch, ModeSearch) {
     let am = req.assembly_modes.clone().unwrap_or_default();
     let default_n_grid = u32::try_from(modes::default_n_grid(nr)).unwrap_or(1);
-    let n_grid = u32_in(
-        v,
-        "/assembly_modes/n_grid",
-        am.n_grid,
-        N_GRID,
-        default_n_grid,
-    );
-    let mtol = f64_in(
-        v,
-        "/assembly_modes/tol",
-        am.tol,
-        ASSEMBLY_MODES_TOL,
-        modes::DEFAULT_TOL,
-    );
+    let n_grid = am.n_grid.unwrap_or(default_n_grid);
+    let mtol = am.tol.unwrap_or(modes::DEFAULT_TOL);
     let default_cell = u32::try_from(modes::DEFAULT_CELL).unwrap_or(2);
-    let cell = u32_in(v, "/assembly_modes/cell", am.cell, CELL, default_cell);
+    let cell = am.cell.unwrap_or(default_cell);
     let default_max_refine = u32::try_from(modes::DEFAULT_MAX_REFINE).unwrap_or(4000);
-    let max_refine = u32_in(
-        v,
-        "/assembly_modes/max_refine",
-        am.max_refine,
-        MAX_REFINE,
-        default_max_refine,
-    );
+    let max_refine = am.max_refine.unwrap_or(default_max_refine);
     let modes = ModeSearch {
         n_grid: usize_of(n_grid),
         tol: mtol,
@@ -682,18 +777,13 @@ fn mode_search(
     (modes, home_fallback_modes)
 }
 
-/// The sweep grid; a grid of more than [`MAX_GRID_NODES`] nodes is a separate failure (reported
-/// only when everything else is valid).
-fn grid(v: &mut Validator, grid: Option<[u32; 2]>) -> ([u32; 2], Option<CalcFailure>) {
+/// The sweep grid (each side 2..401: checked at the door); a grid of more than
+/// [`MAX_GRID_NODES`] nodes is a separate failure (reported only when everything else is valid).
+fn grid(grid: Option<[u32; 2]>) -> ([u32; 2], Option<CalcFailure>) {
     let grid = grid.unwrap_or([31, 31]);
-    for (k, &g) in grid.iter().enumerate() {
-        v.uint(&format!("/workspace/grid/{k}"), "", u64::from(g), GRID_SIDE);
-    }
     let nodes = u64::from(grid[0]) * u64::from(grid[1]);
     let too_large = (nodes > MAX_GRID_NODES).then(|| {
-        CalcFailure::field(
-            ProblemClass::TooLarge,
-            "GRID_TOO_LARGE",
+        GRID_TOO_LARGE.fail(
             "/workspace/grid",
             format!(
                 "{} x {} = {nodes} nodes exceeds the limit of {MAX_GRID_NODES}; split the ranges into tiles (they can run in parallel)",
@@ -716,25 +806,19 @@ fn ranges(v: &mut Validator, ranges: Option<[[f64; 2]; 2]>, model: &Model) -> [[
     };
     let ranges = ranges.unwrap_or(strokes);
     for (k, r) in ranges.iter().enumerate() {
-        if coords(v, &format!("/workspace/ranges_m/{k}"), r) && r[0] >= r[1] {
-            v.push(
-                format!("/workspace/ranges_m/{k}"),
-                format!("min must be < max, got [{}, {}]", r[0], r[1]),
-            );
-        }
+        v.ensure_rule(
+            r[0] < r[1],
+            &RANGE_ORDER,
+            format!("/workspace/ranges_m/{k}"),
+            || format!("min must be < max, got [{}, {}]", r[0], r[1]),
+        );
     }
     ranges
 }
 
 /// The physical limits of the sweep (allowable stress: the design's unless given).
-fn limits(v: &mut Validator, w: &WorkspaceRequest, model: &Model) -> Limits {
+fn limits(w: &WorkspaceRequest, model: &Model) -> Limits {
     let lim = w.limits.clone().unwrap_or_default();
-    if let Some(g) = lim.min_actuator_gap_m {
-        v.range("/workspace/limits/min_actuator_gap_m", "", g, COORDINATE_M);
-    }
-    if let Some(s) = lim.sigma_allow_pa {
-        v.range("/workspace/limits/sigma_allow_pa", "", s, SIGMA_ALLOW_PA);
-    }
     Limits {
         min_gap: lim.min_actuator_gap_m,
         sigma_allow: lim.sigma_allow_pa.or(model.design.sigma_allow),
@@ -743,68 +827,28 @@ fn limits(v: &mut Validator, w: &WorkspaceRequest, model: &Model) -> Limits {
 }
 
 /// The wave settings of the sweep after its grid and ranges: neighbours, sub-steps, tries,
-/// jump limits, conditioning, stability test and physical limits.
+/// jump limits, conditioning, stability test and physical limits (every value within its range:
+/// checked at the door).
 fn sweep_settings(
-    v: &mut Validator,
     w: &WorkspaceRequest,
     (grid, ranges): ([u32; 2], [[f64; 2]; 2]),
     model: &Model,
 ) -> SweepSettings {
-    // 4 or 8 is enforced when the request is decoded (`Neighbours`).
     let neighbours = w.neighbours.map_or(4, |n| n.0);
-    let max_substeps = u32_in(
-        v,
-        "/workspace/max_substeps",
-        w.max_substeps,
-        MAX_SUBSTEPS,
-        8,
-    );
-    if !max_substeps.is_power_of_two() {
-        v.push(
-            "/workspace/max_substeps",
-            format!("must be a power of two (1, 2, 4, ..., 64), got {max_substeps}"),
-        );
-    }
-    let [max_tries, substep_max_iter] = [
-        ("/workspace/max_tries", w.max_tries, MAX_TRIES, 4),
-        (
-            "/workspace/substep_max_iter",
-            w.substep_max_iter,
-            SUBSTEP_MAX_ITER,
-            20,
-        ),
-    ]
-    .map(|(ptr, x, range, default)| u32_in(v, ptr, x, range, default));
+    let max_substeps = w.max_substeps.map_or(8, |n| n.0);
+    let max_tries = w.max_tries.unwrap_or(4);
+    let substep_max_iter = w.substep_max_iter.unwrap_or(20);
     let jl = w.jump_limits.clone().unwrap_or_default();
-    let [angle_jump, position_factor, cond_max] = [
-        (
-            "/workspace/jump_limits/angle_deg",
-            jl.angle_deg,
-            JUMP_LIMITS_ANGLE_DEG,
-            5.0,
-        ),
-        (
-            "/workspace/jump_limits/position_factor",
-            jl.position_factor,
-            JUMP_LIMITS_POSITION_FACTOR,
-            5.0,
-        ),
-        ("/workspace/cond_max", w.cond_max, COND_MAX, 1e12),
-    ]
-    .map(|(ptr, x, range, default)| f64_in(v, ptr, x, range, default));
+    let angle_jump = jl.angle_deg.unwrap_or(5.0);
+    let position_factor = jl.position_factor.unwrap_or(5.0);
+    let cond_max = w.cond_max.unwrap_or(1e12);
     let stability = match w.stability_check.unwrap_or(StabilityCheckName::Full) {
         StabilityCheckName::Full => StabilityCheck::Full,
         StabilityCheckName::DetSign => StabilityCheck::DetSign,
         StabilityCheckName::None => StabilityCheck::None,
     };
-    let segments = u32_in(
-        v,
-        "/workspace/stability_segments",
-        w.stability_segments,
-        STABILITY_SEGMENTS,
-        DEFAULT_SWEEP_SEGMENTS,
-    );
-    let limits = limits(v, w, model);
+    let segments = w.stability_segments.unwrap_or(DEFAULT_SWEEP_SEGMENTS);
+    let limits = limits(w, model);
     SweepSettings {
         grid: [usize_of(grid[0]), usize_of(grid[1])],
         ranges,
@@ -833,13 +877,14 @@ fn seed(v: &mut Validator, seed: Option<&SeedRequest>, nr: usize) -> SeedInput {
             index: 0,
         };
     };
-    if let Some(i) = &s.inputs_m {
-        coords(v, "/workspace/seed/inputs_m", i);
-    }
     let kind = SeedKind::from(s.kind);
     let state = match (kind, &s.state) {
         (SeedKind::Guess, None) => {
-            v.push("/workspace/seed/state", "required when seed.kind = guess");
+            v.rule(
+                &STATE_REQUIRED,
+                "/workspace/seed/state",
+                "required when seed.kind = guess",
+            );
             None
         }
         (SeedKind::Guess, Some(st)) => Some(state(v, "/workspace/seed/state/v", st, nr)),
@@ -863,23 +908,17 @@ fn workspace(
         return (None, None);
     }
     let n_act = model.n_act();
-    if n_act != 2 {
-        v.push(
-            "/design/actuators",
-            format!("mode workspace needs exactly 2 actuators (2-D grid), got {n_act}"),
-        );
-    }
-    let w = req.workspace.clone().unwrap_or_default();
-    let (grid, too_large) = grid(v, w.grid);
-    let ranges = ranges(v, w.ranges_m, model);
-    let settings = sweep_settings(v, &w, (grid, ranges), model);
-    let qt = f64_in(
-        v,
-        "/workspace/quasi_translational_deg",
-        w.quasi_translational_deg,
-        QUASI_TRANSLATIONAL_DEG,
-        1.0,
+    v.ensure_rule(
+        n_act == 2,
+        &WORKSPACE_ACTUATORS,
+        "/design/actuators",
+        || format!("mode workspace needs exactly 2 actuators (2-D grid), got {n_act}"),
     );
+    let w = req.workspace.clone().unwrap_or_default();
+    let (grid, too_large) = grid(w.grid);
+    let ranges = ranges(v, w.ranges_m, model);
+    let settings = sweep_settings(&w, (grid, ranges), model);
+    let qt = w.quasi_translational_deg.unwrap_or(1.0);
     let seed = seed(v, w.seed.as_ref(), model.n_rods());
     let sweep = SweepInput {
         settings,
@@ -891,17 +930,18 @@ fn workspace(
     (Some(sweep), too_large)
 }
 
-/// The request's `shard` (validated by [`common::shard`]), which only a workspace sweep takes:
-/// its items are the waves, one per seed (see the `shard` field of the request).
+/// The request's `shard` (its index below its count), which only a workspace sweep takes: its
+/// items are the waves, one per seed (see the `shard` field of the request).
 fn shard(v: &mut Validator, req: &ContinuumWorkspaceRequest) -> Option<Shard> {
-    let shard = common::shard(v, req.shard);
+    let shard = common::shard_rule(v, req.shard);
     let one_job = match req.mode {
         wire::Mode::Workspace => None,
         wire::Mode::Fk => Some("fk"),
         wire::Mode::AssemblyModes => Some("assembly_modes"),
     };
     if let (Some(mode), Some(_)) = (one_job, req.shard) {
-        v.push(
+        v.rule(
+            &SHARD_NOT_APPLICABLE,
             "/shard",
             format!("shard splits the waves of a workspace sweep; mode \"{mode}\" has no sweep"),
         );
@@ -939,9 +979,7 @@ fn search_size(n_grid: usize, nr: usize, has_home: bool) -> Result<(), CalcFailu
     } else {
         " (the design has no stress-free home, so the FK starts from the mode search)"
     };
-    Err(CalcFailure::field(
-        ProblemClass::TooLarge,
-        "SEARCH_TOO_LARGE",
+    Err(SEARCH_TOO_LARGE.fail(
         "/assembly_modes/n_grid",
         format!(
             "(2 N_grid)^(2N) = {combos:.3e} grid combinations for N_grid = {n_grid} and N = {nr} rods exceeds {MAX_COMBINATIONS:e}; lower n_grid{why}"
@@ -949,9 +987,20 @@ fn search_size(n_grid: usize, nr: usize, has_home: bool) -> Result<(), CalcFailu
     ))
 }
 
+impl TryFrom<ContinuumWorkspaceRequest> for Input {
+    type Error = CalcFailure;
+
+    /// The rules between fields of a request whose per-field rules were checked at the door.
+    fn try_from(req: ContinuumWorkspaceRequest) -> Result<Self, CalcFailure> {
+        Self::try_from(&req)
+    }
+}
+
 impl TryFrom<&ContinuumWorkspaceRequest> for Input {
     type Error = CalcFailure;
 
+    /// The rules between fields of a request whose per-field rules were checked at the door
+    /// ([`crate::calc::rules::check`]).
     fn try_from(req: &ContinuumWorkspaceRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         let mut warnings = Vec::new();
@@ -966,9 +1015,9 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
         let (force, moment) = load(&mut v, req, &model);
         let lambda = inputs(&mut v, req, &model);
         let (start, continuation_steps, stepping) = start(&mut v, req.start.as_ref(), nr);
-        let (stability, segments, shape_points) = outputs(&mut v, req);
-        let (modes, home_fallback_modes) = mode_search(&mut v, req, nr);
-        let time_limit = common::time_limit(&mut v, req.time_limit_ms);
+        let (stability, segments, shape_points) = outputs(req);
+        let (modes, home_fallback_modes) = mode_search(req, nr);
+        let time_limit = req.time_limit_ms.map(Duration::from_millis);
         let shard = shard(&mut v, req);
         let (sweep, too_large) = workspace(&mut v, req, &model);
         let has_home = model.design.home.is_some()
@@ -1020,6 +1069,7 @@ mod tests {
             "mode": "workspace", "design": {"preset": "keops_d1"}
         }))
         .expect("request decodes");
+        crate::calc::rules::check(&req).expect("per-field rules hold");
         let input = Input::try_from(&req).expect("valid");
         let got = input.sweep.expect("workspace mode").settings;
         assert_eq!(got, SweepSettings::with_defaults(got.grid, got.ranges));

@@ -118,25 +118,38 @@ pub use wire::{ContinuumWorkspaceRequest, ContinuumWorkspaceResponse};
 use crate::calc::CalcFailure;
 use crate::numerics::Budget;
 
-/// Entry point of `POST /v1/continuum-workspace`: validate, compute (within the request's own
-/// time limit), respond.
+/// Compute and build the answer of `POST /v1/continuum-workspace` for a request that passed the
+/// door (per-field rules, then the rules between fields in [`Input::try_from`]), within the
+/// request's own time limit.
 ///
 /// # Errors
-/// A [`CalcFailure`] (HTTP 422) for invalid input, an answer estimated above the response limit,
-/// or an assembly mode index beyond the modes the search found. Non-convergence and a spent
-/// budget are not errors: they are reported in the answer.
-pub fn run(
-    req: ContinuumWorkspaceRequest,
+/// `RESPONSE_TOO_LARGE` before computing when the answer would exceed the budget's limit;
+/// `ASSEMBLY_MODE_NOT_FOUND` for an assembly mode index beyond the modes the search found.
+/// Non-convergence and a spent budget are not errors: they are reported in the answer.
+pub fn run_valid(
+    input: &Input,
     budget: &Budget,
 ) -> Result<ContinuumWorkspaceResponse, CalcFailure> {
-    let input = Input::try_from(&req)?;
-    output::response_size(&input).check(budget)?;
+    output::response_size(input).check(budget)?;
     let budget = match input.time_limit {
         Some(t) => budget.clone().capped(t),
         None => budget.clone(),
     };
-    let out = compute::compute(&input, &budget)?;
-    Ok(output::respond(&input, out, &budget))
+    let out = compute::compute(input, &budget)?;
+    Ok(output::respond(input, out, &budget))
+}
+
+/// The whole path of a request without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
+///
+/// # Errors
+/// As the endpoint: every offending field with its JSON pointer, or the calculation's failure.
+pub fn run(
+    req: ContinuumWorkspaceRequest,
+    budget: &Budget,
+) -> Result<ContinuumWorkspaceResponse, CalcFailure> {
+    crate::calc::rules::check(&req)?;
+    run_valid(&Input::try_from(&req)?, budget)
 }
 
 /// The request's own time limit (`time_limit_ms`, capped at the service maximum).

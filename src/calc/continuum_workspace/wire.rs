@@ -62,6 +62,7 @@ pub struct ContinuumWorkspaceRequest {
     pub design: DesignRequest,
     /// Actuator inputs `lambda_j` \[m\] (fk, assembly_modes; inside the strokes).
     #[serde(default)]
+    #[rule(items = COORDINATE_M)]
     #[schema(example = json!([-0.15, 0.2225]))]
     pub inputs_m: Option<Vec<f64>>,
     /// Platform load.
@@ -91,6 +92,7 @@ pub struct ContinuumWorkspaceRequest {
     pub assembly_modes: Option<AssemblyModesRequest>,
     /// Wall-clock limit for this request \[ms\] (extension; capped by the service limit).
     #[serde(default)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(example = 10_000)]
     pub time_limit_ms: Option<u64>,
     /// Run only block `index` of `count` near-equal contiguous blocks of the sweep's WAVES
@@ -108,6 +110,12 @@ pub struct ContinuumWorkspaceRequest {
     pub shard: Option<Shard>,
 }
 
+impl crate::calc::common::TimeLimited for ContinuumWorkspaceRequest {
+    fn time_limit(&self) -> Option<std::time::Duration> {
+        self.time_limit_ms.map(std::time::Duration::from_millis)
+    }
+}
+
 /// Mechanism design (spec 3.1): either `preset` alone (optionally with `sigma_allow_pa`) or
 /// `actuators` + `rods`.
 #[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
@@ -120,17 +128,21 @@ pub struct DesignRequest {
     pub preset: Option<PresetName>,
     /// Linear guides (1..4).
     #[serde(default)]
+    #[rule(min_items = 1, max_items = MAX_ACTUATORS)]
     pub actuators: Option<Vec<ActuatorRequest>>,
     /// Rods (2..8).
     #[serde(default)]
+    #[rule(min_items = MIN_RODS, max_items = MAX_RODS)]
     pub rods: Option<Vec<RodRequest>>,
     /// Inputs at which every rod is straight and unloaded with `theta_EE = 0` \[m\]; computed by
     /// least squares when absent.
     #[serde(default)]
+    #[rule(items = COORDINATE_M)]
     #[schema(example = json!([-0.25, 0.2725]))]
     pub home_inputs_m: Option<Vec<f64>>,
     /// Allowable bending stress \[Pa\]: FK warnings and default workspace stress limit.
     #[serde(default)]
+    #[rule(range = SIGMA_ALLOW_PA)]
     #[schema(example = 1.2e9)]
     pub sigma_allow_pa: Option<f64>,
 }
@@ -141,12 +153,15 @@ pub struct DesignRequest {
 #[serde(deny_unknown_fields)]
 pub struct ActuatorRequest {
     /// Point on the guide `o_j` \[m\].
+    #[rule(items = COORDINATE_M)]
     #[schema(example = json!([0.0, 0.0]))]
     pub origin_m: [f64; 2],
     /// Guide direction `d_j` (normalised by the service; norm > 1e-12).
+    #[rule(items = Range::FINITE)]
     #[schema(example = json!([1.0, 0.0]))]
     pub direction: [f64; 2],
     /// Admissible inputs `[min, max]` \[m\], min < max.
+    #[rule(items = COORDINATE_M)]
     #[schema(example = json!([-0.7, 0.2]))]
     pub stroke_m: [f64; 2],
 }
@@ -156,36 +171,45 @@ pub struct ActuatorRequest {
 #[schema(as = continuum_workspace::RodRequest)]
 #[serde(deny_unknown_fields)]
 pub struct RodRequest {
-    /// Index `j(i)` of the actuator carrying the clamp.
+    /// Index `j(i)` of the actuator carrying the clamp (below the number of actuators).
+    #[rule(range = ACTUATOR_INDEX)]
     #[schema(example = 0)]
     pub actuator: usize,
-    /// Clamp offset `c_i` on the carriage \[m\].
+    /// Clamp offset `c_i` on the carriage \[m\] (default `[0, 0]`).
     #[serde(default)]
+    #[rule(items = COORDINATE_M)]
     #[schema(example = json!([-0.0225, 0.0]))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub offset_m: Option<[f64; 2]>,
     /// Clamp angle `theta_c,i` \[deg\] (tangent direction at s = 0, counter-clockwise from +X).
+    #[rule(range = Range::FINITE)]
     #[schema(example = -60.0)]
     pub clamp_angle_deg: f64,
     /// Rod length `L_i` \[m\].
+    #[rule(range = LENGTH_M)]
     #[schema(example = 0.5)]
     pub length_m: f64,
-    /// Solid round section diameter `d_i` \[m\] (L/d >= 20 recommended, >= 5 required).
+    /// Solid round section diameter `d_i` \[m\] (L/d >= 20 recommended, >= 5 required; required
+    /// unless `ei_nm2` is given).
     #[serde(default)]
+    #[rule(range = DIAMETER_M)]
     #[schema(example = 0.004)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub diameter_m: Option<f64>,
     /// Bending stiffness `EI_i` [N m^2] (alternative to the diameter; overrides `E pi d^4/64`).
     #[serde(default)]
+    #[rule(range = EI_NM2)]
     #[schema(example = 2.63894)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ei_nm2: Option<f64>,
     /// Young's modulus `E_i` \[Pa\] (default 2.1e11).
     #[serde(default)]
+    #[rule(range = YOUNGS_MODULUS_PA)]
     #[schema(example = 2.1e11)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub youngs_modulus_pa: Option<f64>,
     /// Platform point `r_i` in the platform frame \[m\].
+    #[rule(items = COORDINATE_M)]
     #[schema(example = json!([-0.0225, 0.0]))]
     pub attach_m: [f64; 2],
 }
@@ -195,12 +219,14 @@ pub struct RodRequest {
 #[schema(as = continuum_workspace::LoadRequest)]
 #[serde(deny_unknown_fields)]
 pub struct LoadRequest {
-    /// Force `F` at P \[N\]; `|F| <= 1e4 EI_ref/L_ref^2`.
+    /// Force `F` at P \[N\]; `|F| <= 1e4 EI_ref/L_ref^2` (default `[0, 0]`).
     #[serde(default)]
+    #[rule(items = Range::FINITE)]
     #[schema(example = json!([0.0, -50.0]))]
     pub force_n: Option<[f64; 2]>,
-    /// Couple `M` [N m]; `|M| <= 1e4 EI_ref/L_ref` (extension of "finite").
+    /// Couple `M` [N m]; `|M| <= 1e4 EI_ref/L_ref` (extension of "finite"; default 0).
     #[serde(default)]
+    #[rule(range = Range::FINITE)]
     #[schema(example = 0.0)]
     pub moment_nm: Option<f64>,
 }
@@ -210,16 +236,19 @@ pub struct LoadRequest {
 #[schema(as = continuum_workspace::SolverRequest)]
 #[serde(deny_unknown_fields)]
 pub struct SolverRequest {
-    /// Base RK4 steps per rod (raised by the load rule of spec 4.1).
+    /// Base RK4 steps per rod (raised by the load rule of spec 4.1; default 32).
     #[serde(default)]
+    #[rule(range = RK4_STEPS)]
     #[schema(example = 32)]
     pub rk4_steps: Option<u32>,
-    /// Newton stop on the scaled residual (inf-norm).
+    /// Newton stop on the scaled residual (inf-norm; default 1e-10).
     #[serde(default)]
+    #[rule(range = SOLVER_TOL)]
     #[schema(example = 1e-10)]
     pub tol: Option<f64>,
-    /// Newton iterations per solve.
+    /// Newton iterations per solve (default 50).
     #[serde(default)]
+    #[rule(range = SOLVER_MAX_ITER)]
     #[schema(example = 50)]
     pub max_iter: Option<u32>,
     /// Add axial compliance `EA = E pi d^2/4` (recommended for N >= 4).
@@ -249,6 +278,7 @@ pub enum StartKind {
 #[serde(deny_unknown_fields)]
 pub struct SolverState {
     /// Unknown vector `[mb0_1, nbx_1, nby_1, ..., px/L_ref, py/L_ref, theta_EE]` (length 3N+3).
+    #[rule(items = Range::FINITE)]
     pub v: Vec<f64>,
 }
 
@@ -265,11 +295,13 @@ pub struct StartRequest {
     pub state: Option<SolverState>,
     /// Assembly-mode index in the margin-sorted list (kind = assembly_mode; default 0).
     #[serde(default)]
+    #[rule(range = INDEX)]
     #[schema(example = 0)]
     pub index: Option<usize>,
     /// Override of the number of equal continuation steps from home (extension; default
     /// `max(10, ceil(max |dlambda| / (0.01 L_ref)))`).
     #[serde(default)]
+    #[rule(range = CONTINUATION_STEPS)]
     #[schema(example = 30)]
     pub continuation_steps: Option<u32>,
     /// Step control of the continuation from home (kind = home; the path runs in the
@@ -310,16 +342,18 @@ pub enum ContinuationKind {
 #[schema(as = continuum_workspace::OutputsRequest)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsRequest {
-    /// Run the stability test (spec 4.5).
+    /// Run the stability test (spec 4.5; default true).
     #[serde(default)]
     #[schema(example = true)]
     pub stability: Option<bool>,
-    /// Segments per rod `M` of the stability test.
+    /// Segments per rod `M` of the stability test (default 40).
     #[serde(default)]
+    #[rule(range = STABILITY_SEGMENTS)]
     #[schema(example = 40)]
     pub stability_segments: Option<u32>,
-    /// Sample points per rod of the returned shapes (0 = none).
+    /// Sample points per rod of the returned shapes (0 = none, the default).
     #[serde(default)]
+    #[rule(range = ROD_SHAPE_POINTS)]
     #[schema(example = 0)]
     pub rod_shape_points: Option<u32>,
 }
@@ -350,6 +384,7 @@ pub struct SeedRequest {
     pub kind: SeedKind,
     /// Inputs near which the seed node is chosen \[m\] (default: home inputs, else the range centre).
     #[serde(default)]
+    #[rule(items = COORDINATE_M)]
     pub inputs_m: Option<[f64; 2]>,
     /// Solver state (kind = guess).
     #[serde(default)]
@@ -357,6 +392,7 @@ pub struct SeedRequest {
     pub state: Option<SolverState>,
     /// Assembly-mode index (kind = assembly_mode; default 0).
     #[serde(default)]
+    #[rule(range = INDEX)]
     pub index: Option<usize>,
 }
 
@@ -365,12 +401,14 @@ pub struct SeedRequest {
 #[schema(as = continuum_workspace::JumpLimits)]
 #[serde(deny_unknown_fields)]
 pub struct JumpLimits {
-    /// Largest platform rotation per sub-step \[deg\].
+    /// Largest platform rotation per sub-step \[deg\] (default 5).
     #[serde(default)]
+    #[rule(range = JUMP_LIMITS_ANGLE_DEG)]
     #[schema(example = 5.0)]
     pub angle_deg: Option<f64>,
-    /// Largest platform displacement per sub-step as a multiple of the input change.
+    /// Largest platform displacement per sub-step as a multiple of the input change (default 5).
     #[serde(default)]
+    #[rule(range = JUMP_LIMITS_POSITION_FACTOR)]
     #[schema(example = 5.0)]
     pub position_factor: Option<f64>,
 }
@@ -411,10 +449,12 @@ pub struct WorkspaceLimits {
     /// Minimum carriage gap \[m\] (clamp points of carriage 2 minus those of carriage 1, along guide
     /// 1); null = none.
     #[serde(default)]
+    #[rule(range = COORDINATE_M)]
     #[schema(example = 0.05)]
     pub min_actuator_gap_m: Option<f64>,
     /// Allowable bending stress \[Pa\]; null = `design.sigma_allow_pa` or none.
     #[serde(default)]
+    #[rule(range = SIGMA_ALLOW_PA)]
     pub sigma_allow_pa: Option<f64>,
     /// `ignore` (default) or `reject`.
     #[serde(default)]
@@ -440,12 +480,14 @@ pub enum AreaMethod {
 #[schema(as = continuum_workspace::WorkspaceRequest)]
 #[serde(deny_unknown_fields)]
 pub struct WorkspaceRequest {
-    /// Grid `[n1, n2]`, 2..401 each, n1*n2 <= 40401.
+    /// Grid `[n1, n2]`, 2..401 each, n1*n2 <= 40401 (default `[31, 31]`).
     #[serde(default)]
+    #[rule(items = GRID_SIDE)]
     #[schema(example = json!([31, 31]))]
     pub grid: Option<[u32; 2]>,
-    /// Input ranges `[[min1, max1], [min2, max2]]` \[m\] (default: the strokes).
+    /// Input ranges `[[min1, max1], [min2, max2]]` \[m\], min < max (default: the strokes).
     #[serde(default)]
+    #[rule(items_items = COORDINATE_M)]
     #[schema(example = json!([[-0.70, 0.20], [-0.1775, 0.7225]]))]
     pub ranges_m: Option<[[f64; 2]; 2]>,
     /// Seed of the wave (default home).
@@ -461,16 +503,18 @@ pub struct WorkspaceRequest {
     pub predictor: Option<bool>,
     /// Largest number of sub-steps, a power of two 1..64 (default 8).
     #[serde(default)]
-    #[schema(example = 8)]
-    pub max_substeps: Option<u32>,
+    #[schema(nullable = false, example = 8)]
+    pub max_substeps: Option<Substeps>,
     /// Attempts per node 1..8 (default 4).
     #[serde(default)]
+    #[rule(range = MAX_TRIES)]
     #[schema(example = 4)]
     pub max_tries: Option<u32>,
     /// Newton iterations per sub-step solve, capped by `solver.max_iter` (default 20; extension:
     /// a sub-step started from the tangent predictor converges in 2-7 iterations, a solve still
     /// wandering after 20 is abandoned for smaller sub-steps).
     #[serde(default)]
+    #[rule(range = SUBSTEP_MAX_ITER)]
     #[schema(example = 20)]
     pub substep_max_iter: Option<u32>,
     /// Jump limits per sub-step.
@@ -479,6 +523,7 @@ pub struct WorkspaceRequest {
     pub jump_limits: Option<JumpLimits>,
     /// Largest accepted condition number of the scaled Jacobian (default 1e12).
     #[serde(default)]
+    #[rule(range = COND_MAX)]
     #[schema(example = 1e12)]
     pub cond_max: Option<f64>,
     /// `full` (default), `det_sign` or `none`.
@@ -487,6 +532,7 @@ pub struct WorkspaceRequest {
     pub stability_check: Option<StabilityCheckName>,
     /// Segments per rod of the stability test (default 20 in sweeps).
     #[serde(default)]
+    #[rule(range = STABILITY_SEGMENTS)]
     #[schema(example = 20)]
     pub stability_segments: Option<u32>,
     /// Physical limits.
@@ -495,6 +541,7 @@ pub struct WorkspaceRequest {
     pub limits: Option<WorkspaceLimits>,
     /// Threshold of the quasi-translational area \[deg\] (default 1).
     #[serde(default)]
+    #[rule(range = QUASI_TRANSLATIONAL_DEG)]
     #[schema(example = 1.0)]
     pub quasi_translational_deg: Option<f64>,
     /// `union` (default) or `sum`.
@@ -516,19 +563,23 @@ pub struct AssemblyModesRequest {
     /// 4 rods, 2 for 5 or more); the search that picks the start of a design without a
     /// stress-free home defaults to min(6, that).
     #[serde(default)]
+    #[rule(range = N_GRID)]
     #[schema(example = 9)]
     pub n_grid: Option<u32>,
     /// `Tol` on the normalised grid residual, dimensionless (default 0.5; 0.45 for the start of a
     /// design without a stress-free home).
     #[serde(default)]
+    #[rule(range = ASSEMBLY_MODES_TOL)]
     #[schema(example = 0.5)]
     pub tol: Option<f64>,
     /// Coarse cell size (default 2).
     #[serde(default)]
+    #[rule(range = CELL)]
     #[schema(example = 2)]
     pub cell: Option<u32>,
     /// Maximum Newton refinements (default 4000).
     #[serde(default)]
+    #[rule(range = MAX_REFINE)]
     #[schema(example = 4000)]
     pub max_refine: Option<u32>,
 }
@@ -912,8 +963,8 @@ pub struct AssemblyModesResponse {
     pub report: SolverReport,
 }
 
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
+// The per-field rules of this module's wire types (`#[rule(...)]` on the fields above: the door
+// checks them and the document states them).
 /// Largest accepted coordinate, stroke or length magnitude \[m\]: the scales the service is
 /// tested at run from 1e-6 m to 1e6 m; beyond, products such as EI or B x n leave the range
 /// where the scaled residual is meaningful.
@@ -969,87 +1020,14 @@ pub const QUASI_TRANSLATIONAL_DEG: Range = Range::closed(1e-9, 180.0);
 pub const GRID_SIDE: Range = Range::int(2, 401);
 /// Most actuators of a design.
 pub const MAX_ACTUATORS: usize = 4;
+/// Fewest rods of a design (spec 3.1).
+pub const MIN_RODS: usize = 2;
+/// Most rods of a design (spec 3.1).
+pub const MAX_RODS: usize = 8;
 /// Index of a design's actuator (below the number of actuators: a cross-field rule).
 pub const ACTUATOR_INDEX: Range = Range::int(0, MAX_ACTUATORS as i64 - 1);
 /// An index into a list (assembly mode, seed node).
 pub const INDEX: Range = Range::INTEGER.min(0.0);
-
-crate::schema_bounds! {
-    ContinuumWorkspaceRequest {
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-        inputs_m @items: COORDINATE_M,
-    },
-    DesignRequest {
-        sigma_allow_pa: SIGMA_ALLOW_PA,
-        home_inputs_m @items: COORDINATE_M,
-    },
-    ActuatorRequest {
-        origin_m @items: COORDINATE_M,
-        stroke_m @items: COORDINATE_M,
-    },
-    RodRequest {
-        actuator: ACTUATOR_INDEX,
-        offset_m @items: COORDINATE_M,
-        attach_m @items: COORDINATE_M,
-        length_m: LENGTH_M,
-        diameter_m: DIAMETER_M,
-        ei_nm2: EI_NM2,
-        youngs_modulus_pa: YOUNGS_MODULUS_PA,
-    },
-    SolverRequest {
-        rk4_steps: RK4_STEPS,
-        tol: SOLVER_TOL,
-        max_iter: SOLVER_MAX_ITER,
-    },
-    StartRequest {
-        index: INDEX,
-        continuation_steps: CONTINUATION_STEPS,
-    },
-    OutputsRequest {
-        stability_segments: STABILITY_SEGMENTS,
-        rod_shape_points: ROD_SHAPE_POINTS,
-    },
-    SeedRequest {
-        index: INDEX,
-    },
-    JumpLimits {
-        angle_deg: JUMP_LIMITS_ANGLE_DEG,
-        position_factor: JUMP_LIMITS_POSITION_FACTOR,
-    },
-    WorkspaceLimits {
-        min_actuator_gap_m: COORDINATE_M,
-        sigma_allow_pa: SIGMA_ALLOW_PA,
-    },
-    WorkspaceRequest {
-        grid @items: GRID_SIDE,
-        max_substeps: MAX_SUBSTEPS,
-        max_tries: MAX_TRIES,
-        substep_max_iter: SUBSTEP_MAX_ITER,
-        cond_max: COND_MAX,
-        stability_segments: STABILITY_SEGMENTS,
-        quasi_translational_deg: QUASI_TRANSLATIONAL_DEG,
-    },
-    AssemblyModesRequest {
-        n_grid: N_GRID,
-        tol: ASSEMBLY_MODES_TOL,
-        cell: CELL,
-        max_refine: MAX_REFINE,
-    },
-    ModeSearchOut {
-        n_grid: N_GRID,
-        cell: CELL,
-        max_refine: MAX_REFINE,
-    },
-}
-
-/// Bounds of nested arrays (rendered inline).
-#[must_use]
-pub fn nested_bounds() -> Vec<crate::calc::SchemaBound> {
-    vec![crate::calc::SchemaBound::at::<WorkspaceRequest>(
-        "/properties/ranges_m/items/items",
-        COORDINATE_M,
-    )]
-}
 
 /// Neighbourhood of the workspace wave: the integer 4 or 8.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, crate::calc::Rules)]
@@ -1082,5 +1060,41 @@ impl utoipa::PartialSchema for Neighbours {
 impl ToSchema for Neighbours {
     fn name() -> std::borrow::Cow<'static, str> {
         std::borrow::Cow::Borrowed("continuum_workspace.Neighbours")
+    }
+}
+
+/// Largest number of sub-steps of one workspace edge: a power of two, 1..64.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, crate::calc::Rules)]
+#[serde(try_from = "u32")]
+pub struct Substeps(pub u32);
+
+impl TryFrom<u32> for Substeps {
+    type Error = String;
+    fn try_from(n: u32) -> Result<Self, String> {
+        if n.is_power_of_two() && MAX_SUBSTEPS.contains(f64::from(n)) {
+            Ok(Self(n))
+        } else {
+            Err(format!(
+                "must be a power of two (1, 2, 4, ..., 64), got {n}"
+            ))
+        }
+    }
+}
+
+impl utoipa::PartialSchema for Substeps {
+    fn schema() -> utoipa::openapi::RefOr<utoipa::openapi::schema::Schema> {
+        utoipa::openapi::schema::ObjectBuilder::new()
+            .schema_type(utoipa::openapi::schema::SchemaType::new(
+                utoipa::openapi::schema::Type::Integer,
+            ))
+            .enum_values(Some([1, 2, 4, 8, 16, 32, 64]))
+            .description(Some("A power of two, 1..64."))
+            .into()
+    }
+}
+
+impl ToSchema for Substeps {
+    fn name() -> std::borrow::Cow<'static, str> {
+        std::borrow::Cow::Borrowed("continuum_workspace.Substeps")
     }
 }

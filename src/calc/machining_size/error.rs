@@ -1,5 +1,5 @@
-//! Failures of the machining-size computations. Field-level validation problems are collected in
-//! `input.rs` (code `INVALID_INPUT`, or `MODEL_INVALID` / `UNSUPPORTED_MODEL` for model
+//! Failures of the machining-size computations. The rules between fields are checked in
+//! `input.rs` (each with its own code, `MODEL_INVALID` / `UNSUPPORTED_MODEL` for model
 //! documents) and returned directly as a [`CalcFailure`]; the errors here arise while computing.
 
 use thiserror::Error;
@@ -12,6 +12,12 @@ pub const MODEL_INVALID: &str = "MODEL_INVALID";
 pub const UNSUPPORTED_MODEL: &str = "UNSUPPORTED_MODEL";
 /// Code of a request whose work exceeds the documented limits.
 pub const TOO_LARGE: &str = "TOO_LARGE";
+/// Code of a SMOGN relevance that marks every sample rare, or none.
+pub const SMOGN_DEGENERATE_RELEVANCE: &str = "SMOGN_DEGENERATE_RELEVANCE";
+/// Code of a GRA series that cannot be normalised by its mean.
+pub const GRA_ZERO_MEAN: &str = "GRA_ZERO_MEAN";
+/// Code of a spent budget before an answer that cannot be partial.
+pub const DEADLINE_EXCEEDED: &str = "DEADLINE_EXCEEDED";
 
 /// Error of the module's `compute` functions.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -56,18 +62,18 @@ impl From<MachiningSizeError> for CalcFailure {
         match e {
             MachiningSizeError::SmognDegenerate { pointer, .. } => CalcFailure::field(
                 ProblemClass::Infeasible,
-                "SMOGN_DEGENERATE_RELEVANCE",
+                SMOGN_DEGENERATE_RELEVANCE,
                 format!("{pointer}/relevance"),
                 detail,
             ),
             MachiningSizeError::GraZeroMean { .. } => CalcFailure::field(
                 ProblemClass::Infeasible,
-                "GRA_ZERO_MEAN",
+                GRA_ZERO_MEAN,
                 "/gra/normalise",
                 detail,
             ),
             MachiningSizeError::Deadline { .. } => {
-                CalcFailure::general(ProblemClass::TooLarge, "DEADLINE_EXCEEDED", detail)
+                CalcFailure::general(ProblemClass::TooLarge, DEADLINE_EXCEEDED, detail)
             }
         }
     }

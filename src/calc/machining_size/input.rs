@@ -1,27 +1,244 @@
-//! Validation of the three requests into domain inputs (spec §2.5): every problem is collected
-//! with its JSON pointer by the one [`Validator`]; model documents are read by
-//! [`super::document`] with the pointer of their first defect.
+//! The rules between fields of the three requests (spec §2.5), turning them into domain inputs.
+//! Every per-field rule (ranges, list lengths, finite numbers) is declared on the wire types and
+//! checked at the door; what is left here is what JSON Schema cannot state (a row's width tied
+//! to the feature names or the model, orderings, the data's shape against the parameters, the
+//! work an answer needs), each rule with its own code ([`TRAIN_RULES`], [`PREDICT_RULES`],
+//! [`ANALYZE_RULES`]). Model documents are read by [`super::document`] with the pointer of their
+//! first defect (codes `MODEL_INVALID`, `UNSUPPORTED_MODEL`).
 
 use std::collections::HashSet;
 
-use crate::calc::common::time_limit;
-use crate::calc::{CalcFailure, Range, Validator};
+use crate::calc::common::{self, RESPONSE_TOO_LARGE_RULE, SHARD_INDEX_BELOW_COUNT};
+use crate::calc::{CalcFailure, CrossRule, Validator};
 
 use super::boost::{BoostParams, Method};
 use super::data::{Matrix, n_train_rows};
 use super::document::{self, DocLimits};
-use super::error::{MODEL_INVALID, TOO_LARGE, UNSUPPORTED_MODEL};
+use super::error::{
+    DEADLINE_EXCEEDED, GRA_ZERO_MEAN, MODEL_INVALID, SMOGN_DEGENERATE_RELEVANCE, TOO_LARGE,
+    UNSUPPORTED_MODEL,
+};
 use super::gra::Normalise;
 use super::model::Model;
 use super::smogn::SmognParams;
 use super::wire::{
-    self, AnalyzeRequest, FRACTION, GRA_RHO, GraNormalise, K_FOLD, LEARNING_RATE, MAX_BACKGROUND,
-    MAX_BIN, MAX_DEPTH, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
-    MAX_INTERVENTIONAL_PAIRS, MAX_PREDICT_ROWS, MAX_ROWS, MAX_SCORE_CELLS, MAX_SHAP_CELLS,
-    MAX_TREES, MIN_ROWS, N_ESTIMATORS, PCA_COMPONENTS, PredictRequest, REGULARISATION,
-    RELEVANCE_PHI, SMOGN_K, SMOGN_PERTURBATION, SMOGN_THRESHOLD, TARGET, TEST_FRACTION,
-    TrainOutputKind, TrainRequest, TreeMethod,
+    self, AnalyzeRequest, GraNormalise, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
+    MAX_INTERVENTIONAL_PAIRS, MAX_SCORE_CELLS, MAX_SHAP_CELLS, MAX_TREES, PredictRequest,
+    RELEVANCE_PHI, TrainOutputKind, TrainRequest, TreeMethod,
 };
+
+/// Feature names are not blank.
+pub const FEATURE_NAME_EMPTY: CrossRule = CrossRule::invalid(
+    "FEATURE_NAME_EMPTY",
+    &["/feature_names/*"],
+    "Every feature name holds a character other than white space.",
+);
+/// Feature names are unique.
+pub const FEATURE_NAME_DUPLICATE: CrossRule = CrossRule::invalid(
+    "FEATURE_NAME_DUPLICATE",
+    &["/feature_names/*"],
+    "Feature names are unique.",
+);
+/// A row has one value per feature name.
+pub const ROW_WIDTH: CrossRule = CrossRule::invalid(
+    "ROW_WIDTH",
+    &["/rows/*", "/feature_names"],
+    "Every row of rows has one value per name of feature_names.",
+);
+/// One target per row.
+pub const TARGET_LENGTH: CrossRule = CrossRule::invalid(
+    "TARGET_LENGTH",
+    &["/target", "/rows"],
+    "target has one value per row of rows.",
+);
+/// The targets vary.
+pub const CONSTANT_TARGET: CrossRule = CrossRule::invalid(
+    "CONSTANT_TARGET",
+    &["/target"],
+    "Not all targets are equal (else there is nothing to learn).",
+);
+/// An empty child cannot divide by zero.
+pub const REG_LAMBDA_ZERO: CrossRule = CrossRule::invalid(
+    "REG_LAMBDA_ZERO",
+    &["/params/reg_lambda", "/params/min_child_weight"],
+    "params.reg_lambda > 0 when params.min_child_weight is 0 (spec §8 hazard 4).",
+);
+/// The training split can hold two children.
+pub const TRAINING_ROWS: CrossRule = CrossRule::invalid(
+    "TRAINING_ROWS",
+    &[
+        "/params/min_child_weight",
+        "/validation/test_fraction",
+        "/rows",
+    ],
+    "The training split (rows less the holdout) has at least 2·max(1, min_child_weight) rows.",
+);
+/// Every fold's training rows can hold two children.
+pub const FOLD_ROWS: CrossRule = CrossRule::invalid(
+    "FOLD_ROWS",
+    &["/validation/k_fold", "/params/min_child_weight", "/rows"],
+    "Each k-fold training split (n − ⌈n/k⌉ rows) has at least 2·max(1, min_child_weight) rows.",
+);
+/// Something is left to split on.
+pub const ALL_FEATURES_CONSTANT: CrossRule = CrossRule::invalid(
+    "ALL_FEATURES_CONSTANT",
+    &["/rows", "/preprocessing/drop_constant"],
+    "With preprocessing.drop_constant, at least one feature column is not constant.",
+);
+/// Each tree draws at least one feature.
+pub const COLSAMPLE_NO_FEATURE: CrossRule = CrossRule::invalid(
+    "COLSAMPLE_NO_FEATURE",
+    &["/params/colsample_bytree", "/rows"],
+    "⌊colsample_bytree · d⌋ ≥ 1 for the d features left after dropping constant columns.",
+);
+/// Only a k-fold cross-validation can be sharded.
+pub const SHARD_NOT_APPLICABLE: CrossRule = CrossRule::invalid(
+    "SHARD_NOT_APPLICABLE",
+    &["/shard", "/validation/k_fold"],
+    "shard is given only with validation.k_fold (it splits the folds).",
+);
+/// SMOGN control points of `/train`: φ in [0, 1].
+pub const TRAIN_RELEVANCE_PHI: CrossRule = CrossRule::invalid(
+    "RELEVANCE_PHI",
+    &["/preprocessing/smogn/relevance/*/1"],
+    "The relevance φ of every SMOGN control point [y, φ] is in [0, 1].",
+);
+/// SMOGN control points of `/train`: y increasing.
+pub const TRAIN_RELEVANCE_ORDER: CrossRule = CrossRule::invalid(
+    "RELEVANCE_ORDER",
+    &["/preprocessing/smogn/relevance/*/0"],
+    "The y of the SMOGN control points [y, φ] strictly increase.",
+);
+/// SMOGN control points of `/analyze`: φ in [0, 1].
+pub const ANALYZE_RELEVANCE_PHI: CrossRule = CrossRule::invalid(
+    "RELEVANCE_PHI",
+    &["/smogn/relevance/*/1"],
+    "The relevance φ of every SMOGN control point [y, φ] is in [0, 1].",
+);
+/// SMOGN control points of `/analyze`: y increasing.
+pub const ANALYZE_RELEVANCE_ORDER: CrossRule = CrossRule::invalid(
+    "RELEVANCE_ORDER",
+    &["/smogn/relevance/*/0"],
+    "The y of the SMOGN control points [y, φ] strictly increase.",
+);
+/// SMOGN of `/train` finds rare and normal samples (found while computing).
+pub const TRAIN_SMOGN_DEGENERATE: CrossRule = CrossRule::infeasible(
+    SMOGN_DEGENERATE_RELEVANCE,
+    &["/preprocessing/smogn/relevance"],
+    "SMOGN's relevance marks some but not all training samples as rare.",
+);
+/// SMOGN of `/analyze` finds rare and normal samples (found while computing).
+pub const ANALYZE_SMOGN_DEGENERATE: CrossRule = CrossRule::infeasible(
+    SMOGN_DEGENERATE_RELEVANCE,
+    &["/smogn/relevance"],
+    "SMOGN's relevance marks some but not all samples as rare.",
+);
+/// The model document is well-formed.
+pub const MODEL_DOCUMENT: CrossRule = CrossRule::invalid(
+    MODEL_INVALID,
+    &["/model"],
+    "The model is our document (format machining-size-gbdt/1) or {\"xgboost_json\": ...}, with \
+     children in range, no cycles or shared children, depth ≤ 64, ≤ 5000 trees, ≤ 1 000 000 \
+     nodes, finite numbers and split features below n_features.",
+);
+/// The model is within v1.
+pub const MODEL_SUPPORTED: CrossRule = CrossRule::invalid(
+    UNSUPPORTED_MODEL,
+    &["/model"],
+    "The model's objective is reg:squarederror, its booster gbtree, with a single output.",
+);
+/// A `/predict` row has one value per model feature.
+pub const PREDICT_ROW_WIDTH: CrossRule = CrossRule::invalid(
+    "ROW_WIDTH",
+    &["/rows/*", "/background/*", "/model"],
+    "Every row of rows (and of background) has one value per model feature.",
+);
+/// Names given to `/predict` are the model's.
+pub const FEATURE_NAMES_MISMATCH: CrossRule = CrossRule::invalid(
+    "FEATURE_NAMES_MISMATCH",
+    &["/feature_names", "/model"],
+    "feature_names, when given, has one name per model feature and equals the model's names.",
+);
+/// Interventional SHAP needs a background.
+pub const BACKGROUND_REQUIRED: CrossRule = CrossRule::invalid(
+    "BACKGROUND_REQUIRED",
+    &["/background", "/shap"],
+    "background is given when shap is interventional.",
+);
+/// The SHAP, interaction and background work of `/predict` is within the limits.
+pub const PREDICT_WORK: CrossRule = CrossRule::too_large(
+    TOO_LARGE,
+    &["/rows", "/background", "/interactions"],
+    "With SHAP, rows·d ≤ 4 000 000; interventional rows·background ≤ 1 000 000; with \
+     interactions, rows ≤ 1000 and rows·d² ≤ 2 000 000 (d: model features).",
+);
+/// The PCA scores of `/analyze` are within the limit.
+pub const ANALYZE_WORK: CrossRule = CrossRule::too_large(
+    TOO_LARGE,
+    &["/pca/scores", "/pca/components", "/rows"],
+    "With pca.scores, rows·components ≤ 4 000 000.",
+);
+/// A GRA series can be normalised by its mean (found while computing).
+pub const GRA_MEAN: CrossRule = CrossRule::infeasible(
+    GRA_ZERO_MEAN,
+    &["/gra/normalise", "/rows", "/target"],
+    "With gra.normalise mean, no series (feature or target) has a mean of 0.",
+);
+/// An answer that cannot be partial is finished within the budget (found while computing).
+pub const DEADLINE: CrossRule = CrossRule::too_large(
+    DEADLINE_EXCEEDED,
+    &["/time_limit_ms"],
+    "The work of an answer that cannot be partial (SHAP values, an analysis) ends within the \
+     request's time limit.",
+);
+
+/// The rules between fields of `POST /v1/machining-size/train`, as the document lists them.
+pub const TRAIN_RULES: &[CrossRule] = &[
+    FEATURE_NAME_EMPTY,
+    FEATURE_NAME_DUPLICATE,
+    ROW_WIDTH,
+    TARGET_LENGTH,
+    CONSTANT_TARGET,
+    REG_LAMBDA_ZERO,
+    TRAINING_ROWS,
+    FOLD_ROWS,
+    ALL_FEATURES_CONSTANT,
+    COLSAMPLE_NO_FEATURE,
+    SHARD_INDEX_BELOW_COUNT,
+    SHARD_NOT_APPLICABLE,
+    TRAIN_RELEVANCE_PHI,
+    TRAIN_RELEVANCE_ORDER,
+    TRAIN_SMOGN_DEGENERATE,
+    DEADLINE,
+    RESPONSE_TOO_LARGE_RULE,
+];
+
+/// The rules between fields of `POST /v1/machining-size/predict`, as the document lists them.
+pub const PREDICT_RULES: &[CrossRule] = &[
+    MODEL_DOCUMENT,
+    MODEL_SUPPORTED,
+    PREDICT_ROW_WIDTH,
+    FEATURE_NAMES_MISMATCH,
+    BACKGROUND_REQUIRED,
+    PREDICT_WORK,
+    DEADLINE,
+    RESPONSE_TOO_LARGE_RULE,
+];
+
+/// The rules between fields of `POST /v1/machining-size/analyze`, as the document lists them.
+pub const ANALYZE_RULES: &[CrossRule] = &[
+    FEATURE_NAME_EMPTY,
+    FEATURE_NAME_DUPLICATE,
+    ROW_WIDTH,
+    TARGET_LENGTH,
+    ANALYZE_RELEVANCE_PHI,
+    ANALYZE_RELEVANCE_ORDER,
+    ANALYZE_WORK,
+    GRA_MEAN,
+    ANALYZE_SMOGN_DEGENERATE,
+    DEADLINE,
+    RESPONSE_TOO_LARGE_RULE,
+];
 
 /// A validated `/train` request.
 #[derive(Debug, Clone)]
@@ -118,21 +335,19 @@ pub struct AnalyzeInput {
     pub smogn: Option<(SmognParams, bool)>,
 }
 
-/// Names: 1..200, unique, non-empty.
+/// Names (1..200 of them: checked at the door): unique, not blank.
 fn check_names(v: &mut Validator, names: &[String]) {
-    if names.is_empty() || names.len() > MAX_FEATURES {
-        v.push_code(
-            TOO_LARGE,
-            "/feature_names",
-            format!("must name 1..{MAX_FEATURES} features, got {}", names.len()),
-        );
-    }
     let mut seen = HashSet::new();
     for (i, n) in names.iter().enumerate() {
         if n.trim().is_empty() {
-            v.push(format!("/feature_names/{i}"), "must not be empty");
+            v.rule(
+                &FEATURE_NAME_EMPTY,
+                format!("/feature_names/{i}"),
+                "must not be empty",
+            );
         } else if !seen.insert(n.as_str()) {
-            v.push(
+            v.rule(
+                &FEATURE_NAME_DUPLICATE,
                 format!("/feature_names/{i}"),
                 format!("duplicate feature name \"{n}\""),
             );
@@ -140,21 +355,9 @@ fn check_names(v: &mut Validator, names: &[String]) {
     }
 }
 
-/// Rows: count in `lo..=hi`, each of width `d`, finite. Reports the first ragged row (with a
-/// count) and the first non-finite value.
-fn check_rows(v: &mut Validator, at: &str, rows: &[Vec<f64>], d: usize, lo: usize, hi: usize) {
-    if rows.len() < lo || rows.len() > hi {
-        let code = if rows.len() > hi {
-            TOO_LARGE
-        } else {
-            crate::calc::INVALID_INPUT
-        };
-        v.push_code(
-            code,
-            at,
-            format!("must have {lo}..{hi} rows, got {}", rows.len()),
-        );
-    }
+/// Rows (their count and finite values: checked at the door): each of width `d`. Reports the
+/// first ragged row (with a count).
+fn check_widths(v: &mut Validator, rule: &CrossRule, at: &str, rows: &[Vec<f64>], d: usize) {
     let mut ragged = rows.iter().enumerate().filter(|(_, r)| r.len() != d);
     if let Some((i, r)) = ragged.next() {
         let more = ragged.count();
@@ -163,7 +366,8 @@ fn check_rows(v: &mut Validator, at: &str, rows: &[Vec<f64>], d: usize, lo: usiz
         } else {
             String::new()
         };
-        v.push(
+        v.rule(
+            rule,
             format!("{at}/{i}"),
             format!(
                 "must have {d} values (one per feature), got {}{tail}",
@@ -171,55 +375,45 @@ fn check_rows(v: &mut Validator, at: &str, rows: &[Vec<f64>], d: usize, lo: usiz
             ),
         );
     }
-    if let Some((i, j)) = rows
-        .iter()
-        .enumerate()
-        .find_map(|(i, r)| r.iter().position(|x| !x.is_finite()).map(|j| (i, j)))
-    {
-        v.push(
-            format!("{at}/{i}/{j}"),
-            format!("must be a finite number, got {}", rows[i][j]),
-        );
-    }
 }
 
 /// Names, rows and target of `/train` and `/analyze`.
 fn check_data(v: &mut Validator, names: &[String], rows: &[Vec<f64>], target: &[f64]) {
     check_names(v, names);
-    check_rows(v, "/rows", rows, names.len(), MIN_ROWS, MAX_ROWS);
-    if target.len() != rows.len() {
-        v.push(
-            "/target",
+    check_widths(v, &ROW_WIDTH, "/rows", rows, names.len());
+    v.ensure_rule(
+        target.len() == rows.len(),
+        &TARGET_LENGTH,
+        "/target",
+        || {
             format!(
                 "must have one value per row ({}), got {}",
                 rows.len(),
                 target.len()
-            ),
-        );
-    }
-    v.all_in("/target", "target", target, TARGET);
+            )
+        },
+    );
 }
 
+/// SMOGN's parameters (ranges and the count of control points: checked at the door); the
+/// control points' φ in [0, 1] and increasing y (`rules`: φ rule, order rule of the endpoint).
 fn smogn_params(
     v: &mut Validator,
     at: &str,
+    (phi_rule, order_rule): (&CrossRule, &CrossRule),
     relevance: &[[f64; 2]],
     (threshold, k, perturbation, seed): (f64, u32, f64, u64),
 ) -> SmognParams {
-    if relevance.len() < 2 {
-        v.push(
-            format!("{at}/relevance"),
-            format!(
-                "needs at least 2 control points [y, φ], got {}",
-                relevance.len()
-            ),
-        );
-    }
     for (i, p) in relevance.iter().enumerate() {
-        v.range(&format!("{at}/relevance/{i}/0"), "y", p[0], Range::FINITE);
-        v.range(&format!("{at}/relevance/{i}/1"), "φ", p[1], RELEVANCE_PHI);
+        v.ensure_rule(
+            RELEVANCE_PHI.contains(p[1]),
+            phi_rule,
+            format!("{at}/relevance/{i}/1"),
+            || format!("φ must be {RELEVANCE_PHI}, got {}", p[1]),
+        );
         if i > 0 && p[0] <= relevance[i - 1][0] {
-            v.push(
+            v.rule(
+                order_rule,
                 format!("{at}/relevance/{i}/0"),
                 format!(
                     "control points must be strictly increasing in y: {} after {}",
@@ -229,19 +423,6 @@ fn smogn_params(
             );
         }
     }
-    v.range(
-        &format!("{at}/threshold"),
-        "threshold",
-        threshold,
-        SMOGN_THRESHOLD,
-    );
-    v.uint(&format!("{at}/k"), "k", u64::from(k), SMOGN_K);
-    v.range(
-        &format!("{at}/perturbation"),
-        "perturbation",
-        perturbation,
-        SMOGN_PERTURBATION,
-    );
     SmognParams {
         relevance: relevance.iter().map(|p| (p[0], p[1])).collect(),
         threshold,
@@ -253,13 +434,9 @@ fn smogn_params(
 
 /// The failure of a validator known to hold problems.
 fn failure(v: Validator) -> CalcFailure {
-    v.finish().err().unwrap_or_else(|| {
-        CalcFailure::general(
-            crate::calc::ProblemClass::InvalidInput,
-            crate::calc::INVALID_INPUT,
-            "invalid request",
-        )
-    })
+    v.finish()
+        .err()
+        .unwrap_or_else(|| MODEL_DOCUMENT.fail_general("invalid request"))
 }
 
 /// Columns of `x` that are constant.
@@ -277,77 +454,23 @@ impl TryFrom<TrainRequest> for TrainInput {
     )]
     fn try_from(req: TrainRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        time_limit(&mut v, req.time_limit_ms);
         check_data(&mut v, &req.feature_names, &req.rows, &req.target);
         let p = &req.params;
-        v.uint(
-            "/params/n_estimators",
-            "n_estimators",
-            u64::from(p.n_estimators),
-            N_ESTIMATORS,
-        );
-        v.uint(
-            "/params/max_depth",
-            "max_depth",
-            u64::from(p.max_depth),
-            MAX_DEPTH,
-        );
-        v.range(
-            "/params/learning_rate",
-            "learning_rate",
-            p.learning_rate,
-            LEARNING_RATE,
-        );
-        v.range(
+        v.ensure_rule(
+            !(p.reg_lambda == 0.0 && p.min_child_weight == 0.0),
+            &REG_LAMBDA_ZERO,
             "/params/reg_lambda",
-            "reg_lambda",
-            p.reg_lambda,
-            REGULARISATION,
-        );
-        v.range(
-            "/params/reg_alpha",
-            "reg_alpha",
-            p.reg_alpha,
-            REGULARISATION,
-        );
-        v.range("/params/gamma", "gamma", p.gamma, REGULARISATION);
-        v.range(
-            "/params/min_child_weight",
-            "min_child_weight",
-            p.min_child_weight,
-            REGULARISATION,
-        );
-        v.range(
-            "/params/colsample_bytree",
-            "colsample_bytree",
-            p.colsample_bytree,
-            FRACTION,
-        );
-        v.range("/params/subsample", "subsample", p.subsample, FRACTION);
-        if let Some(b) = p.base_score {
-            v.range("/params/base_score", "base_score", b, TARGET);
-        }
-        v.uint("/params/max_bin", "max_bin", u64::from(p.max_bin), MAX_BIN);
-        if p.reg_lambda == 0.0 && p.min_child_weight == 0.0 {
-            v.push(
-                "/params/reg_lambda",
+            || {
                 "reg_lambda must be > 0 when min_child_weight is 0 (an empty child would divide \
-                 by zero, spec §8 hazard 4)",
-            );
-        }
-        let val = &req.validation;
-        v.range(
-            "/validation/test_fraction",
-            "test_fraction",
-            val.test_fraction,
-            TEST_FRACTION,
+                 by zero, spec §8 hazard 4)"
+                    .to_owned()
+            },
         );
-        if let Some(k) = val.k_fold {
-            v.uint("/validation/k_fold", "k_fold", u64::from(k), K_FOLD);
-        }
-        let shard = crate::calc::common::shard(&mut v, req.shard);
-        v.ensure(
+        let val = &req.validation;
+        let shard = common::shard_rule(&mut v, req.shard);
+        v.ensure_rule(
             req.shard.is_none() || val.k_fold.is_some(),
+            &SHARD_NOT_APPLICABLE,
             "/shard",
             || "shard splits the k-fold cross-validation: set validation.k_fold".to_owned(),
         );
@@ -355,6 +478,7 @@ impl TryFrom<TrainRequest> for TrainInput {
             smogn_params(
                 &mut v,
                 "/preprocessing/smogn",
+                (&TRAIN_RELEVANCE_PHI, &TRAIN_RELEVANCE_ORDER),
                 &s.relevance,
                 (s.threshold, s.k, s.perturbation, s.seed),
             )
@@ -367,7 +491,8 @@ impl TryFrom<TrainRequest> for TrainInput {
         let min_rows = 2.0 * p.min_child_weight.max(1.0);
         let n_train = n_train_rows(n, val.test_fraction);
         if (n_train as f64) < min_rows {
-            v.push(
+            v.rule(
+                &TRAINING_ROWS,
                 "/params/min_child_weight",
                 format!(
                     "the training split has {n_train} rows but needs at least \
@@ -379,7 +504,8 @@ impl TryFrom<TrainRequest> for TrainInput {
             let k = k as usize;
             let smallest = n - n.div_ceil(k);
             if (smallest as f64) < min_rows {
-                v.push(
+                v.rule(
+                    &FOLD_ROWS,
                     "/validation/k_fold",
                     format!(
                         "{k} folds of {n} rows leave {smallest} training rows in a fold, fewer than \
@@ -392,7 +518,8 @@ impl TryFrom<TrainRequest> for TrainInput {
         let x = Matrix::from_rows(req.rows, d);
         let y = req.target;
         if y.iter().all(|&t| (t - y[0]) == 0.0) {
-            v.push(
+            v.rule(
+                &CONSTANT_TARGET,
                 "/target",
                 "all targets are equal: there is nothing to learn (spec §2.5)",
             );
@@ -404,13 +531,15 @@ impl TryFrom<TrainRequest> for TrainInput {
         };
         let features: Vec<usize> = (0..d).filter(|f| !dropped.contains(f)).collect();
         if features.is_empty() {
-            v.push(
+            v.rule(
+                &ALL_FEATURES_CONSTANT,
                 "/rows",
                 "every feature is constant: there is nothing to split on (set \
                  preprocessing.drop_constant to false to fit the mean only)",
             );
         } else if (p.colsample_bytree * features.len() as f64).floor() < 1.0 {
-            v.push(
+            v.rule(
+                &COLSAMPLE_NO_FEATURE,
                 "/params/colsample_bytree",
                 format!(
                     "colsample_bytree {} leaves 0 of {} features per tree (⌊colsample·d⌋ must be \
@@ -472,6 +601,9 @@ fn read_model(v: &mut Validator, doc: &serde_json::Value) -> Option<Model> {
     let result = match wrapped {
         Some(o) => {
             if let Some(k) = o.keys().find(|k| *k != "xgboost_json") {
+                // A member the published schema does not allow (`additionalProperties: false`):
+                // a per-field rule the door cannot see inside the untyped model, so it keeps the
+                // per-field code.
                 v.push(
                     format!("/model/{k}"),
                     format!("unknown field `{k}` next to `xgboost_json`"),
@@ -486,15 +618,22 @@ fn read_model(v: &mut Validator, doc: &serde_json::Value) -> Option<Model> {
         Ok(m) => Some(m),
         Err(e) => {
             let unsupported = e.detail.contains("supported");
-            v.push_code(
-                if unsupported {
-                    UNSUPPORTED_MODEL
-                } else {
-                    MODEL_INVALID
-                },
-                e.pointer,
-                e.detail,
-            );
+            if e.detail.starts_with("unknown field") {
+                // An unknown member fails the published shape (`additionalProperties: false`),
+                // a per-field rule the door cannot see inside the untyped model: the per-field
+                // code.
+                v.push(e.pointer, e.detail);
+            } else {
+                v.rule(
+                    if unsupported {
+                        &MODEL_SUPPORTED
+                    } else {
+                        &MODEL_DOCUMENT
+                    },
+                    e.pointer,
+                    e.detail,
+                );
+            }
             None
         }
     }
@@ -505,22 +644,23 @@ impl TryFrom<PredictRequest> for PredictInput {
 
     fn try_from(req: PredictRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        time_limit(&mut v, req.time_limit_ms);
         let Some(model) = read_model(&mut v, &req.model) else {
             return Err(failure(v));
         };
         let d = model.n_features;
-        check_rows(&mut v, "/rows", &req.rows, d, 1, MAX_PREDICT_ROWS);
+        check_widths(&mut v, &PREDICT_ROW_WIDTH, "/rows", &req.rows, d);
         if let Some(names) = &req.feature_names {
             if names.len() != d {
-                v.push(
+                v.rule(
+                    &FEATURE_NAMES_MISMATCH,
                     "/feature_names",
                     format!("the model has {d} features, got {} names", names.len()),
                 );
             } else if !model.feature_names.is_empty()
                 && let Some(i) = (0..d).find(|&i| names[i] != model.feature_names[i])
             {
-                v.push(
+                v.rule(
+                    &FEATURE_NAMES_MISMATCH,
                     format!("/feature_names/{i}"),
                     format!(
                         "must be the model's feature \"{}\", got \"{}\"",
@@ -532,8 +672,8 @@ impl TryFrom<PredictRequest> for PredictInput {
         let n = req.rows.len();
         let shap = ShapKind::from(req.shap);
         if shap != ShapKind::None && n * d > MAX_SHAP_CELLS {
-            v.push_code(
-                TOO_LARGE,
+            v.rule(
+                &PREDICT_WORK,
                 "/rows",
                 format!(
                     "SHAP values for {n} rows × {d} features exceed {MAX_SHAP_CELLS} numbers; \
@@ -545,15 +685,16 @@ impl TryFrom<PredictRequest> for PredictInput {
         let mut background = Vec::new();
         if shap == ShapKind::Interventional {
             match &req.background {
-                None => v.push(
+                None => v.rule(
+                    &BACKGROUND_REQUIRED,
                     "/background",
                     "interventional SHAP needs background rows (spec §2.5)",
                 ),
                 Some(b) => {
-                    check_rows(&mut v, "/background", b, d, 1, MAX_BACKGROUND);
+                    check_widths(&mut v, &PREDICT_ROW_WIDTH, "/background", b, d);
                     if n * b.len() > MAX_INTERVENTIONAL_PAIRS {
-                        v.push_code(
-                            TOO_LARGE,
+                        v.rule(
+                            &PREDICT_WORK,
                             "/background",
                             format!(
                                 "{n} rows × {} background rows exceed {MAX_INTERVENTIONAL_PAIRS} \
@@ -567,8 +708,8 @@ impl TryFrom<PredictRequest> for PredictInput {
             }
         }
         if req.interactions && (n > MAX_INTERACTION_ROWS || n * d * d > MAX_INTERACTION_CELLS) {
-            v.push_code(
-                TOO_LARGE,
+            v.rule(
+                &PREDICT_WORK,
                 "/interactions",
                 format!(
                     "interaction values need rows ≤ {MAX_INTERACTION_ROWS} and rows·d² ≤ \
@@ -598,10 +739,8 @@ impl TryFrom<AnalyzeRequest> for AnalyzeInput {
 
     fn try_from(req: AnalyzeRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        time_limit(&mut v, req.time_limit_ms);
         check_data(&mut v, &req.feature_names, &req.rows, &req.target);
         let gra = req.gra.as_ref().map(|g| {
-            v.range("/gra/rho", "rho", g.rho, GRA_RHO);
             (
                 g.rho,
                 match g.normalise {
@@ -611,19 +750,11 @@ impl TryFrom<AnalyzeRequest> for AnalyzeInput {
             )
         });
         let pca = req.pca.as_ref().map(|p| {
-            if let Some(k) = p.components {
-                v.uint(
-                    "/pca/components",
-                    "components",
-                    u64::from(k),
-                    PCA_COMPONENTS,
-                );
-            }
             if p.scores {
                 let k = p.components.map_or(req.feature_names.len(), |k| k as usize);
                 if req.rows.len() * k > MAX_SCORE_CELLS {
-                    v.push_code(
-                        TOO_LARGE,
+                    v.rule(
+                        &ANALYZE_WORK,
                         "/pca/scores",
                         format!(
                             "scores of {} rows × {k} components exceed {MAX_SCORE_CELLS} numbers",
@@ -639,6 +770,7 @@ impl TryFrom<AnalyzeRequest> for AnalyzeInput {
                 smogn_params(
                     &mut v,
                     "/smogn",
+                    (&ANALYZE_RELEVANCE_PHI, &ANALYZE_RELEVANCE_ORDER),
                     &s.relevance,
                     (s.threshold, s.k, s.perturbation, s.seed),
                 ),

@@ -80,29 +80,53 @@ pub use error::MachiningSizeError;
 pub use input::{AnalyzeInput, PredictInput, TrainInput};
 pub use wire::{
     AnalyzeRequest, AnalyzeResponse, PredictRequest, PredictResponse, TrainRequest, TrainResponse,
-    schema_bounds,
 };
 
-/// Entry point of `POST /v1/machining-size/train`: validate, train, respond.
+/// Train and build the answer of `POST /v1/machining-size/train` for a request that passed the
+/// door (per-field rules, then the rules between fields in [`TrainInput::try_from`]).
 ///
 /// # Errors
-/// A [`CalcFailure`] (HTTP 422) for invalid input or an impossible SMOGN relevance.
-pub fn run_train(req: TrainRequest, budget: &Budget) -> Result<TrainResponse, CalcFailure> {
-    let input = TrainInput::try_from(req)?;
-    let out = compute::train(&input, budget)?;
-    Ok(output::respond_train(&input, &out, budget))
+/// A [`CalcFailure`] (HTTP 422) for an impossible SMOGN relevance or a spent budget.
+pub fn run_train_valid(input: &TrainInput, budget: &Budget) -> Result<TrainResponse, CalcFailure> {
+    let out = compute::train(input, budget)?;
+    Ok(output::respond_train(input, &out, budget))
 }
 
-/// Entry point of `POST /v1/machining-size/predict`: validate (read the model), predict and
-/// explain, respond.
+/// The whole path of a `/train` request without HTTP (tests, benchmarks): the per-field rules,
+/// the rules between fields, then [`run_train_valid`].
 ///
 /// # Errors
-/// A [`CalcFailure`] (HTTP 422) for invalid input, a rejected model document or a spent budget.
+/// As the endpoint: every offending field with its JSON pointer, or the calculation's failure.
+pub fn run_train(req: TrainRequest, budget: &Budget) -> Result<TrainResponse, CalcFailure> {
+    crate::calc::rules::check(&req)?;
+    run_train_valid(&TrainInput::try_from(req)?, budget)
+}
+
+/// Predict, explain and build the answer of `POST /v1/machining-size/predict` for a request that
+/// passed the door (per-field rules, then the model and the rules between fields in
+/// [`PredictInput::try_from`]).
+///
+/// # Errors
+/// `RESPONSE_TOO_LARGE` before computing when the answer would exceed the budget's limit; a
+/// spent budget.
+pub fn run_predict_valid(
+    input: &PredictInput,
+    budget: &Budget,
+) -> Result<PredictResponse, CalcFailure> {
+    predict_size(input).check(budget)?;
+    let out = compute::predict(input, budget)?;
+    Ok(output::respond_predict(input, &out, budget))
+}
+
+/// The whole path of a `/predict` request without HTTP (tests, benchmarks): the per-field rules,
+/// the model and the rules between fields, then [`run_predict_valid`].
+///
+/// # Errors
+/// As the endpoint: every offending field with its JSON pointer, a rejected model document, or
+/// the calculation's failure.
 pub fn run_predict(req: PredictRequest, budget: &Budget) -> Result<PredictResponse, CalcFailure> {
-    let input = PredictInput::try_from(req)?;
-    predict_size(&input).check(budget)?;
-    let out = compute::predict(&input, budget)?;
-    Ok(output::respond_predict(&input, &out, budget))
+    crate::calc::rules::check(&req)?;
+    run_predict_valid(&PredictInput::try_from(req)?, budget)
 }
 
 /// Upper estimate of a `/predict` answer from the validated request (checked before
@@ -122,13 +146,26 @@ pub fn predict_size(input: &PredictInput) -> ResponseSize {
     size
 }
 
-/// Entry point of `POST /v1/machining-size/analyze`: validate, analyse, respond.
+/// Analyse and build the answer of `POST /v1/machining-size/analyze` for a request that passed
+/// the door (per-field rules, then the rules between fields in [`AnalyzeInput::try_from`]).
 ///
 /// # Errors
-/// A [`CalcFailure`] (HTTP 422) for invalid input, a zero-mean GRA series, a degenerate SMOGN
-/// relevance or a spent budget.
+/// A [`CalcFailure`] (HTTP 422) for a zero-mean GRA series, a degenerate SMOGN relevance or a
+/// spent budget.
+pub fn run_analyze_valid(
+    input: &AnalyzeInput,
+    budget: &Budget,
+) -> Result<AnalyzeResponse, CalcFailure> {
+    let out = compute::analyze(input, budget)?;
+    Ok(output::respond_analyze(input, &out, budget))
+}
+
+/// The whole path of an `/analyze` request without HTTP (tests, benchmarks): the per-field
+/// rules, the rules between fields, then [`run_analyze_valid`].
+///
+/// # Errors
+/// As the endpoint: every offending field with its JSON pointer, or the calculation's failure.
 pub fn run_analyze(req: AnalyzeRequest, budget: &Budget) -> Result<AnalyzeResponse, CalcFailure> {
-    let input = AnalyzeInput::try_from(req)?;
-    let out = compute::analyze(&input, budget)?;
-    Ok(output::respond_analyze(&input, &out, budget))
+    crate::calc::rules::check(&req)?;
+    run_analyze_valid(&AnalyzeInput::try_from(req)?, budget)
 }

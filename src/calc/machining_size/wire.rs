@@ -1,5 +1,6 @@
 //! Wire types of `POST /v1/machining-size/train`, `/predict` and `/analyze` (spec §2, §5, §10),
-//! the module's bound constants and its `schema_bounds!` table.
+//! the module's bound constants and the per-field rules (`#[rule(...)]`, checked at the door and
+//! stated in the document).
 //!
 //! Targets and predictions are in the caller's unit (the paper's sizes are in mm); features in
 //! theirs. Field names follow the spec (`n_estimators`, `reg_alpha`, `MAE`, ...), so XGBoost users
@@ -13,7 +14,8 @@ use crate::calc::common::{Shard, ShardOut, TimeLimited, Warning};
 use crate::numerics::SolverReport;
 
 // ---------------------------------------------------------------------------------------------
-// Bounds (one source: the validator and the OpenAPI document read these)
+// Bounds (one source: the `#[rule]`s below read these; the door checks them, the document
+// states them)
 // ---------------------------------------------------------------------------------------------
 
 /// Most rows of a data set (spec §2.5).
@@ -79,38 +81,6 @@ pub const CHILD_INDEX: Range = Range::int(-1, 2_147_483_647);
 /// Cover of a node of a model document.
 pub const COVER: Range = Range::FINITE.min(0.0);
 
-crate::schema_bounds! {
-    TrainRequest { target @items: TARGET, time_limit_ms: crate::calc::common::TIME_LIMIT_MS },
-    PredictRequest { time_limit_ms: crate::calc::common::TIME_LIMIT_MS },
-    TrainParams {
-        n_estimators: N_ESTIMATORS,
-        max_depth: MAX_DEPTH,
-        learning_rate: LEARNING_RATE,
-        reg_lambda: REGULARISATION,
-        reg_alpha: REGULARISATION,
-        gamma: REGULARISATION,
-        min_child_weight: REGULARISATION,
-        colsample_bytree: FRACTION,
-        subsample: FRACTION,
-        base_score: TARGET,
-        max_bin: MAX_BIN,
-    },
-    ValidationIn { test_fraction: TEST_FRACTION, k_fold: K_FOLD },
-    SmognIn { threshold: SMOGN_THRESHOLD, k: SMOGN_K, perturbation: SMOGN_PERTURBATION },
-    SmognPreviewIn { threshold: SMOGN_THRESHOLD, k: SMOGN_K, perturbation: SMOGN_PERTURBATION },
-    AnalyzeRequest { target @items: TARGET, time_limit_ms: crate::calc::common::TIME_LIMIT_MS },
-    GraIn { rho: GRA_RHO },
-    PcaIn { components: PCA_COMPONENTS },
-    GbdtModel { base_score: TARGET, n_features: MODEL_FEATURES },
-    TreeDoc {
-        left @items: CHILD_INDEX,
-        right @items: CHILD_INDEX,
-        feature @items: CHILD_INDEX,
-        value @items: TARGET,
-        cover @items: COVER,
-    },
-}
-
 // ---------------------------------------------------------------------------------------------
 // /train
 // ---------------------------------------------------------------------------------------------
@@ -121,15 +91,15 @@ crate::schema_bounds! {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::TrainRequest)]
 #[serde(deny_unknown_fields)]
-#[rules(legacy_nulls)]
 pub struct TrainRequest {
     /// Column names: 1..200, unique, non-empty.
-    #[schema(min_items = 1, max_items = 200)]
+    #[rule(min_items = 1, max_items = MAX_FEATURES, code = "TOO_LARGE")]
     pub feature_names: Vec<String>,
     /// Feature matrix, row-major: 10..100 000 rows, each with one finite value per name.
-    #[schema(min_items = 10, max_items = 100000)]
+    #[rule(min_items = MIN_ROWS, max_items = MAX_ROWS, items_items = Range::FINITE, code = "TOO_LARGE")]
     pub rows: Vec<Vec<f64>>,
     /// Measured dimension y per row [target unit, e.g. mm]: one per row, not all equal.
+    #[rule(items = TARGET)]
     pub target: Vec<f64>,
     /// Boosting parameters (defaults: the paper's Table 2).
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
@@ -141,11 +111,12 @@ pub struct TrainRequest {
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub validation: ValidationIn,
     /// Optional outputs: `importance` (default), `shap_summary`, `test_predictions`.
-    #[serde(default = "default_outputs")]
+    #[serde(default = "default_outputs", deserialize_with = "null_default_outputs")]
     pub outputs: Vec<TrainOutputKind>,
     /// Wall-clock budget of the request \[ms\], 1..600 000 (capped by the server); training stops
     /// at the first round after it and returns the trees built.
     #[serde(default)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,
     /// Evaluate only block `index` of `count` near-equal contiguous blocks of the k
@@ -160,6 +131,34 @@ fn default_outputs() -> Vec<TrainOutputKind> {
     vec![TrainOutputKind::Importance]
 }
 
+/// Readers of optional fields whose default is not their type's `Default`: `null` reads as the
+/// documented default, exactly as if the field were absent.
+macro_rules! null_reads {
+    ($($name:ident: $t:ty = $default:expr;)*) => {$(
+        fn $name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$t, D::Error> {
+            Ok(Option::<$t>::deserialize(d)?.unwrap_or_else(|| $default))
+        }
+    )*};
+}
+
+null_reads! {
+    null_default_outputs: Vec<TrainOutputKind> = default_outputs();
+    null_n_estimators: u32 = TrainParams::default().n_estimators;
+    null_max_depth: u32 = TrainParams::default().max_depth;
+    null_learning_rate: f64 = TrainParams::default().learning_rate;
+    null_reg_lambda: f64 = TrainParams::default().reg_lambda;
+    null_reg_alpha: f64 = TrainParams::default().reg_alpha;
+    null_min_child_weight: f64 = TrainParams::default().min_child_weight;
+    null_colsample_bytree: f64 = TrainParams::default().colsample_bytree;
+    null_subsample: f64 = TrainParams::default().subsample;
+    null_max_bin: u32 = TrainParams::default().max_bin;
+    null_test_fraction: f64 = ValidationIn::default().test_fraction;
+    null_rho: f64 = GraIn::default().rho;
+    null_half: f64 = half();
+    null_five: u32 = five();
+    null_two_percent: f64 = two_percent();
+}
+
 impl TimeLimited for TrainRequest {
     fn time_limit(&self) -> Option<std::time::Duration> {
         self.time_limit_ms.map(std::time::Duration::from_millis)
@@ -171,42 +170,64 @@ impl TimeLimited for TrainRequest {
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::TrainParams)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct TrainParams {
     /// Boosting rounds (trees), 1..5000. Default 400.
+    #[serde(deserialize_with = "null_n_estimators")]
+    #[rule(range = N_ESTIMATORS)]
     pub n_estimators: u32,
     /// Tree depth, 1..12. Default 6.
+    #[serde(deserialize_with = "null_max_depth")]
+    #[rule(range = MAX_DEPTH)]
     pub max_depth: u32,
     /// Shrinkage η, (0, 1]. Default 0.05.
+    #[serde(deserialize_with = "null_learning_rate")]
+    #[rule(range = LEARNING_RATE)]
     pub learning_rate: f64,
     /// λ, L2 penalty on leaf weights [target unit²], [0, 1e6]. Default 0.1. With
     /// `min_child_weight` = 0 it must be > 0 (an empty child would divide by zero).
+    #[serde(deserialize_with = "null_reg_lambda")]
+    #[rule(range = REGULARISATION)]
     pub reg_lambda: f64,
     /// α, L1 penalty on leaf weights [target unit], [0, 1e6]. Default 0.05.
+    #[serde(deserialize_with = "null_reg_alpha")]
+    #[rule(range = REGULARISATION)]
     pub reg_alpha: f64,
     /// γ, minimum loss change of a split [target unit²], [0, 1e6], compared with the un-halved
     /// loss change as XGBoost does. Default 0.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
+    #[rule(range = REGULARISATION)]
     pub gamma: f64,
     /// Minimum hessian sum (rows) per child, [0, 1e6]. Default 1. The training split needs at
     /// least 2·max(1, min_child_weight) rows.
+    #[serde(deserialize_with = "null_min_child_weight")]
+    #[rule(range = REGULARISATION)]
     pub min_child_weight: f64,
     /// Fraction of features drawn for each tree, (0, 1]. Default 0.8 (paper); 1.0 makes the
     /// model deterministic with respect to XGBoost. ⌊colsample·d⌋ must be ≥ 1 (d = features
     /// left after dropping constant columns).
+    #[serde(deserialize_with = "null_colsample_bytree")]
+    #[rule(range = FRACTION)]
     pub colsample_bytree: f64,
     /// Fraction of training rows drawn for each tree (without replacement), (0, 1]. Default 1.
+    #[serde(deserialize_with = "null_subsample")]
+    #[rule(range = FRACTION)]
     pub subsample: f64,
     /// Seed of column and row sampling. Default 0.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub seed: u64,
     /// Initial prediction [target unit], |b| ≤ 1e100; absent → mean of the training targets
     /// (XGBoost ≥ 2.0 for squared error).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[rule(range = TARGET)]
     #[schema(nullable = false)]
     pub base_score: Option<f64>,
     /// Split search: `exact` (default) or `hist`.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     #[schema(inline)]
     pub tree_method: TreeMethod,
     /// Bins per feature for `hist`, 2..1024. Default 256.
+    #[serde(deserialize_with = "null_max_bin")]
+    #[rule(range = MAX_BIN)]
     pub max_bin: u32,
 }
 
@@ -276,24 +297,27 @@ impl Default for PreprocessingIn {
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::SmognIn)]
 #[serde(deny_unknown_fields)]
-#[rules(legacy_nulls)]
 pub struct SmognIn {
     /// Relevance control points `[[y, φ], ...]`: at least 2, y strictly increasing
     /// [target unit], φ in [0, 1]. Required (the automatic box-plot relevance fails on
     /// quantised targets).
-    #[schema(min_items = 2, value_type = Vec<[f64; 2]>)]
+    #[rule(min_items = 2, items_items = Range::FINITE)]
+    #[schema(value_type = Vec<[f64; 2]>)]
     pub relevance: Vec<[f64; 2]>,
     /// A sample is rare when φ(y) ≥ threshold, [0, 1]. Default 0.5.
-    #[serde(default = "half")]
+    #[serde(default = "half", deserialize_with = "null_half")]
+    #[rule(range = SMOGN_THRESHOLD)]
     pub threshold: f64,
     /// Nearest neighbours per seed, 1..50. Default 5.
-    #[serde(default = "five")]
+    #[serde(default = "five", deserialize_with = "null_five")]
+    #[rule(range = SMOGN_K)]
     pub k: u32,
     /// Relative sd of the Gaussian perturbation, [0, 1]. Default 0.02.
-    #[serde(default = "two_percent")]
+    #[serde(default = "two_percent", deserialize_with = "null_two_percent")]
+    #[rule(range = SMOGN_PERTURBATION)]
     pub perturbation: f64,
     /// Seed of the resampling. Default 0.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub seed: u64,
 }
 
@@ -311,16 +335,19 @@ fn two_percent() -> f64 {
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::ValidationIn)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct ValidationIn {
     /// Holdout share, [0, 0.5]. Default 0.2 (the paper's 80/20). The first
     /// ⌊(1 − test_fraction)·n⌋ rows of a seeded permutation train.
+    #[serde(deserialize_with = "null_test_fraction")]
+    #[rule(range = TEST_FRACTION)]
     pub test_fraction: f64,
     /// k-fold cross-validation over all rows (seeded permutation, folds of near-equal size),
     /// 2..20; absent → none.
+    #[rule(range = K_FOLD)]
     #[schema(nullable = false)]
     pub k_fold: Option<u32>,
     /// Seed of the holdout and fold permutations. Default 0.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub seed: u64,
 }
 
@@ -391,17 +418,19 @@ pub struct GbdtModel {
     /// Always `reg:squarederror` (v1).
     pub objective: String,
     /// Initial prediction [target unit], |b| ≤ 1e100.
+    #[rule(range = TARGET)]
     pub base_score: f64,
     /// Column names, one per feature (may be empty).
     pub feature_names: Vec<String>,
     /// Number of input columns a row must have, 1..200.
+    #[rule(range = MODEL_FEATURES)]
     pub n_features: u32,
     /// Training parameters (informational; `/predict` ignores them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub params: Option<TrainParams>,
     /// The trees, at most 5000.
-    #[schema(max_items = 5000)]
+    #[rule(max_items = MAX_TREES)]
     pub trees: Vec<TreeDoc>,
 }
 
@@ -412,10 +441,13 @@ pub struct GbdtModel {
 pub struct TreeDoc {
     /// Left child per node, −1 at leaves. Every node is reached from the root exactly once (no
     /// cycles, no shared children); both children are −1 or both are node indices.
+    #[rule(items = CHILD_INDEX)]
     pub left: Vec<i64>,
     /// Right child per node, −1 at leaves.
+    #[rule(items = CHILD_INDEX)]
     pub right: Vec<i64>,
     /// Split feature per node (0..n_features−1 at internal nodes; −1 at leaves).
+    #[rule(items = CHILD_INDEX)]
     pub feature: Vec<i64>,
     /// Threshold θ per node (finite; `x < θ` goes left; 0 at leaves).
     pub threshold: Vec<f64>,
@@ -424,8 +456,10 @@ pub struct TreeDoc {
     pub default_left: Vec<bool>,
     /// Node value [target unit], |v| ≤ 1e100: the leaf output (already × η) at leaves, the
     /// node's own weight × η at internal nodes.
+    #[rule(items = TARGET)]
     pub value: Vec<f64>,
     /// Cover (training rows, = hessian sum) per node, ≥ 0.
+    #[rule(items = COVER)]
     pub cover: Vec<f64>,
     /// Loss change Δ of the split per node (0 at leaves) [target unit²].
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
@@ -678,7 +712,7 @@ pub struct PredictRequest {
     #[schema(value_type = ModelDocument)]
     pub model: serde_json::Value,
     /// Rows to predict, 1..100 000, each with one finite value per model feature.
-    #[schema(min_items = 1, max_items = 100000)]
+    #[rule(min_items = 1, max_items = MAX_PREDICT_ROWS, items_items = Range::FINITE, code = "TOO_LARGE")]
     pub rows: Vec<Vec<f64>>,
     /// Column names of `rows`; when given they must equal the model's.
     #[serde(default)]
@@ -690,13 +724,15 @@ pub struct PredictRequest {
     pub shap: ShapKind,
     /// Background rows of interventional SHAP, 1..1000; rows × background ≤ 1 000 000.
     #[serde(default)]
-    #[schema(nullable = false, min_items = 1, max_items = 1000)]
+    #[rule(min_items = 1, max_items = MAX_BACKGROUND, items_items = Range::FINITE, code = "TOO_LARGE")]
+    #[schema(nullable = false)]
     pub background: Option<Vec<Vec<f64>>>,
     /// SHAP interaction values (path-dependent; rows ≤ 1000 and rows·d² ≤ 2 000 000).
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub interactions: bool,
     /// Wall-clock budget of the request \[ms\], 1..600 000 (capped by the server).
     #[serde(default)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,
 }
@@ -821,12 +857,13 @@ pub struct ModelSummary {
 #[serde(deny_unknown_fields)]
 pub struct AnalyzeRequest {
     /// Column names: 1..200, unique, non-empty.
-    #[schema(min_items = 1, max_items = 200)]
+    #[rule(min_items = 1, max_items = MAX_FEATURES, code = "TOO_LARGE")]
     pub feature_names: Vec<String>,
     /// Feature matrix, row-major: 10..100 000 rows, each with one finite value per name.
-    #[schema(min_items = 10, max_items = 100000)]
+    #[rule(min_items = MIN_ROWS, max_items = MAX_ROWS, items_items = Range::FINITE, code = "TOO_LARGE")]
     pub rows: Vec<Vec<f64>>,
     /// Measured dimension per row [target unit] (the GRA reference series, SMOGN's target).
+    #[rule(items = TARGET)]
     pub target: Vec<f64>,
     /// Grey relational grades of every non-constant feature against the target.
     #[serde(default)]
@@ -842,6 +879,7 @@ pub struct AnalyzeRequest {
     pub smogn: Option<SmognPreviewIn>,
     /// Wall-clock budget of the request \[ms\], 1..600 000 (capped by the server).
     #[serde(default)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,
 }
@@ -856,12 +894,14 @@ impl TimeLimited for AnalyzeRequest {
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::GraIn)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct GraIn {
     /// Distinguishing coefficient ρ, (0, 1]. Default 0.5.
+    #[serde(deserialize_with = "null_rho")]
+    #[rule(range = GRA_RHO)]
     pub rho: f64,
     /// `mean` (default: each series divided by its mean; a series with mean 0 is rejected) or
     /// `none`.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     #[schema(inline)]
     pub normalise: GraNormalise,
 }
@@ -893,13 +933,14 @@ pub enum GraNormalise {
 #[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::PcaIn)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct PcaIn {
     /// Components kept for loadings and the composite score, 1..200; absent → all (more than
     /// the non-constant features → all, with a warning).
+    #[rule(range = PCA_COMPONENTS)]
     #[schema(nullable = false)]
     pub components: Option<u32>,
     /// Also return the scores S (rows × components ≤ 4 000 000). Default false.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub scores: bool,
 }
 
@@ -907,26 +948,29 @@ pub struct PcaIn {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = machining_size::SmognPreviewIn)]
 #[serde(deny_unknown_fields)]
-#[rules(legacy_nulls)]
 pub struct SmognPreviewIn {
     /// Relevance control points `[[y, φ], ...]`: at least 2, y strictly increasing
     /// [target unit], φ in [0, 1].
-    #[schema(min_items = 2, value_type = Vec<[f64; 2]>)]
+    #[rule(min_items = 2, items_items = Range::FINITE)]
+    #[schema(value_type = Vec<[f64; 2]>)]
     pub relevance: Vec<[f64; 2]>,
     /// A sample is rare when φ(y) ≥ threshold, [0, 1]. Default 0.5.
-    #[serde(default = "half")]
+    #[serde(default = "half", deserialize_with = "null_half")]
+    #[rule(range = SMOGN_THRESHOLD)]
     pub threshold: f64,
     /// Nearest neighbours per seed, 1..50. Default 5.
-    #[serde(default = "five")]
+    #[serde(default = "five", deserialize_with = "null_five")]
+    #[rule(range = SMOGN_K)]
     pub k: u32,
     /// Relative sd of the Gaussian perturbation, [0, 1]. Default 0.02.
-    #[serde(default = "two_percent")]
+    #[serde(default = "two_percent", deserialize_with = "null_two_percent")]
+    #[rule(range = SMOGN_PERTURBATION)]
     pub perturbation: f64,
     /// Seed of the resampling. Default 0.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub seed: u64,
     /// Return the resampled rows and targets. Default false.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub include_data: bool,
 }
 
