@@ -90,6 +90,13 @@ pub fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
                     }
                     ApiError::invalid_field(pointer, message)
                 }
+                // serde_json reports some wrong types (`null` for a required enum) as syntax
+                // errors; a body that is JSON is never a 400 (checked on this error path only).
+                _ if !pointer.is_empty()
+                    && serde_json::from_slice::<serde::de::IgnoredAny>(bytes).is_ok() =>
+                {
+                    ApiError::invalid_field(pointer, format!("invalid value: {message}"))
+                }
                 _ => {
                     let e = ApiError::malformed_json(format!(
                         "{message} at line {}, column {}",
@@ -290,6 +297,27 @@ mod tests {
         let e = decode::<Outer>(br#"{"items":[{"t_b":1e400}]}"#).unwrap_err();
         assert_eq!(e.status(), StatusCode::UNPROCESSABLE_ENTITY);
         assert_eq!(e.body().errors[0].pointer, "/items/0/t_b");
+    }
+
+    #[derive(Debug, serde::Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    enum Mode {
+        Single,
+    }
+
+    #[derive(Debug, serde::Deserialize)]
+    #[expect(dead_code, reason = "decoded to be refused, never read")]
+    struct WithMode {
+        mode: Mode,
+    }
+
+    #[test]
+    fn null_for_a_required_enum_is_a_value_problem_not_a_400() {
+        let e = decode::<WithMode>(br#"{"mode": null}"#).unwrap_err();
+        assert_eq!(e.status(), StatusCode::UNPROCESSABLE_ENTITY);
+        assert_eq!(e.body().errors[0].pointer, "/mode");
+        let e = decode::<WithMode>(br#"{"mode": nul"#).unwrap_err();
+        assert_eq!(e.status(), StatusCode::BAD_REQUEST);
     }
 
     #[test]
