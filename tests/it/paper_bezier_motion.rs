@@ -682,9 +682,8 @@ fn shaper_rows_match_an_independent_integration() {
         ("light", light_system(), (10.0, 1.5)),
     ] {
         let sys = &system;
-        let j = sys["J_eq_kgm2"]
-            .as_f64()
-            .unwrap_or_else(|| 5e-3 + 5e-3 + 2.8);
+        // The paper drive lists its inertias: J_eq is their sum, as the service forms it.
+        let j = sys["J_eq_kgm2"].as_f64().unwrap_or(5e-3 + 5e-3 + 2.8);
         let plant = Plant::new(
             j,
             sys["k_Nm_per_rad"].as_f64().expect("k"),
