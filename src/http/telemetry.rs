@@ -27,9 +27,27 @@ fn handle() -> &'static PrometheusHandle {
     })
 }
 
-/// Install the recorder (idempotent); call before serving so early requests are counted.
+/// How often histogram samples are folded into their buckets.
+const UPKEEP: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// Install the recorder (idempotent); call before serving so early requests are counted. Starts
+/// the recorder's upkeep: a recorder installed with `install_recorder` keeps every histogram
+/// sample until the next render, so without a scrape memory grows with each request (the soak
+/// showed +11 MiB in 15 min); the upkeep folds them into buckets every few seconds.
 pub fn install() {
-    let _ = handle();
+    static UPKEEP_STARTED: OnceLock<()> = OnceLock::new();
+    let h = handle();
+    UPKEEP_STARTED.get_or_init(|| {
+        let h = h.clone();
+        let _ = std::thread::Builder::new()
+            .name("mechcalc-metrics-upkeep".to_owned())
+            .spawn(move || {
+                loop {
+                    std::thread::sleep(UPKEEP);
+                    h.run_upkeep();
+                }
+            });
+    });
 }
 
 /// The current metrics in the Prometheus text format.
