@@ -58,7 +58,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         bezier_motion::wire::schema_bounds(),
         bus_fuel_economy::wire::schema_bounds(),
         bus_fuel_economy::wire::variant_bounds(),
-        cam_law_fit::wire::schema_bounds(),
         cognates::wire::schema_bounds(),
         cognates::wire::variant_bounds(),
         component_importance::wire::schema_bounds(),

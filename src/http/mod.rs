@@ -166,10 +166,16 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
 #[must_use]
 pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRule])> {
     use crate::calc;
-    vec![(
-        "/v1/cam-law/evaluate",
-        calc::cam_law::input::CROSS_FIELD_RULES,
-    )]
+    vec![
+        (
+            "/v1/cam-law/evaluate",
+            calc::cam_law::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/fit-cam-law",
+            calc::cam_law_fit::input::CROSS_FIELD_RULES,
+        ),
+    ]
 }
 
 /// The document as utoipa generates it, before [`openapi::document`] completes it.
