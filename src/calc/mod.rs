@@ -58,8 +58,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         bezier_motion::wire::schema_bounds(),
         bus_fuel_economy::wire::schema_bounds(),
         bus_fuel_economy::wire::variant_bounds(),
-        cognates::wire::schema_bounds(),
-        cognates::wire::variant_bounds(),
         component_importance::wire::schema_bounds(),
         component_importance::wire::variant_bounds(),
         continuum_workspace::wire::schema_bounds(),

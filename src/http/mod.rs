@@ -171,6 +171,7 @@ pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRul
             "/v1/cam-law/evaluate",
             calc::cam_law::input::CROSS_FIELD_RULES,
         ),
+        ("/v1/cognates", calc::cognates::input::CROSS_FIELD_RULES),
         (
             "/v1/fit-cam-law",
             calc::cam_law_fit::input::CROSS_FIELD_RULES,
