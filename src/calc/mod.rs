@@ -66,8 +66,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         irefc::stress::wire::schema_bounds(),
         irefc::efficiency::wire::schema_bounds(),
         machining_size::schema_bounds(),
-        spatial_coupling::wire::schema_bounds(),
-        spatial_coupling::wire::nested_bounds(),
         vibration_absorber::wire::schema_bounds(),
     ]
     .concat()

@@ -176,6 +176,10 @@ pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRul
             "/v1/fit-cam-law",
             calc::cam_law_fit::input::CROSS_FIELD_RULES,
         ),
+        (
+            "/v1/spatial-coupling",
+            calc::spatial_coupling::input::CROSS_FIELD_RULES,
+        ),
     ]
 }
 
