@@ -62,9 +62,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         component_importance::wire::variant_bounds(),
         continuum_workspace::wire::schema_bounds(),
         continuum_workspace::wire::nested_bounds(),
-        irefc::wire::schema_bounds(),
-        irefc::stress::wire::schema_bounds(),
-        irefc::efficiency::wire::schema_bounds(),
         machining_size::schema_bounds(),
         vibration_absorber::wire::schema_bounds(),
     ]

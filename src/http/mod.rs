@@ -177,6 +177,14 @@ pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRul
             calc::cam_law_fit::input::CROSS_FIELD_RULES,
         ),
         (
+            "/v1/irefc-efficiency",
+            calc::irefc::efficiency::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/irefc-stress",
+            calc::irefc::stress::input::CROSS_FIELD_RULES,
+        ),
+        (
             "/v1/spatial-coupling",
             calc::spatial_coupling::input::CROSS_FIELD_RULES,
         ),
