@@ -581,25 +581,25 @@ fn check_initial(
     v: &mut Validator,
 ) -> ([f64; 7], [bool; 7], Option<&'static str>) {
     let mut fixed_zero = [false; 7];
-    if let Some(fz) = &req.fixed_zero {
-        if fz.len() == 7 {
-            fixed_zero.copy_from_slice(fz);
-            if fixed_zero[..3].iter().all(|z| *z) {
-                v.rule(
-                    &EMPTY_PULSE,
-                    "/fixed_zero",
-                    "fixes all of c0, c1, c2: the first acceleration pulse would be empty; free at least one of them",
-                );
-            }
-            if fixed_zero[4..].iter().all(|z| *z) {
-                v.rule(
-                    &EMPTY_PULSE,
-                    "/fixed_zero",
-                    "fixes all of c4, c5, c6: the second acceleration pulse would be empty; free at least one of them",
-                );
-            }
+    // 7 flags: checked at the door.
+    if let Some(fz) = &req.fixed_zero
+        && fz.len() == 7
+    {
+        fixed_zero.copy_from_slice(fz);
+        if fixed_zero[..3].iter().all(|z| *z) {
+            v.rule(
+                &EMPTY_PULSE,
+                "/fixed_zero",
+                "fixes all of c0, c1, c2: the first acceleration pulse would be empty; free at least one of them",
+            );
         }
-        // (7 flags: checked at the door.)
+        if fixed_zero[4..].iter().all(|z| *z) {
+            v.rule(
+                &EMPTY_PULSE,
+                "/fixed_zero",
+                "fixes all of c4, c5, c6: the second acceleration pulse would be empty; free at least one of them",
+            );
+        }
     }
     let mut initial = [1.0 / 7.0; 7];
     let mut initial_pointer = None;
