@@ -757,12 +757,14 @@ fn with_derived(
     (channels, derived, warnings)
 }
 
-/// Validate a request into a [`FitInput`].
+/// Check the rules between fields of a request whose per-field rules passed the door, turning
+/// it into a [`FitInput`].
 ///
 /// # Errors
-/// [`ProblemClass::InvalidInput`] listing every offending field; [`ProblemClass::TooLarge`]
-/// when the cost estimate exceeds [`MAX_COST`]; [`ProblemClass::Infeasible`] when the boundary
-/// conditions admit no representable law of this duration (the initial law overflows f64).
+/// Every broken rule of [`CROSS_FIELD_RULES`] with its pointer (invalid input listed at once);
+/// [`FIT_TOO_EXPENSIVE`] when the cost estimate exceeds [`MAX_COST`];
+/// [`INFEASIBLE_CONSTRAINTS`] when the boundary conditions admit no representable law of this
+/// duration (the initial law overflows f64).
 pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let mut v = Validator::new();
     let xs = abscissa(&req, &mut v);
