@@ -57,14 +57,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         common::schema_bounds(),
         bezier_motion::wire::schema_bounds(),
-        cam_law_fit::wire::schema_bounds(),
-        cognates::wire::schema_bounds(),
-        cognates::wire::variant_bounds(),
-        irefc::wire::schema_bounds(),
-        irefc::stress::wire::schema_bounds(),
-        irefc::efficiency::wire::schema_bounds(),
-        spatial_coupling::wire::schema_bounds(),
-        spatial_coupling::wire::nested_bounds(),
         vibration_absorber::wire::schema_bounds(),
     ]
     .concat()

@@ -3,8 +3,8 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::cam_law_fit::{self, FitCamLawRequest, FitCamLawResponse};
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
+use crate::calc::cam_law_fit::{self, FitCamLawRequest, FitCamLawResponse, FitInput};
 
 /// Identify a cam motion law: the 7 segment coefficients of the general modified-trapezoidal law
 /// that best reproduce measured motion.
@@ -29,8 +29,11 @@ use crate::calc::cam_law_fit::{self, FitCamLawRequest, FitCamLawResponse};
 )]
 pub async fn fit(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<FitCamLawRequest>,
+    Valid { input, limit, .. }: Valid<FitCamLawRequest, FitInput>,
 ) -> Result<Response, ApiError> {
-    let limit = cam_law_fit::time_limit(&req);
-    run_calc(&state, limit, move |budget| cam_law_fit::run(req, budget)).await
+    // `limit`: the smaller of `time_limit_ms` and `optimizer.time_limit_ms` (TimeLimited).
+    run_calc(&state, limit, move |budget| {
+        cam_law_fit::run_valid(&input, budget)
+    })
+    .await
 }

@@ -3,9 +3,8 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::cognates::{self, wire::CognatesRequest, wire::CognatesResponse};
-use crate::calc::common::TimeLimited;
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
+use crate::calc::cognates::{self, CognatesInput, wire::CognatesRequest, wire::CognatesResponse};
 
 /// Roberts–Chebyshev cognates: two other four-bars that trace the same coupler curve.
 ///
@@ -30,8 +29,10 @@ use crate::calc::common::TimeLimited;
 )]
 pub async fn construct(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<CognatesRequest>,
+    Valid { input, limit, .. }: Valid<CognatesRequest, CognatesInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
-    run_calc(&state, limit, move |budget| cognates::run(req, budget)).await
+    run_calc(&state, limit, move |budget| {
+        cognates::run_valid(&input, budget)
+    })
+    .await
 }

@@ -4,8 +4,9 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::common::TimeLimited;
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
+use crate::calc::irefc::efficiency::input::EfficiencyInput;
+use crate::calc::irefc::stress::input::StressJob;
 use crate::calc::irefc::{
     self, IrefcEfficiencyRequest, IrefcEfficiencyResponse, IrefcStressRequest, IrefcStressResponse,
 };
@@ -35,10 +36,12 @@ use crate::calc::irefc::{
 )]
 pub async fn stress(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<IrefcStressRequest>,
+    Valid { input, limit, .. }: Valid<IrefcStressRequest, StressJob>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
-    run_calc(&state, limit, move |budget| irefc::run_stress(req, budget)).await
+    run_calc(&state, limit, move |budget| {
+        irefc::stress::run_valid(&input, budget)
+    })
+    .await
 }
 
 /// IREFC cycloid gear: slip speeds, friction power and mesh efficiency.
@@ -62,11 +65,10 @@ pub async fn stress(
 )]
 pub async fn efficiency(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<IrefcEfficiencyRequest>,
+    Valid { input, limit, .. }: Valid<IrefcEfficiencyRequest, EfficiencyInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        irefc::run_efficiency(req, budget)
+        irefc::efficiency::run_valid(&input, budget)
     })
     .await
 }

@@ -3,9 +3,10 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::common::TimeLimited;
-use crate::calc::spatial_coupling::{self, SpatialCouplingRequest, SpatialCouplingResponse};
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
+use crate::calc::spatial_coupling::{
+    self, SpatialCouplingInput, SpatialCouplingRequest, SpatialCouplingResponse,
+};
 
 /// Kinematics of the RP1PR coupling between crossed shafts, in closed form.
 ///
@@ -32,11 +33,10 @@ use crate::calc::spatial_coupling::{self, SpatialCouplingRequest, SpatialCouplin
 )]
 pub async fn evaluate(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<SpatialCouplingRequest>,
+    Valid { input, limit, .. }: Valid<SpatialCouplingRequest, SpatialCouplingInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        spatial_coupling::run(req, budget)
+        spatial_coupling::run_valid(&input, budget)
     })
     .await
 }

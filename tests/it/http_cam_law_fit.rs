@@ -126,10 +126,10 @@ async fn sample_problems_are_422_with_pointers() {
 
 #[tokio::test]
 async fn constraint_and_option_problems_are_all_listed() {
+    // The per-field rules are checked at the door and all listed together, before any rule
+    // between fields runs.
     let mut b = small();
-    b["constraints"] = json!({"t_a": 1.0, "t_b": 0.5});
-    b["objective"] = json!({"metric": "dtw", "dtw_window": 13});
-    b["optimizer"] = json!({"method": "lsq", "max_evaluations": 0, "time_limit_ms": 700000,
+    b["optimizer"] = json!({"max_evaluations": 0, "time_limit_ms": 700000,
                             "snap_tol": 0.1, "dtw_global_restarts": 10, "ga": {"p_crossover": 1.5}});
     b["initial_coefficients"] = json!([0.1, 0.1, -0.1, 0.1, 0.1, 0.1, 0.1]);
     b["outputs"] = json!({"curves": {"count": 100001}});
@@ -138,9 +138,6 @@ async fn constraint_and_option_problems_are_all_listed() {
     assert_eq!(p["type"], "/problems/invalid-input");
     let ptrs = r.pointers();
     for want in [
-        "/constraints/t_b",
-        "/objective/dtw_window",
-        "/optimizer/method",
         "/optimizer/max_evaluations",
         "/optimizer/time_limit_ms",
         "/optimizer/snap_tol",
@@ -150,6 +147,219 @@ async fn constraint_and_option_problems_are_all_listed() {
         "/outputs/curves/count",
     ] {
         assert!(ptrs.iter().any(|q| q == want), "{want} missing in {p}");
+    }
+    // A schema-valid request breaking three rules between fields gets all three listed.
+    let mut b = small();
+    b["constraints"] = json!({"t_a": 1.0, "t_b": 0.5});
+    b["objective"] = json!({"metric": "dtw", "dtw_window": 13});
+    b["optimizer"] = json!({"method": "lsq"});
+    let r = post_json(PATH, &b).await;
+    let p = r.problem(422);
+    assert_eq!(p["type"], "/problems/invalid-input");
+    let ptrs = r.pointers();
+    for want in [
+        "/constraints/t_b",
+        "/objective/dtw_window",
+        "/optimizer/method",
+    ] {
+        assert!(ptrs.iter().any(|q| q == want), "{want} missing in {p}");
+    }
+}
+
+/// The codes the document lists under the operation's `x-cross-field-rules`.
+async fn documented_cross_codes() -> Vec<String> {
+    let doc = common::get("/openapi.json").await.json();
+    doc["paths"][PATH]["post"]["x-cross-field-rules"]
+        .as_array()
+        .expect("x-cross-field-rules listed")
+        .iter()
+        .map(|r| r["code"].as_str().expect("code").to_owned())
+        .collect()
+}
+
+#[tokio::test]
+async fn every_rule_between_fields_is_listed_and_reachable() {
+    let codes = documented_cross_codes().await;
+    let with = |f: &dyn Fn(&mut Value)| {
+        let mut b = small();
+        f(&mut b);
+        b
+    };
+    let xs = small()["abscissa"]["values"].clone();
+    let s = small()["channels"]["displacement"].clone();
+    let cases: Vec<(&str, &str, Value)> = vec![
+        (
+            "ABSCISSA_ORDER",
+            "/abscissa/values/4",
+            with(&|b| b["abscissa"]["values"][4] = json!(0.1)),
+        ),
+        (
+            "ABSCISSA_ORDER",
+            "/abscissa/grid/end",
+            with(&|b| b["abscissa"] = json!({"grid": {"start": 1.0, "end": 0.0, "count": 12}})),
+        ),
+        (
+            "NO_CHANNEL",
+            "/channels",
+            with(&|b| b["channels"] = json!({})),
+        ),
+        (
+            "CHANNEL_LENGTH",
+            "/channels/displacement",
+            with(&|b| b["channels"]["displacement"] = json!([0.0, 0.5, 1.0])),
+        ),
+        (
+            "FIT_CHANNEL_MISSING",
+            "/fit_on",
+            with(&|b| b["fit_on"] = json!("velocity")),
+        ),
+        (
+            "END_DISPLACEMENT_REQUIRED",
+            "/constraints/s_a",
+            json!({"abscissa": {"values": xs}, "channels": {"velocity": s}, "fit_on": "velocity"}),
+        ),
+        (
+            "SEGMENT_INTERVAL",
+            "/constraints/t_b",
+            with(&|b| b["constraints"] = json!({"t_a": 1.0, "t_b": 0.5})),
+        ),
+        (
+            "ABSCISSA_OUTSIDE",
+            "/abscissa/values/10",
+            with(&|b| b["constraints"] = json!({"t_a": 0.0, "t_b": 0.9})),
+        ),
+        (
+            "DTW_WINDOW_SAMPLES",
+            "/objective/dtw_window",
+            with(&|b| b["objective"] = json!({"metric": "dtw", "dtw_window": 13})),
+        ),
+        (
+            "METHOD_METRIC",
+            "/optimizer/method",
+            with(&|b| {
+                b["objective"] = json!({"metric": "dtw"});
+                b["optimizer"] = json!({"method": "lsq"});
+            }),
+        ),
+        (
+            "INITIAL_EXCLUSIVE",
+            "/initial_law",
+            with(&|b| {
+                b["initial_law"] = json!("cycloidal");
+                b["initial_coefficients"] = json!([1, 1, 1, 1, 1, 1, 1]);
+            }),
+        ),
+        (
+            "INITIAL_LAW_CLASS",
+            "/initial_law",
+            with(&|b| b["initial_law"] = json!("polynomial_345")),
+        ),
+        (
+            "EMPTY_PULSE",
+            "/fixed_zero",
+            with(&|b| b["fixed_zero"] = json!([true, true, true, false, false, false, false])),
+        ),
+        ("FIT_TOO_EXPENSIVE", "/optimizer/max_evaluations", {
+            let mut b = table1();
+            b["objective"] = json!({"metric": "dtw", "dtw_window": 300});
+            b["optimizer"]["max_evaluations"] = json!(10_000_000);
+            b
+        }),
+        (
+            "INFEASIBLE_CONSTRAINTS",
+            "/constraints",
+            json!({
+                "abscissa": {"values": (0..8).map(|k| f64::from(k) * 1e-300 / 7.0).collect::<Vec<_>>()},
+                "channels": {"velocity": [0.0, 1.0, 2.0, 3.0, 3.0, 2.0, 1.0, 0.0]},
+                "fit_on": "velocity",
+                "constraints": {"s_a": 0.0, "s_b": 1e12}
+            }),
+        ),
+    ];
+    for (code, pointer, body) in cases {
+        assert!(
+            codes.iter().any(|c| c == code),
+            "{code} is not listed: {codes:?}"
+        );
+        let r = post_json(PATH, &body).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], code, "{p}");
+        assert!(
+            r.pointers().iter().any(|q| q == pointer),
+            "{code}: expected pointer {pointer}, got {p}"
+        );
+    }
+}
+
+/// An answer without its timing fields (`optimizer_report.cpu_ms`, `wall_ms`).
+fn untimed(mut v: Value) -> Value {
+    fn strip(v: &mut Value) {
+        match v {
+            Value::Object(m) => {
+                m.retain(|k, _| !["cpu_ms", "wall_ms", "elapsed_ms"].contains(&k.as_str()));
+                m.values_mut().for_each(strip);
+            }
+            Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
+
+#[tokio::test]
+async fn null_optional_fields_answer_as_absent() {
+    let plain = table1();
+    let mut nulls = table1();
+    for k in [
+        "derive_missing",
+        "initial_coefficients",
+        "initial_law",
+        "fixed_zero",
+        "time_limit_ms",
+    ] {
+        nulls[k] = Value::Null;
+    }
+    nulls["abscissa"]["values"] = Value::Null;
+    nulls["channels"]["displacement"] = Value::Null;
+    nulls["channels"]["velocity"] = Value::Null;
+    nulls["objective"]["dtw_window"] = Value::Null;
+    for k in ["ga", "dtw_global_restarts", "polish", "snap_tol"] {
+        nulls["optimizer"][k] = Value::Null;
+    }
+    nulls["outputs"]["curves"]["quantities"] = Value::Null;
+    let a = post_json(PATH, &plain).await;
+    assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+    let b = post_json(PATH, &nulls).await;
+    assert_eq!(b.status, 200, "{}", String::from_utf8_lossy(&b.bytes));
+    assert_eq!(untimed(a.json()), untimed(b.json()));
+    // Every optional field of a nested object null (GA settings, constraints, curves), and
+    // every optional object itself null: the defaults, as when absent.
+    let mut inner = small();
+    inner["optimizer"] = json!({"method": null, "seed": null, "max_evaluations": null,
+        "time_limit_ms": null, "dtw_global_restarts": null, "polish": null, "snap_tol": null,
+        "ga": {"population": null, "generations": null, "p_crossover": null, "p_inversion": null,
+               "p_range_mutation": null, "range0": null, "range_factor": null, "range_every": null,
+               "p_mutation": null, "stall_generations": null}});
+    inner["constraints"] = json!({"t_a": null, "t_b": null, "s_a": null, "s_b": null,
+        "v_a": null, "v_b": null, "a_a": null, "a_b": null});
+    inner["objective"] = json!({"metric": null, "dtw_window": null});
+    inner["outputs"] = json!({"curves": {"count": null, "quantities": null}, "error_table": null,
+        "history": null, "classify": null});
+    inner["units"] = json!({"x": null, "s": null});
+    let mut top = small();
+    for k in ["constraints", "objective", "optimizer", "outputs", "units"] {
+        top[k] = Value::Null;
+    }
+    // (Unit labels are echoed: the baseline of `units: {x: null, s: null}` is `units: {}`.)
+    let mut with_units = small();
+    with_units["units"] = json!({});
+    for (plain, body) in [(with_units, inner), (small(), top)] {
+        let a = post_json(PATH, &plain).await;
+        assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+        let b = post_json(PATH, &body).await;
+        assert_eq!(b.status, 200, "{}", String::from_utf8_lossy(&b.bytes));
+        assert_eq!(untimed(a.json()), untimed(b.json()));
     }
 }
 

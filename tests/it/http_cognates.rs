@@ -150,3 +150,145 @@ async fn input_angle_outside_the_range_is_not_an_error() {
     assert_eq!(v["mechanisms"][0]["snapshot"]["status"], "not_assemblable");
     assert!(v["mechanisms"][0]["snapshot"].get("joints").is_none());
 }
+
+/// The codes the document lists under the operation's `x-cross-field-rules`.
+async fn documented_cross_codes() -> Vec<String> {
+    let doc = common::get("/openapi.json").await.json();
+    doc["paths"][PATH]["post"]["x-cross-field-rules"]
+        .as_array()
+        .expect("x-cross-field-rules listed")
+        .iter()
+        .map(|r| r["code"].as_str().expect("code").to_owned())
+        .collect()
+}
+
+#[tokio::test]
+async fn every_rule_between_fields_is_listed_and_reachable() {
+    let codes = documented_cross_codes().await;
+    let joints =
+        json!({"A": [0, 0], "B": [3.1, 0], "D": [1.0, 0.5], "E": [2.5, 1.0], "P": [1.5, 1.5]});
+    let cases = [
+        ("JOINTS_EXCLUSIVE", "/ground", json!({"joints": joints})),
+        ("DIMENSIONS_REQUIRED", "/crank", json!({"crank": null})),
+        (
+            "GROUND_B_OR_LENGTH",
+            "/ground/length",
+            json!({"ground": {"B": [3.1, 0], "length": 3.1}}),
+        ),
+        (
+            "GROUND_ANGLE_WITH_LENGTH",
+            "/ground/angle_deg",
+            json!({"ground": {"B": [3.1, 0], "angle_deg": 10.0}}),
+        ),
+        (
+            "COINCIDENT_PIVOTS",
+            "/ground/B",
+            json!({"ground": {"B": [0, 0]}}),
+        ),
+        ("NON_POSITIVE_LENGTH", "/crank", json!({"crank": 1e-13})),
+        (
+            "COUPLER_TRIANGLE_INVALID",
+            "/coupler_point",
+            json!({"coupler_point": {"d": 0.1, "e": 1.56}}),
+        ),
+        (
+            "COUPLER_POINT_AT_JOINT",
+            "/coupler_point",
+            json!({"coupler_point": {"u": 0.0, "v": 0.0}}),
+        ),
+    ];
+    for (code, pointer, patch) in cases {
+        assert!(
+            codes.iter().any(|c| c == code),
+            "{code} is not listed: {codes:?}"
+        );
+        let mut b = table1();
+        for (k, v) in patch.as_object().expect("object") {
+            b[k] = v.clone();
+        }
+        let r = post_json(PATH, &b).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], code, "{p}");
+        assert!(
+            r.pointers().iter().any(|q| q == pointer),
+            "{code}: expected pointer {pointer}, got {p}"
+        );
+    }
+    // The failures found while computing (geometric_rejections_have_their_codes reaches them).
+    for code in [
+        "NOT_ASSEMBLABLE",
+        "TOO_MANY_POINTS",
+        "DEADLINE_EXCEEDED",
+        "RESPONSE_TOO_LARGE",
+    ] {
+        assert!(
+            codes.iter().any(|c| c == code),
+            "{code} is not listed: {codes:?}"
+        );
+    }
+}
+
+/// An answer without its timing fields (`meta.compute_us`).
+fn untimed(mut v: Value) -> Value {
+    fn strip(v: &mut Value) {
+        match v {
+            Value::Object(m) => {
+                m.retain(|k, _| k != "compute_us");
+                m.values_mut().for_each(strip);
+            }
+            Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
+
+#[tokio::test]
+async fn null_optional_fields_answer_as_absent() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("api/cognates/table1.json");
+    let plain: Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("example")).expect("json");
+    let mut nulls = plain.clone();
+    for k in ["joints", "angle_reference", "time_limit_ms"] {
+        nulls[k] = Value::Null;
+    }
+    nulls["ground"]["length"] = Value::Null;
+    nulls["ground"]["angle_deg"] = Value::Null;
+    for k in ["u", "v", "p", "alpha_deg"] {
+        nulls["coupler_point"][k] = Value::Null;
+    }
+    nulls["options"]["metrics"] = Value::Null;
+    nulls["options"]["grashof_rtol"] = Value::Null;
+    let a = post_json(PATH, &plain).await;
+    assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+    let b = post_json(PATH, &nulls).await;
+    assert_eq!(b.status, 200, "{}", String::from_utf8_lossy(&b.bytes));
+    assert_eq!(untimed(a.json()), untimed(b.json()));
+    // Every option null, the options object null, the ground's A and the coupler side null: the
+    // defaults, as when absent.
+    let mut every = table1();
+    every["options"] = json!({"curves": null, "points_per_circuit": null, "spacing": null,
+        "curve_mode": null, "verify": null, "geared_fivebars": null, "metrics": null,
+        "grashof_rtol": null});
+    let mut top = table1();
+    top["options"] = Value::Null;
+    top["branch"] = Value::Null;
+    let mut no_branch = table1();
+    no_branch.as_object_mut().map(|m| m.remove("branch"));
+    let mut side = table1();
+    side["ground"]["A"] = Value::Null;
+    side["coupler_point"]["side"] = Value::Null;
+    let mut no_side = table1();
+    no_side["ground"].as_object_mut().map(|m| m.remove("A"));
+    no_side["coupler_point"]
+        .as_object_mut()
+        .map(|m| m.remove("side"));
+    for (plain, body) in [(table1(), every), (no_branch, top), (no_side, side)] {
+        let a = post_json(PATH, &plain).await;
+        assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+        let b = post_json(PATH, &body).await;
+        assert_eq!(b.status, 200, "{}", String::from_utf8_lossy(&b.bytes));
+        assert_eq!(untimed(a.json()), untimed(b.json()));
+    }
+}

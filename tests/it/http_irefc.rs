@@ -260,3 +260,277 @@ async fn mutated_examples_never_fail_with_500() {
         );
     }
 }
+
+/// The codes the document lists under the operation's `x-cross-field-rules`.
+async fn documented_cross_codes(path: &str) -> Vec<String> {
+    let doc = common::get("/openapi.json").await.json();
+    doc["paths"][path]["post"]["x-cross-field-rules"]
+        .as_array()
+        .expect("x-cross-field-rules listed")
+        .iter()
+        .map(|r| r["code"].as_str().expect("code").to_owned())
+        .collect()
+}
+
+/// `example` with the members of `patch` set (a `null` member is removed).
+fn patched(name: &str, patch: &Value) -> Value {
+    let mut b = example(name);
+    for (k, v) in patch.as_object().expect("object") {
+        if v.is_null() {
+            b.as_object_mut().map(|m| m.remove(k));
+        } else {
+            b[k] = v.clone();
+        }
+    }
+    b
+}
+
+#[tokio::test]
+#[expect(
+    clippy::too_many_lines,
+    reason = "one table: a request per rule of both routes"
+)]
+async fn every_rule_between_fields_is_listed_and_reachable() {
+    let stress_codes = documented_cross_codes(STRESS).await;
+    let eff_codes = documented_cross_codes(EFFICIENCY).await;
+    let sweep =
+        json!({"Z2": {"from": 10, "to": 12}, "chi": {"from": 1.25, "to": 1.3, "step": 0.01}});
+    let cases = [
+        // (path, code, pointer, example, patch)
+        (
+            STRESS,
+            "BAD_RANGE",
+            "/sweep",
+            "stress_single",
+            json!({"sweep": sweep}),
+        ),
+        (
+            STRESS,
+            "BAD_RANGE",
+            "/shard",
+            "stress_single",
+            json!({"shard": {"index": 0, "count": 2}}),
+        ),
+        (
+            STRESS,
+            "SHARD_INDEX_BELOW_COUNT",
+            "/shard/index",
+            "stress_sweep",
+            json!({"shard": {"index": 2, "count": 2}}),
+        ),
+        (
+            STRESS,
+            "MISSING_FIELD",
+            "/Z2",
+            "stress_single",
+            json!({"Z2": null}),
+        ),
+        (
+            STRESS,
+            "MISSING_FIELD",
+            "/rb_mm",
+            "stress_sweep",
+            json!({"rb_mm": null}),
+        ),
+        (
+            STRESS,
+            "BAD_RANGE",
+            "/sweep/Z2/to",
+            "stress_sweep",
+            json!({"sweep": {"Z2": {"from": 12, "to": 10}, "chi": {"from": 1.25, "to": 1.3, "step": 0.01}}}),
+        ),
+        (
+            STRESS,
+            "BAD_RANGE",
+            "/sweep/chi/to",
+            "stress_sweep",
+            json!({"sweep": {"Z2": {"from": 10, "to": 12}, "chi": {"from": 1.3, "to": 1.25, "step": 0.01}}}),
+        ),
+        (
+            STRESS,
+            "BAD_RANGE",
+            "/lb_mm",
+            "stress_single",
+            json!({"lb_mm": 2000.001}),
+        ),
+        (
+            STRESS,
+            "GRID_TOO_FINE",
+            "/step_deg",
+            "stress_single",
+            json!({"step_deg": 1e-5}),
+        ),
+        (
+            STRESS,
+            "SWEEP_TOO_LARGE",
+            "/sweep",
+            "stress_sweep",
+            json!({"sweep": {"Z2": {"from": 10, "to": 40}, "chi": {"from": 1.25, "to": 1.67, "step": 1e-6}}}),
+        ),
+        (
+            STRESS,
+            "ELEMENT_OVERLAP",
+            "/rb_mm",
+            "stress_single",
+            json!({"rb_mm": 3.4}),
+        ),
+        (
+            STRESS,
+            "UNDERCUT",
+            "/rb_mm",
+            "stress_single",
+            json!({"Z2": 40, "chi": 1.25}),
+        ),
+        (
+            EFFICIENCY,
+            "AMBIGUOUS_LOAD",
+            "/input_torque_Nm",
+            "efficiency_paper",
+            json!({"input_torque_Nm": 9.55}),
+        ),
+        (
+            EFFICIENCY,
+            "MISSING_FIELD",
+            "/power_W",
+            "efficiency_paper",
+            json!({"power_W": null}),
+        ),
+        (
+            EFFICIENCY,
+            "BAD_RANGE",
+            "/phase_deg",
+            "efficiency_paper",
+            json!({"phase_deg": 14.0}),
+        ),
+        (
+            EFFICIENCY,
+            "UNDERCUT",
+            "/rb_mm",
+            "efficiency_paper",
+            json!({"Z2": 40, "chi": 1.25}),
+        ),
+        (
+            EFFICIENCY,
+            "ELEMENT_OVERLAP",
+            "/rb_mm",
+            "efficiency_paper",
+            json!({"rb_mm": 3.4}),
+        ),
+    ];
+    for (path, code, pointer, name, patch) in cases {
+        let codes = if path == STRESS {
+            &stress_codes
+        } else {
+            &eff_codes
+        };
+        assert!(
+            codes.iter().any(|c| c == code),
+            "{path}: {code} is not listed: {codes:?}"
+        );
+        let r = post_json(path, &patched(name, &patch)).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], code, "{path} {patch}: {p}");
+        assert!(
+            r.pointers().iter().any(|q| q == pointer),
+            "{path} {code}: expected pointer {pointer}, got {p}"
+        );
+    }
+    // Failures found while computing, listed too.
+    for code in ["NON_FINITE", "DEADLINE", "RESPONSE_TOO_LARGE"] {
+        assert!(
+            stress_codes.iter().any(|c| c == code),
+            "{code}: {stress_codes:?}"
+        );
+        assert!(eff_codes.iter().any(|c| c == code), "{code}: {eff_codes:?}");
+    }
+}
+
+/// An answer without its timing fields (`compute_ms`, the report's `elapsed_ms`).
+fn untimed(mut v: Value) -> Value {
+    fn strip(v: &mut Value) {
+        match v {
+            Value::Object(m) => {
+                m.retain(|k, _| k != "compute_ms" && k != "elapsed_ms");
+                m.values_mut().for_each(strip);
+            }
+            Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
+
+#[tokio::test]
+async fn null_optional_fields_answer_as_absent() {
+    let with_nulls = |name: &str, top: &[&str], nested: &[(&str, &str)]| {
+        let mut b = example(name);
+        for k in top {
+            b[*k] = Value::Null;
+        }
+        for (o, k) in nested {
+            b[*o][*k] = Value::Null;
+        }
+        b
+    };
+    let cases = [
+        (
+            STRESS,
+            "stress_single",
+            with_nulls(
+                "stress_single",
+                &[
+                    "curves_stride",
+                    "profile_points",
+                    "sweep",
+                    "shard",
+                    "time_limit_ms",
+                ],
+                &[("include", "profiles"), ("include", "subsurface")],
+            ),
+        ),
+        (
+            STRESS,
+            "stress_sweep",
+            with_nulls(
+                "stress_sweep",
+                &[
+                    "Z2",
+                    "chi",
+                    "output_link",
+                    "lb_mm",
+                    "wheel_material",
+                    "roller_material",
+                    "load_sharing",
+                    "include",
+                    "curves_stride",
+                    "profile_points",
+                    "shard",
+                    "time_limit_ms",
+                ],
+                &[("sweep", "rb_mm"), ("sweep", "r2_mm")],
+            ),
+        ),
+        (
+            EFFICIENCY,
+            "efficiency_paper",
+            with_nulls(
+                "efficiency_paper",
+                &["input_torque_Nm", "time_limit_ms"],
+                &[],
+            ),
+        ),
+    ];
+    for (path, name, nulls) in cases {
+        let a = post_json(path, &example(name)).await;
+        assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.bytes));
+        let b = post_json(path, &nulls).await;
+        assert_eq!(
+            b.status,
+            200,
+            "{name}: {}",
+            String::from_utf8_lossy(&b.bytes)
+        );
+        assert_eq!(untimed(a.json()), untimed(b.json()), "{name}");
+    }
+}

@@ -149,15 +149,20 @@ async fn invalid_fields_point_at_themselves() {
 /// Several bad fields at once: one 422 listing each.
 #[tokio::test]
 async fn every_bad_field_is_listed() {
+    // The per-field rules are checked at the door, all listed together; |cos 2α| ≥ 1e-9 is a
+    // rule of the operation (a hole in α's range), checked once the fields are valid.
     let r = post_json(
         PATH,
-        &json!({"alpha_deg": 45, "a_m": -1, "beta_deg": 100, "sweep": {"n_points": 0}}),
+        &json!({"alpha_deg": 44, "a_m": -1, "beta_deg": 100, "sweep": {"n_points": 0}}),
     )
     .await;
     r.problem(422);
     let mut got = r.pointers();
     got.sort();
-    assert_eq!(got, ["/a_m", "/alpha_deg", "/beta_deg", "/sweep/n_points"]);
+    assert_eq!(got, ["/a_m", "/beta_deg", "/sweep/n_points"]);
+    let r = post_json(PATH, &json!({"alpha_deg": 45, "sweep": {"n_points": 5}})).await;
+    r.problem(422);
+    assert_eq!(r.pointers(), ["/alpha_deg"]);
 }
 
 /// Decode errors: wrong branch, wrong types, unknown members.
@@ -266,4 +271,96 @@ async fn warnings_name_the_hazard() {
         codes.iter().any(|c| c == "CONTACT_ILL_CONDITIONED"),
         "{codes:?}"
     );
+}
+
+/// The codes the document lists under the operation's `x-cross-field-rules`.
+async fn documented_cross_codes() -> Vec<String> {
+    let doc = common::get("/openapi.json").await.json();
+    doc["paths"][PATH]["post"]["x-cross-field-rules"]
+        .as_array()
+        .expect("x-cross-field-rules listed")
+        .iter()
+        .map(|r| r["code"].as_str().expect("code").to_owned())
+        .collect()
+}
+
+#[tokio::test]
+async fn every_rule_between_fields_is_listed_and_reachable() {
+    let codes = documented_cross_codes().await;
+    let cases = [
+        (
+            "PERPENDICULAR_SHAFTS",
+            "/alpha_deg",
+            json!({"alpha_deg": 45}),
+        ),
+        (
+            "SUPPORT_PLANE_INVALID",
+            "/beta_deg",
+            json!({"alpha_deg": 15, "beta_deg": 80, "sweep": {"n_points": 5}}),
+        ),
+    ];
+    for (code, pointer, body) in cases {
+        assert!(
+            codes.iter().any(|c| c == code),
+            "{code} is not listed: {codes:?}"
+        );
+        let r = post_json(PATH, &body).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], code, "{body}: {p}");
+        assert!(
+            r.pointers().iter().any(|q| q == pointer),
+            "{code}: expected pointer {pointer}, got {p}"
+        );
+    }
+    for code in ["DEADLINE_EXCEEDED", "RESPONSE_TOO_LARGE"] {
+        assert!(codes.iter().any(|c| c == code), "{code}: {codes:?}");
+    }
+}
+
+/// An answer without its timing fields (the report's `elapsed_ms`).
+fn untimed(mut v: Value) -> Value {
+    fn strip(v: &mut Value) {
+        match v {
+            Value::Object(m) => {
+                m.retain(|k, _| k != "elapsed_ms");
+                m.values_mut().for_each(strip);
+            }
+            Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
+
+#[tokio::test]
+async fn null_optional_fields_answer_as_absent() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("api/spatial_coupling/paper_case.json");
+    let plain: Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("example")).expect("json");
+    let mut nulls = plain.clone();
+    nulls["time_limit_ms"] = Value::Null;
+    nulls["outputs"]["decimate"] = Value::Null;
+    // Every optional field null at every depth, against the same fields absent.
+    let every = json!({"alpha_deg": null, "a_m": null, "beta_deg": null, "omega1_rad_s": null,
+        "branch": null, "theta1_deg": null, "body3_points_m": null, "time_limit_ms": null,
+        "sweep": {"start_deg": null, "end_deg": null, "n_points": null},
+        "outputs": {"contact": null, "relative_1": null, "relative_2": null, "frames": null,
+                    "summary": null, "series": null, "decimate": null, "check": null}});
+    let absent = json!({"sweep": {}, "outputs": {}});
+    let top = json!({"outputs": null, "sweep": null, "theta1_deg": [30, 60]});
+    let top_absent = json!({"theta1_deg": [30, 60]});
+    for (a, b) in [(plain, nulls), (absent, every), (top_absent, top)] {
+        let ra = post_json(PATH, &a).await;
+        assert_eq!(ra.status, 200, "{}", String::from_utf8_lossy(&ra.bytes));
+        let rb = post_json(PATH, &b).await;
+        assert_eq!(
+            rb.status,
+            200,
+            "{b}: {}",
+            String::from_utf8_lossy(&rb.bytes)
+        );
+        assert_eq!(untimed(ra.json()), untimed(rb.json()), "{b}");
+    }
 }

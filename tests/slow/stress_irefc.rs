@@ -470,14 +470,20 @@ fn sweep_ranges_and_lists() {
     let base = json!({"mode": "sweep", "torque_Nm": 100, "step_deg": 5,
         "sweep": {"Z2": {"from": 20, "to": 10}, "chi": {"from": 1.5, "to": 1.4, "step": -0.1},
                   "rb_mm": [], "r2_mm": [20, -1]}});
+    // The per-field rules (checked at the door) are listed together; the order of a range's ends
+    // is a rule between fields, checked once every field is valid.
     let e = sweep(&base, &Budget::unlimited()).expect_err("bad ranges");
     let ptrs: Vec<&str> = e.errors.iter().map(|i| i.pointer.as_str()).collect();
-    for p in [
-        "/sweep/Z2/to",
-        "/sweep/chi/step",
-        "/sweep/rb_mm",
-        "/sweep/r2_mm/1",
-    ] {
+    for p in ["/sweep/chi/step", "/sweep/rb_mm", "/sweep/r2_mm/1"] {
+        assert!(ptrs.contains(&p), "{p} missing in {ptrs:?}");
+    }
+    let reversed = json!({"mode": "sweep", "torque_Nm": 100, "step_deg": 5, "rb_mm": 1,
+        "sweep": {"Z2": {"from": 20, "to": 10}, "chi": {"from": 1.5, "to": 1.4, "step": 0.1},
+                  "r2_mm": [20]}});
+    let e = sweep(&reversed, &Budget::unlimited()).expect_err("reversed ranges");
+    assert_eq!(e.code, "BAD_RANGE");
+    let ptrs: Vec<&str> = e.errors.iter().map(|i| i.pointer.as_str()).collect();
+    for p in ["/sweep/Z2/to", "/sweep/chi/to"] {
         assert!(ptrs.contains(&p), "{p} missing in {ptrs:?}");
     }
     let ok = json!({"torque_Nm": 100, "step_deg": 5,

@@ -1,21 +1,163 @@
-//! Validation of a fit request into a [`FitInput`] (spec §2 "Reject with 422", §3.3 data
-//! preparation). Every offending field is collected with its JSON pointer before failing once.
+//! The rules between fields of a fit request (spec §2 "Reject with 422", §3.3 data preparation),
+//! turning it into a [`FitInput`]. Every per-field rule (ranges, lengths, exactly one of
+//! `values`/`grid`) is declared on the wire types and checked at the door; what is left here is
+//! what JSON Schema cannot state, each rule with its own code ([`CROSS_FIELD_RULES`]).
 
 use crate::calc::cam_law::law::{
     BoundaryConditions, K1, LawError, LawNotice, Quantity, SevenSegmentLaw,
 };
 use crate::calc::cam_law::wire::Units;
-use crate::calc::common::TIME_LIMIT_MS;
-use crate::calc::{CalcFailure, ProblemClass, Validator};
+use crate::calc::{CalcFailure, CrossRule, Validator};
 
 use super::compute::{Algorithm, Settings};
 use super::optim::ga::GaParams;
-use super::wire;
 use super::wire::{
-    Channels, FitCamLawRequest, FitQuantity, GaIn, MAX_CURVE_COUNT, MAX_SAMPLES, MIN_SAMPLES,
-    Method, MetricName, OptimizerIn,
+    Channels, FitCamLawRequest, FitQuantity, GaIn, MAX_CURVE_COUNT, Method, MetricName, OptimizerIn,
 };
 use crate::numerics::grid;
+
+/// Abscissae strictly increase; a grid's end lies beyond its start and its points stay distinct.
+pub const ABSCISSA_ORDER: CrossRule = CrossRule::invalid(
+    "ABSCISSA_ORDER",
+    &["/abscissa/values/*", "/abscissa/grid/end", "/abscissa/grid"],
+    "Abscissae strictly increase; a grid's `end` is greater than its `start`, and its `count` \
+     points stay strictly increasing in f64.",
+);
+/// At least one channel is supplied.
+pub const NO_CHANNEL: CrossRule = CrossRule::invalid(
+    "NO_CHANNEL",
+    &["/channels"],
+    "At least one of `channels.displacement`, `channels.velocity`, `channels.acceleration` is given.",
+);
+/// Every channel has one value per abscissa.
+pub const CHANNEL_LENGTH: CrossRule = CrossRule::invalid(
+    "CHANNEL_LENGTH",
+    &[
+        "/channels/displacement",
+        "/channels/velocity",
+        "/channels/acceleration",
+        "/abscissa",
+    ],
+    "Every supplied channel holds exactly one value per abscissa (N values).",
+);
+/// The fitted channel is supplied or can be derived from a lower one.
+pub const FIT_CHANNEL: CrossRule = CrossRule::invalid(
+    "FIT_CHANNEL_MISSING",
+    &["/fit_on", "/derive_missing", "/channels"],
+    "The `fit_on` channel (default acceleration) is supplied, or `derive_missing` is true and a \
+     lower channel (s → v → a) is supplied to differentiate.",
+);
+/// Without a displacement channel the end displacements are given.
+pub const END_DISPLACEMENT: CrossRule = CrossRule::invalid(
+    "END_DISPLACEMENT_REQUIRED",
+    &[
+        "/constraints/s_a",
+        "/constraints/s_b",
+        "/channels/displacement",
+    ],
+    "`constraints.s_a` and `constraints.s_b` are given when no displacement channel is supplied.",
+);
+/// The segment has a positive, resolvable length within the law's magnitude cap.
+pub const SEGMENT_INTERVAL: CrossRule = CrossRule::invalid(
+    "SEGMENT_INTERVAL",
+    &["/constraints/t_a", "/constraints/t_b"],
+    "t_b > t_a (each defaulting to the first/last abscissa), and t_b − t_a exceeds \
+     1e-12·max(|t_a|, |t_b|) so the knots stay distinct.",
+);
+/// Every sample lies inside the segment.
+pub const ABSCISSA_OUTSIDE: CrossRule = CrossRule::invalid(
+    "ABSCISSA_OUTSIDE",
+    &[
+        "/abscissa/values/*",
+        "/abscissa/grid",
+        "/constraints/t_a",
+        "/constraints/t_b",
+    ],
+    "Every sample abscissa lies in [t_a, t_b] within 1e-9·(t_b − t_a) (values within that \
+     tolerance are clamped).",
+);
+/// The DTW band is at most the number of samples.
+pub const DTW_WINDOW_SAMPLES: CrossRule = CrossRule::invalid(
+    "DTW_WINDOW_SAMPLES",
+    &["/objective/dtw_window", "/abscissa"],
+    "objective.dtw_window ≤ N, the number of samples.",
+);
+/// Least squares cannot minimize the DTW metric.
+pub const METHOD_METRIC: CrossRule = CrossRule::invalid(
+    "METHOD_METRIC",
+    &["/optimizer/method", "/objective/metric"],
+    "optimizer.method `lsq` is used only with objective.metric `euclidean`.",
+);
+/// At most one starting point.
+pub const INITIAL_EXCLUSIVE: CrossRule = CrossRule::invalid(
+    "INITIAL_EXCLUSIVE",
+    &["/initial_coefficients", "/initial_law"],
+    "At most one of `initial_coefficients` and `initial_law` is given.",
+);
+/// The starting law belongs to the 7-segment class.
+pub const INITIAL_LAW_CLASS: CrossRule = CrossRule::invalid(
+    "INITIAL_LAW_CLASS",
+    &["/initial_law"],
+    "initial_law is a 7-segment law: constant_acceleration, simple_harmonic, cycloidal, \
+     modified_trapezoid or modified_sine.",
+);
+/// Both acceleration pulses of the starting solution hold some duration.
+pub const EMPTY_PULSE: CrossRule = CrossRule::invalid(
+    "EMPTY_PULSE",
+    &["/fixed_zero", "/initial_coefficients", "/initial_law"],
+    "Both acceleration pulses of the initial solution (c0..c2 and c4..c6, after `fixed_zero`) \
+     keep a free segment with a positive duration.",
+);
+/// The cost estimate stays below [`MAX_COST`].
+pub const FIT_TOO_EXPENSIVE: CrossRule = CrossRule::too_large(
+    "FIT_TOO_EXPENSIVE",
+    &[
+        "/optimizer/max_evaluations",
+        "/abscissa",
+        "/objective/dtw_window",
+    ],
+    "max_evaluations × N × (metric dtw ? 2w+1 : 1) ≤ 2e10 cell operations.",
+);
+/// The initial law exists in f64.
+pub const INFEASIBLE_CONSTRAINTS: CrossRule = CrossRule::infeasible(
+    "INFEASIBLE_CONSTRAINTS",
+    &["/constraints"],
+    "Some 7-segment law over [t_a, t_b] meets the end conditions in f64 (the initial law's \
+     peaks stay finite).",
+);
+/// The fitted law exists in f64 (found while computing).
+pub const LAW_OVERFLOW: CrossRule = CrossRule::too_large(
+    "LAW_OVERFLOW",
+    &["/constraints"],
+    "The fitted law's peaks stay finite in f64.",
+);
+/// Every reported number is finite (found while computing).
+pub const RESULT_OVERFLOW: CrossRule = CrossRule::too_large(
+    "RESULT_OVERFLOW",
+    &["/channels", "/constraints"],
+    "Every reported number of the fitted law is finite in f64 (rescale the units of the data).",
+);
+
+/// The rules between fields of `POST /v1/fit-cam-law`, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    ABSCISSA_ORDER,
+    NO_CHANNEL,
+    CHANNEL_LENGTH,
+    FIT_CHANNEL,
+    END_DISPLACEMENT,
+    SEGMENT_INTERVAL,
+    ABSCISSA_OUTSIDE,
+    DTW_WINDOW_SAMPLES,
+    METHOD_METRIC,
+    INITIAL_EXCLUSIVE,
+    INITIAL_LAW_CLASS,
+    EMPTY_PULSE,
+    FIT_TOO_EXPENSIVE,
+    INFEASIBLE_CONSTRAINTS,
+    LAW_OVERFLOW,
+    RESULT_OVERFLOW,
+    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
+];
 
 /// Samples may lie this fraction of Δt outside `[t_a, t_b]` (they are clamped), spec §2.
 pub const ABSCISSA_TOL: f64 = 1e-9;
@@ -167,43 +309,15 @@ fn algorithm(m: Method) -> Algorithm {
     }
 }
 
-fn check_magnitudes(v: &mut Validator, pointer: &str, values: &[f64]) {
-    v.all_in(pointer, "value", values, super::wire::DATA_VALUE);
-}
-
-/// Validate the abscissa; returns the sample abscissae when valid.
+/// The sample abscissae (exactly one of `values`/`grid`, their lengths and the grid's count are
+/// checked at the door).
 fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
     match (&req.abscissa.values, &req.abscissa.grid) {
-        (Some(_), Some(_)) => {
-            v.push(
-                "/abscissa",
-                "give exactly one of `values` or `grid`, not both",
-            );
-            None
-        }
-        (None, None) => {
-            v.push(
-                "/abscissa",
-                "give one of `values` (sample abscissae) or `grid` {start, end, count}",
-            );
-            None
-        }
+        (Some(_), Some(_)) | (None, None) => None,
         (Some(values), None) => {
-            let n = values.len();
-            if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&n) {
-                v.push(
-                    "/abscissa/values",
-                    format!(
-                        "must hold {MIN_SAMPLES}..{MAX_SAMPLES} samples (7 unknowns need at least 8), got {n}"
-                    ),
-                );
-                return None;
-            }
-            if !v.all_finite("/abscissa/values", values) {
-                return None;
-            }
             if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
-                v.push(
+                v.rule(
+                    &ABSCISSA_ORDER,
                     format!("/abscissa/values/{}", i + 1),
                     format!(
                         "abscissae must be strictly increasing, got {} after {}",
@@ -216,24 +330,20 @@ fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
             Some(values.clone())
         }
         (None, Some(g)) => {
-            let ok_start = v.finite("/abscissa/grid/start", g.start);
-            let ok_end = v.finite("/abscissa/grid/end", g.end);
-            let ok_count = v.uint("/abscissa/grid/count", "", g.count, wire::GRID_COUNT);
-            if ok_start && ok_end && g.end <= g.start {
-                v.push(
+            if g.end <= g.start {
+                v.rule(
+                    &ABSCISSA_ORDER,
                     "/abscissa/grid/end",
                     format!("must be > start = {}, got {}", g.start, g.end),
                 );
                 return None;
             }
-            if !(ok_start && ok_end && ok_count) {
-                return None;
-            }
-            // count ≤ 200 000 was just checked: the conversion cannot fail.
+            // count ≤ 200 000 (checked at the door): the conversion cannot fail.
             let count = usize::try_from(g.count).ok()?;
             let xs = grid::linspace(g.start, g.end, count);
             if xs.windows(2).any(|w| w[1] <= w[0]) {
-                v.push(
+                v.rule(
+                    &ABSCISSA_ORDER,
                     "/abscissa/grid",
                     format!(
                         "the grid [{}, {}] with {count} points is too fine to be strictly increasing in f64",
@@ -256,12 +366,14 @@ fn supplied(req: &FitCamLawRequest) -> [Option<&Vec<f64>>; 3] {
     ]
 }
 
-/// Channels: one value per abscissa, finite and bounded; the fitted channel supplied or
-/// derivable. Returns whether every supplied channel is valid, and the fitted channel.
+/// Channels: one value per abscissa (their magnitudes are checked at the door); the fitted
+/// channel supplied or derivable. Returns whether every supplied channel is valid, and the
+/// fitted channel.
 fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -> (bool, Channel) {
     let supplied = supplied(req);
     if supplied.iter().all(Option::is_none) {
-        v.push(
+        v.rule(
+            &NO_CHANNEL,
             "/channels",
             "supply at least one of displacement, velocity, acceleration",
         );
@@ -273,19 +385,14 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
             if let Some(n) = n
                 && values.len() != n
             {
-                v.push(
+                v.rule(
+                    &CHANNEL_LENGTH,
                     &p,
                     format!(
                         "must have one value per abscissa ({n}), got {}",
                         values.len()
                     ),
                 );
-                channels_ok = false;
-                continue;
-            }
-            if v.all_finite(&p, values) {
-                check_magnitudes(v, &p, values);
-            } else {
                 channels_ok = false;
             }
         }
@@ -294,7 +401,8 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
     let fit_idx = fit_on.index();
     if supplied[fit_idx].is_none() && !supplied.iter().all(Option::is_none) {
         if !req.derive_missing {
-            v.push(
+            v.rule(
+                &FIT_CHANNEL,
                 "/fit_on",
                 format!(
                     "the {} channel is not supplied: supply it, fit on a supplied channel, or set derive_missing: true",
@@ -302,7 +410,8 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
                 ),
             );
         } else if supplied[..fit_idx].iter().all(Option::is_none) {
-            v.push(
+            v.rule(
+                &FIT_CHANNEL,
                 "/fit_on",
                 format!(
                     "cannot derive {} from the supplied channels: only differentiation s → v → a is offered (no integration); fit on a supplied channel",
@@ -315,8 +424,8 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
     (channels_ok, fit_on)
 }
 
-/// Boundary conditions (given, or taken from the first and last samples) and every sample
-/// inside `[t_a, t_b]`.
+/// Boundary conditions (given, or taken from the first and last samples; their magnitudes are
+/// checked at the door) and every sample inside `[t_a, t_b]`.
 fn check_constraints(
     req: &FitCamLawRequest,
     xs: Option<&[f64]>,
@@ -324,23 +433,6 @@ fn check_constraints(
 ) -> Option<BoundaryConditions> {
     let c = req.constraints;
     let supplied = supplied(req);
-    let named = [
-        ("t_a", c.t_a),
-        ("t_b", c.t_b),
-        ("s_a", c.s_a),
-        ("s_b", c.s_b),
-        ("v_a", c.v_a),
-        ("v_b", c.v_b),
-        ("a_a", c.a_a),
-        ("a_b", c.a_b),
-    ];
-    let mut bc_ok = true;
-    for (name, value) in named {
-        if let Some(x) = value {
-            let p = format!("/constraints/{name}");
-            bc_ok &= v.range(&p, name, x, super::wire::DATA_VALUE);
-        }
-    }
     let first = xs.as_ref().and_then(|x| x.first().copied());
     let last = xs.as_ref().and_then(|x| x.last().copied());
     let t_a = c.t_a.or(first);
@@ -351,20 +443,21 @@ fn check_constraints(
     // (With no channel at all, `/channels` already says what is missing.)
     let any_channel = supplied.iter().any(Option::is_some);
     if s_a.is_none() && s_data.is_none() && any_channel {
-        v.push(
+        v.rule(
+            &END_DISPLACEMENT,
             "/constraints/s_a",
             "required when no displacement channel is supplied (the start displacement)",
         );
     }
     if s_b.is_none() && s_data.is_none() && any_channel {
-        v.push(
+        v.rule(
+            &END_DISPLACEMENT,
             "/constraints/s_b",
             "required when no displacement channel is supplied (the end displacement)",
         );
     }
     let mut bc = None;
     if let (Some(t_a), Some(t_b), Some(s_a), Some(s_b)) = (t_a, t_b, s_a, s_b)
-        && bc_ok
         && t_a.is_finite()
         && t_b.is_finite()
     {
@@ -380,16 +473,17 @@ fn check_constraints(
         };
         match cand.check() {
             Ok(()) => bc = Some(cand),
-            Err(LawError::IntervalNotIncreasing { .. }) => v.push(
+            Err(LawError::IntervalNotIncreasing { .. }) => v.rule(
+                &SEGMENT_INTERVAL,
                 "/constraints/t_b",
                 format!("t_b must be greater than t_a = {t_a}, got {t_b}"),
             ),
-            Err(e @ LawError::IntervalTooShort { .. }) => v.push("/constraints/t_b", e.to_string()),
-            Err(LawError::MagnitudeTooLarge { name, value, limit }) => v.push(
-                format!("/constraints/{name}"),
-                format!("|{name}| must be <= {limit:e} (rescale the unit), got {value:e}"),
-            ),
-            Err(e) => v.push("/constraints", e.to_string()),
+            Err(e @ LawError::IntervalTooShort { .. }) => {
+                v.rule(&SEGMENT_INTERVAL, "/constraints/t_b", e.to_string());
+            }
+            // Every given value and every sample is within DATA_VALUE (the door), so the
+            // magnitude cap cannot be broken; should it be, it is the segment's rule.
+            Err(e) => v.rule(&SEGMENT_INTERVAL, "/constraints", e.to_string()),
         }
     }
     // Samples inside [t_a, t_b] up to the tolerance.
@@ -410,7 +504,8 @@ fn check_constraints(
             } else {
                 pointer_base.to_owned()
             };
-            v.push(
+            v.rule(
+                &ABSCISSA_OUTSIDE,
                 p,
                 format!(
                     "sample x = {x} lies outside the segment [t_a, t_b] = [{}, {}]: set constraints t_a/t_b to cover every sample, or drop the samples outside",
@@ -423,62 +518,40 @@ fn check_constraints(
     bc
 }
 
-/// The optimizer's budgets and settings: `(max_evaluations, dtw_global_restarts, snap_tol)`.
+/// The optimizer's budgets and settings: `(max_evaluations, dtw_global_restarts, snap_tol)`
+/// (their ranges are checked at the door).
 fn check_optimizer(o: &OptimizerIn, metric: MetricName, v: &mut Validator) -> (u64, u32, f64) {
     let method = o.method;
     if metric == MetricName::Dtw && method == Method::Lsq {
-        v.push(
+        v.rule(
+            &METHOD_METRIC,
             "/optimizer/method",
             "`lsq` minimizes a sum of squares and cannot fit the DTW metric: use `auto`, `cmaes`, `de` or `ga`",
         );
     }
     let max_evaluations = o.max_evaluations.unwrap_or(DEFAULT_MAX_EVALUATIONS);
-    v.uint(
-        "/optimizer/max_evaluations",
-        "",
-        max_evaluations,
-        wire::MAX_EVALUATIONS,
-    );
-    if let Some(t) = o.time_limit_ms {
-        v.uint("/optimizer/time_limit_ms", "", t, TIME_LIMIT_MS);
-    }
     let dtw_global_restarts = o.dtw_global_restarts.unwrap_or(DEFAULT_DTW_RESTARTS);
-    v.uint(
-        "/optimizer/dtw_global_restarts",
-        "",
-        u64::from(dtw_global_restarts),
-        wire::DTW_RESTARTS,
-    );
     let snap_tol = o.snap_tol.unwrap_or(DEFAULT_SNAP_TOL);
-    v.range("/optimizer/snap_tol", "", snap_tol, wire::SNAP_TOL);
     (max_evaluations, dtw_global_restarts, snap_tol)
 }
 
-/// The GA settings (spec §3.5.1 defaults for every field not given).
-fn check_ga(ga_in: Option<GaIn>, v: &mut Validator) -> GaParams {
+/// The GA settings (spec §3.5.1 defaults for every field not given; ranges checked at the door).
+fn ga_params(ga_in: Option<GaIn>) -> GaParams {
     let mut ga = GaParams::default();
     let Some(g) = ga_in else {
         return ga;
     };
-    let pg = "/optimizer/ga";
-    if let Some(p) = g.population
-        && v.uint(&format!("{pg}/population"), "", p, wire::POPULATION)
-    {
+    if let Some(p) = g.population {
+        // ≤ 10 000 (checked at the door): the conversion cannot fail.
         ga.population = usize::try_from(p).unwrap_or(100);
     }
-    if let Some(p) = g.generations
-        && v.uint(&format!("{pg}/generations"), "", p, wire::GENERATIONS)
-    {
+    if let Some(p) = g.generations {
         ga.generations = p;
     }
-    if let Some(p) = g.range_every
-        && v.uint(&format!("{pg}/range_every"), "", p, wire::GENERATIONS)
-    {
+    if let Some(p) = g.range_every {
         ga.range_every = p;
     }
-    if let Some(p) = g.stall_generations
-        && v.uint(&format!("{pg}/stall_generations"), "", p, wire::GENERATIONS)
-    {
+    if let Some(p) = g.stall_generations {
         ga.stall_generations = p;
     }
     let probs = [
@@ -493,10 +566,8 @@ fn check_ga(ga_in: Option<GaIn>, v: &mut Validator) -> GaParams {
         ("range_factor", g.range_factor, &mut ga.range_factor),
         ("p_mutation", g.p_mutation, &mut ga.p_mutation),
     ];
-    for (name, value, slot) in probs {
-        if let Some(x) = value
-            && v.range(&format!("{pg}/{name}"), "", x, wire::PROBABILITY)
-        {
+    for (_, value, slot) in probs {
+        if let Some(x) = value {
             *slot = x;
         }
     }
@@ -510,63 +581,47 @@ fn check_initial(
     v: &mut Validator,
 ) -> ([f64; 7], [bool; 7], Option<&'static str>) {
     let mut fixed_zero = [false; 7];
-    if let Some(fz) = &req.fixed_zero {
-        if fz.len() == 7 {
-            fixed_zero.copy_from_slice(fz);
-            if fixed_zero[..3].iter().all(|z| *z) {
-                v.push(
-                    "/fixed_zero",
-                    "fixes all of c0, c1, c2: the first acceleration pulse would be empty; free at least one of them",
-                );
-            }
-            if fixed_zero[4..].iter().all(|z| *z) {
-                v.push(
-                    "/fixed_zero",
-                    "fixes all of c4, c5, c6: the second acceleration pulse would be empty; free at least one of them",
-                );
-            }
-        } else {
-            v.push(
+    // 7 flags: checked at the door.
+    if let Some(fz) = &req.fixed_zero
+        && fz.len() == 7
+    {
+        fixed_zero.copy_from_slice(fz);
+        if fixed_zero[..3].iter().all(|z| *z) {
+            v.rule(
+                &EMPTY_PULSE,
                 "/fixed_zero",
-                format!("must hold 7 flags (one per segment), got {}", fz.len()),
+                "fixes all of c0, c1, c2: the first acceleration pulse would be empty; free at least one of them",
+            );
+        }
+        if fixed_zero[4..].iter().all(|z| *z) {
+            v.rule(
+                &EMPTY_PULSE,
+                "/fixed_zero",
+                "fixes all of c4, c5, c6: the second acceleration pulse would be empty; free at least one of them",
             );
         }
     }
     let mut initial = [1.0 / 7.0; 7];
     let mut initial_pointer = None;
     match (&req.initial_coefficients, req.initial_law) {
-        (Some(_), Some(_)) => v.push(
+        (Some(_), Some(_)) => v.rule(
+            &INITIAL_EXCLUSIVE,
             "/initial_law",
             "give at most one of initial_coefficients and initial_law",
         ),
         (Some(ic), None) => {
             initial_pointer = Some("/initial_coefficients");
+            // 7 numbers ≥ 0: checked at the door.
             if ic.len() == 7 {
-                let mut ok = v.all_finite("/initial_coefficients", ic);
-                for (k, x) in ic.iter().enumerate() {
-                    if ok && *x < 0.0 {
-                        v.push(
-                            format!("/initial_coefficients/{k}"),
-                            format!("coefficients must be >= 0, got {x}"),
-                        );
-                        ok = false;
-                    }
-                }
-                if ok {
-                    initial.copy_from_slice(ic);
-                }
-            } else {
-                v.push(
-                    "/initial_coefficients",
-                    format!("must hold 7 coefficients, got {}", ic.len()),
-                );
+                initial.copy_from_slice(ic);
             }
         }
         (None, Some(law)) => {
             initial_pointer = Some("/initial_law");
             match law.seven_segment_coefficients() {
                 Some(cv) => initial = cv,
-                None => v.push(
+                None => v.rule(
+                    &INITIAL_LAW_CLASS,
                     "/initial_law",
                     format!(
                         "{} is not a 7-segment law: use constant_acceleration, simple_harmonic, cycloidal, modified_trapezoid or modified_sine, or give initial_coefficients",
@@ -589,19 +644,22 @@ fn check_initial(
     if sum.is_finite() && sum > 0.0 {
         initial.iter_mut().for_each(|c| *c /= sum);
         if pulse1 <= 0.0 {
-            v.push(
+            v.rule(
+                &EMPTY_PULSE,
                 p,
                 "c0, c1, c2 (after fixed_zero) are all zero: the first acceleration pulse is empty; give at least one of them a positive value",
             );
         }
         if pulse2 <= 0.0 {
-            v.push(
+            v.rule(
+                &EMPTY_PULSE,
                 p,
                 "c4, c5, c6 (after fixed_zero) are all zero: the second acceleration pulse is empty; give at least one of them a positive value",
             );
         }
     } else if sum.is_finite() {
-        v.push(
+        v.rule(
+            &EMPTY_PULSE,
             p,
             "the coefficients (after fixed_zero) are all zero: both acceleration pulses are empty",
         );
@@ -610,11 +668,11 @@ fn check_initial(
     (initial, fixed_zero, initial_pointer)
 }
 
-/// Dense-curve point count and quantities (each once, in request order).
-fn check_curves(req: &FitCamLawRequest, v: &mut Validator) -> (usize, Vec<Quantity>) {
+/// Dense-curve point count and quantities (each once, in request order; the count's range is
+/// checked at the door).
+fn curves(req: &FitCamLawRequest) -> (usize, Vec<Quantity>) {
     match &req.outputs.curves {
         Some(cv) => {
-            v.uint("/outputs/curves/count", "", cv.count, wire::CURVE_COUNT);
             let mut qs: Vec<Quantity> = Vec::new();
             for q in cv
                 .quantities
@@ -643,21 +701,15 @@ fn check_feasible(
     match SevenSegmentLaw::try_new(initial, bc) {
         Ok(_) => {}
         Err(e @ (LawError::EmptyFirstPulse { .. } | LawError::EmptySecondPulse { .. })) => {
-            return Err(CalcFailure::field(
-                ProblemClass::InvalidInput,
-                "EMPTY_PULSE",
+            return Err(EMPTY_PULSE.fail(
                 initial_pointer.unwrap_or("/fixed_zero"),
                 format!("{e}: give the segments of that pulse a longer initial duration"),
             ));
         }
+        // The boundary conditions and the coefficients passed their checks above, so the law
+        // fails only by overflowing f64.
         Err(e) => {
-            let (class, code) = match e {
-                LawError::Overflow { .. } => (ProblemClass::Infeasible, "INFEASIBLE_CONSTRAINTS"),
-                _ => (ProblemClass::InvalidInput, "INVALID_INPUT"),
-            };
-            return Err(CalcFailure::field(
-                class,
-                code,
+            return Err(INFEASIBLE_CONSTRAINTS.fail(
                 "/constraints",
                 format!(
                     "no 7-segment law over Δt = {} can meet these end conditions in f64 ({e}): widen [t_a, t_b], reduce the end rates or rescale the units",
@@ -705,15 +757,16 @@ fn with_derived(
     (channels, derived, warnings)
 }
 
-/// Validate a request into a [`FitInput`].
+/// Check the rules between fields of a request whose per-field rules passed the door, turning
+/// it into a [`FitInput`].
 ///
 /// # Errors
-/// [`ProblemClass::InvalidInput`] listing every offending field; [`ProblemClass::TooLarge`]
-/// when the cost estimate exceeds [`MAX_COST`]; [`ProblemClass::Infeasible`] when the boundary
-/// conditions admit no representable law of this duration (the initial law overflows f64).
+/// Every broken rule of [`CROSS_FIELD_RULES`] with its pointer (invalid input listed at once);
+/// [`FIT_TOO_EXPENSIVE`] when the cost estimate exceeds [`MAX_COST`];
+/// [`INFEASIBLE_CONSTRAINTS`] when the boundary conditions admit no representable law of this
+/// duration (the initial law overflows f64).
 pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let mut v = Validator::new();
-    let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
     let xs = abscissa(&req, &mut v);
     let n = xs.as_ref().map(Vec::len);
 
@@ -725,15 +778,17 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let metric = req.objective.metric;
     let mut dtw_window = 1usize;
     if let Some(w) = req.objective.dtw_window {
-        let max = n.unwrap_or(MAX_SAMPLES);
-        // The window is at most N ≤ 2e5, the number of samples (a cross-field rule); every i64
-        // converts to a whole f64, far outside the range when huge.
-        let range = wire::DTW_WINDOW.max(max as f64);
-        match usize::try_from(w) {
-            Ok(wu) if range.contains(w as f64) => dtw_window = wu,
-            _ => v.push(
+        // 0 ≤ w ≤ 2e5 (checked at the door); at most N, the number of samples.
+        match (usize::try_from(w), n) {
+            (Ok(wu), Some(max)) if wu <= max => dtw_window = wu,
+            (Ok(_), None) => {}
+            _ => v.rule(
+                &DTW_WINDOW_SAMPLES,
                 "/objective/dtw_window",
-                format!("must be in [0, N = {max}] samples, got {w}"),
+                format!(
+                    "must be in [0, N = {}] samples, got {w}",
+                    n.unwrap_or_default()
+                ),
             ),
         }
     }
@@ -742,28 +797,19 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let o = req.optimizer;
     let method = o.method;
     let (max_evaluations, dtw_global_restarts, snap_tol) = check_optimizer(&o, metric, &mut v);
-    let ga = check_ga(o.ga, &mut v);
+    let ga = ga_params(o.ga);
 
     let (initial, fixed_zero, initial_pointer) = check_initial(&req, &mut v);
-    let (curve_count, curve_quantities) = check_curves(&req, &mut v);
-    // The unit labels' lengths are checked at the door (`cam_law::Units`).
+    let (curve_count, curve_quantities) = curves(&req);
 
     v.finish()?;
-    // Every `None` below was reported above, so `finish` has failed already; these are
-    // unreachable but handled without panicking.
+    // Every `None` below was reported above or is a per-field rule the door checks (exactly one
+    // of `values`/`grid`), so `finish` has failed already unless the door was skipped.
     let (Some(xs), Some(bc)) = (xs, bc) else {
-        return Err(CalcFailure::general(
-            ProblemClass::InvalidInput,
-            "INVALID_INPUT",
-            "abscissa or constraints are invalid",
-        ));
+        return Err(crate::calc::rules::door_skipped("/abscissa"));
     };
     if !channels_ok {
-        return Err(CalcFailure::general(
-            ProblemClass::InvalidInput,
-            "INVALID_INPUT",
-            "a channel is invalid",
-        ));
+        return Err(crate::calc::rules::door_skipped("/channels"));
     }
     let n = xs.len();
 
@@ -777,9 +823,7 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         max_evaluations as f64 * n as f64 * w
     };
     if cost > MAX_COST {
-        return Err(CalcFailure::field(
-            ProblemClass::TooLarge,
-            "FIT_TOO_EXPENSIVE",
+        return Err(FIT_TOO_EXPENSIVE.fail(
             "/optimizer/max_evaluations",
             format!(
                 "estimated cost max_evaluations × N × (2w+1) = {cost:.3e} cell operations exceeds {MAX_COST:e}: lower max_evaluations, decimate the samples or narrow dtw_window"
@@ -835,4 +879,13 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         units: req.units,
         warnings,
     })
+}
+
+impl TryFrom<FitCamLawRequest> for FitInput {
+    type Error = CalcFailure;
+
+    /// The rules between fields ([`validate`]); the per-field rules are checked at the door.
+    fn try_from(req: FitCamLawRequest) -> Result<Self, CalcFailure> {
+        validate(req)
+    }
 }

@@ -56,16 +56,26 @@ pub use error::FitError;
 pub use input::FitInput;
 pub use wire::{FitCamLawRequest, FitCamLawResponse};
 
-/// Validate, fit and build the response of `POST /v1/fit-cam-law`.
+/// Fit and build the response of `POST /v1/fit-cam-law` for a request that passed the door (the
+/// per-field rules, then the rules between fields in [`FitInput::try_from`]).
+///
+/// # Errors
+/// `LAW_OVERFLOW` / `EMPTY_PULSE` / `RESULT_OVERFLOW` when the fitted law cannot be represented.
+pub fn run_valid(input: &FitInput, budget: &Budget) -> Result<FitCamLawResponse, CalcFailure> {
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, out, budget))
+}
+
+/// The whole path of a request without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
 ///
 /// # Errors
 /// A [`CalcFailure`] (HTTP 422) for invalid input (every offending field with its pointer),
-/// a request whose cost estimate is too large, or end conditions no law of this duration can
-/// meet in f64.
+/// a request whose cost estimate is too large, end conditions no law of this duration can meet
+/// in f64, or the calculation's failure.
 pub fn run(req: FitCamLawRequest, budget: &Budget) -> Result<FitCamLawResponse, CalcFailure> {
-    let input = input::validate(req)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, out, budget))
+    crate::calc::rules::check(&req)?;
+    run_valid(&FitInput::try_from(req)?, budget)
 }
 
 /// The request's own wall-clock limit: the top-level `time_limit_ms` of the wire convention and

@@ -61,7 +61,8 @@ pub struct FitCamLawRequest {
     /// c4..c6 non-empty). Default all 1/7 (the paper's initial solution). Exclusive with
     /// `initial_law`.
     #[serde(default)]
-    #[schema(min_items = 7, max_items = 7, example = json!([1, 1, 1, 1, 1, 1, 1]))]
+    #[rule(items = INITIAL_COEFFICIENT, min_items = 7, max_items = 7)]
+    #[schema(example = json!([1, 1, 1, 1, 1, 1, 1]))]
     pub initial_coefficients: Option<Vec<f64>>,
     /// Starting law by Appendix-A name; only laws of the 7-segment class (constant_acceleration,
     /// simple_harmonic, cycloidal, modified_trapezoid, modified_sine). Exclusive with
@@ -72,7 +73,7 @@ pub struct FitCamLawRequest {
     /// 7 flags forcing segments to zero length; both pulses must keep a free segment.
     /// Default all false.
     #[serde(default)]
-    #[schema(min_items = 7, max_items = 7)]
+    #[rule(min_items = 7, max_items = 7)]
     pub fixed_zero: Option<Vec<bool>>,
     /// Which expensive outputs to compute.
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
@@ -83,13 +84,16 @@ pub struct FitCamLawRequest {
     pub units: Option<Units>,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
 }
 
 impl crate::calc::common::TimeLimited for FitCamLawRequest {
+    /// The smaller of `time_limit_ms` and `optimizer.time_limit_ms` (10 000 ms when neither is
+    /// given): see [`super::time_limit`].
     fn time_limit(&self) -> Option<std::time::Duration> {
-        self.time_limit_ms.map(std::time::Duration::from_millis)
+        super::time_limit(self)
     }
 }
 
@@ -97,11 +101,12 @@ impl crate::calc::common::TimeLimited for FitCamLawRequest {
 #[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::FitAbscissa)]
 #[serde(deny_unknown_fields)]
+#[rules(one_of("values", "grid"))]
 pub struct FitAbscissa {
     /// Explicit abscissae \[x\]: strictly increasing, finite, 8..200 000 values, inside
     /// `[t_a − 1e-9·Δt, t_b + 1e-9·Δt]`.
     #[serde(default)]
-    #[schema(min_items = 8, max_items = 200000)]
+    #[rule(min_items = MIN_SAMPLES, max_items = MAX_SAMPLES)]
     pub values: Option<Vec<f64>>,
     /// Uniform grid `x_k = start + k·(end − start)/(count − 1)`, `k = 0..count−1`.
     #[serde(default)]
@@ -121,6 +126,7 @@ pub struct FitGrid {
     #[schema(example = 1.0)]
     pub end: f64,
     /// Number of samples N, 8..200 000.
+    #[rule(range = GRID_COUNT)]
     #[schema(example = 300)]
     pub count: u64,
 }
@@ -132,12 +138,15 @@ pub struct FitGrid {
 pub struct Channels {
     /// Displacement samples `s_k` \[U\].
     #[serde(default)]
+    #[rule(items = DATA_VALUE)]
     pub displacement: Option<Vec<f64>>,
     /// Velocity samples `v_k = ds/dx` [U/x].
     #[serde(default)]
+    #[rule(items = DATA_VALUE)]
     pub velocity: Option<Vec<f64>>,
     /// Acceleration samples `a_k = d²s/dx²` [U/x²].
     #[serde(default)]
+    #[rule(items = DATA_VALUE)]
     pub acceleration: Option<Vec<f64>>,
 }
 
@@ -162,29 +171,37 @@ pub enum FitQuantity {
 #[serde(deny_unknown_fields)]
 pub struct FitConstraints {
     /// Segment start `t_a` \[x\]. Default: first abscissa.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 0.0)]
     pub t_a: Option<f64>,
     /// Segment end `t_b` \[x\], `> t_a`. Default: last abscissa.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 1.0)]
     pub t_b: Option<f64>,
     /// Displacement at the start `s_a` \[U\]. Default: first displacement sample; required
     /// without a displacement channel.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 0.0)]
     pub s_a: Option<f64>,
     /// Displacement at the end `s_b` \[U\]. Default: last displacement sample; required without
     /// a displacement channel.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 1.0)]
     pub s_b: Option<f64>,
     /// Velocity at the start `v_a` [U/x]. Default 0.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 0.2)]
     pub v_a: Option<f64>,
     /// Velocity at the end `v_b` [U/x]. Default 0.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 0.5)]
     pub v_b: Option<f64>,
     /// Acceleration at the start `a_a` [U/x²]. Default 0.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 1.4)]
     pub a_a: Option<f64>,
     /// Acceleration at the end `a_b` [U/x²]. Default 0.
+    #[rule(range = DATA_VALUE)]
     #[schema(example = 1.2)]
     pub a_b: Option<f64>,
 }
@@ -215,6 +232,7 @@ pub struct ObjectiveIn {
     /// DTW band radius `w` \[samples\], `0 ≤ w ≤ N`; default 1 (reproduces the paper). Ignored
     /// for `euclidean`.
     #[serde(default)]
+    #[rule(range = DTW_WINDOW)]
     #[schema(example = 1)]
     pub dtw_window: Option<i64>,
 }
@@ -254,11 +272,13 @@ pub struct OptimizerIn {
     pub seed: Option<u64>,
     /// Hard cap on objective evaluations, 1..10⁷ (default 50 000).
     #[serde(default)]
+    #[rule(range = MAX_EVALUATIONS)]
     #[schema(example = 50000)]
     pub max_evaluations: Option<u64>,
     /// Wall-clock cap \[ms\], 1..600 000 (default 10 000); the best-so-far is returned with
     /// `stop_reason: "deadline"` when it ends.
     #[serde(default)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(example = 10000)]
     pub time_limit_ms: Option<u64>,
     /// GA settings (paper Table 2 defaults).
@@ -267,6 +287,7 @@ pub struct OptimizerIn {
     pub ga: Option<GaIn>,
     /// IPOP-CMA-ES restarts of `auto` when the metric is DTW, 0..9 (default 3).
     #[serde(default)]
+    #[rule(range = DTW_RESTARTS)]
     #[schema(example = 3)]
     pub dtw_global_restarts: Option<u32>,
     /// Run the least-squares + zero-snap polish after `ga`, `de`, `cmaes` (and the snap after
@@ -275,6 +296,7 @@ pub struct OptimizerIn {
     pub polish: Option<bool>,
     /// Zero-snap threshold on normalized coefficients, 0..0.05 (default 2e-3).
     #[serde(default)]
+    #[rule(range = SNAP_TOL)]
     #[schema(example = 0.002)]
     pub snap_tol: Option<f64>,
 }
@@ -285,34 +307,44 @@ pub struct OptimizerIn {
 #[serde(deny_unknown_fields)]
 pub struct GaIn {
     /// Individuals per generation, 4..10 000 (paper 100).
+    #[rule(range = POPULATION)]
     #[schema(example = 100)]
     pub population: Option<u64>,
     /// Maximum generations, 1..100 000 (paper 500).
+    #[rule(range = GENERATIONS)]
     #[schema(example = 500)]
     pub generations: Option<u64>,
     /// Crossover probability per pair, 0..1 (paper 0.85).
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.85)]
     pub p_crossover: Option<f64>,
     /// Inversion probability per child, 0..1 (paper 0.1).
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.1)]
     pub p_inversion: Option<f64>,
     /// Probability per gene of mutation around the range, 0..1 (paper 0.1).
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.1)]
     pub p_range_mutation: Option<f64>,
     /// Initial mutation range (absolute, genes in \[0,1\]), 0..1 (paper 0.10).
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.1)]
     pub range0: Option<f64>,
     /// Range factor applied every `range_every` generations, 0..1 (spec 0.25: "reduced by 75 %").
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.25)]
     pub range_factor: Option<f64>,
     /// Generations between range reductions, 1..100 000 (paper 50).
+    #[rule(range = GENERATIONS)]
     #[schema(example = 50)]
     pub range_every: Option<u64>,
     /// Classic mutation probability per gene, 0..1 (spec 0.01).
+    #[rule(range = PROBABILITY)]
     #[schema(example = 0.01)]
     pub p_mutation: Option<f64>,
     /// Stop after this many generations without relative improvement > 1e-12, 1..100 000
     /// (spec 100).
+    #[rule(range = GENERATIONS)]
     #[schema(example = 100)]
     pub stall_generations: Option<u64>,
 }
@@ -343,6 +375,7 @@ pub struct OutputsIn {
 #[serde(deny_unknown_fields)]
 pub struct CurvesIn {
     /// Number of uniformly spaced points over `[t_a, t_b]`, 0..100 000 (0 = none; 1 gives `t_a`).
+    #[rule(range = CURVE_COUNT)]
     #[schema(example = 0)]
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub count: u64,
@@ -474,8 +507,8 @@ pub struct OptimizerReport {
     pub snapped_segments: Vec<usize>,
 }
 
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
+// The ranges of this module's per-field rules (`#[rule]` on the wire types above): the check at
+// the door and the document both read them.
 /// A sampled value (data channel, boundary value): finite and within the law's magnitude cap
 /// (rescale the unit beyond it); the same bound as the evaluator's boundary values.
 pub const DATA_VALUE: Range = crate::calc::cam_law::wire::BOUNDARY_VALUE;
@@ -498,51 +531,5 @@ pub const GENERATIONS: Range = Range::int(1, 100_000);
 pub const PROBABILITY: Range = Range::closed(0.0, 1.0);
 /// Points of the dense output curves [–] (0: none).
 pub const CURVE_COUNT: Range = Range::int(0, MAX_CURVE_COUNT as i64);
-
-crate::schema_bounds! {
-    FitCamLawRequest {
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    Channels {
-        displacement @items: DATA_VALUE,
-        velocity @items: DATA_VALUE,
-        acceleration @items: DATA_VALUE,
-    },
-    FitGrid {
-        count: GRID_COUNT,
-    },
-    FitConstraints {
-        t_a: DATA_VALUE,
-        t_b: DATA_VALUE,
-        s_a: DATA_VALUE,
-        s_b: DATA_VALUE,
-        v_a: DATA_VALUE,
-        v_b: DATA_VALUE,
-        a_a: DATA_VALUE,
-        a_b: DATA_VALUE,
-    },
-    ObjectiveIn {
-        dtw_window: DTW_WINDOW,
-    },
-    OptimizerIn {
-        max_evaluations: MAX_EVALUATIONS,
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-        dtw_global_restarts: DTW_RESTARTS,
-        snap_tol: SNAP_TOL,
-    },
-    GaIn {
-        population: POPULATION,
-        generations: GENERATIONS,
-        p_crossover: PROBABILITY,
-        p_inversion: PROBABILITY,
-        p_range_mutation: PROBABILITY,
-        range0: PROBABILITY,
-        range_factor: PROBABILITY,
-        range_every: GENERATIONS,
-        p_mutation: PROBABILITY,
-        stall_generations: GENERATIONS,
-    },
-    CurvesIn {
-        count: CURVE_COUNT,
-    },
-}
+/// A starting coefficient [–] (normalized internally, so any finite non-negative number).
+pub const INITIAL_COEFFICIENT: Range = crate::calc::cam_law::wire::COEFFICIENT;

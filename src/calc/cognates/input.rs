@@ -1,20 +1,17 @@
-//! Validation of a [`CognatesRequest`] into the domain input (spec §3, §4.1).
-//!
-//! Every offending field is collected with its JSON pointer and a message naming the quantity, the
-//! value and the broken limit; the failure carries the spec's code of the first problem
-//! (`NON_POSITIVE_LENGTH`, `COINCIDENT_PIVOTS`, `COUPLER_TRIANGLE_INVALID`, `COUPLER_POINT_AT_JOINT`,
-//! else `INVALID_INPUT`).
+//! The rules between fields of a [`CognatesRequest`] (spec §3, §4.1), turning it into the domain
+//! input. Every per-field rule (lengths > 0 with the spec's `NON_POSITIVE_LENGTH`, coordinate
+//! caps, option ranges, exactly one of `B`/`length`) is declared on the wire types and checked at
+//! the door; what is left here is what JSON Schema cannot state, each rule with its own code
+//! ([`CROSS_FIELD_RULES`]; the spec's `NON_POSITIVE_LENGTH`, `COINCIDENT_PIVOTS`,
+//! `COUPLER_TRIANGLE_INVALID`, `COUPLER_POINT_AT_JOINT`).
 //!
 //! Internally the linkage is expressed in a normalised frame: origin at A and lengths divided by a
 //! power of two close to the largest length L (an exact scaling), so every tolerance is absolute and
 //! no square can overflow or underflow whatever the caller's unit.
 
 use crate::calc::common;
-use crate::calc::{CalcFailure, INVALID_INPUT, Range, Validator};
+use crate::calc::{CalcFailure, CrossRule, Validator};
 
-use super::error::{
-    COINCIDENT_PIVOTS, COUPLER_POINT_AT_JOINT, COUPLER_TRIANGLE_INVALID, NON_POSITIVE_LENGTH,
-};
 use super::geometry::{C64, FourBar, Sign, cis, cross};
 use super::sampling::Spacing;
 use super::wire::{
@@ -22,7 +19,120 @@ use super::wire::{
 };
 
 pub use super::wire::MAX_MAGNITUDE;
-use super::wire::{COORDINATE, GRASHOF_RTOL, LENGTH, NON_NEGATIVE_LENGTH, POINTS_PER_CIRCUIT};
+use super::wire::POINTS_PER_CIRCUIT;
+
+/// With `joints`, the dimension fields are omitted.
+pub const JOINTS_EXCLUSIVE: CrossRule = CrossRule::invalid(
+    "JOINTS_EXCLUSIVE",
+    &[
+        "/joints",
+        "/ground",
+        "/crank",
+        "/coupler",
+        "/rocker",
+        "/coupler_point",
+        "/input_angle_deg",
+        "/branch",
+    ],
+    "With `joints`, `ground`, `crank`, `coupler`, `rocker`, `coupler_point`, `input_angle_deg` \
+     and `branch` are omitted (they are read from the drawn configuration).",
+);
+/// Without `joints`, the dimensions are given.
+pub const DIMENSIONS_REQUIRED: CrossRule = CrossRule::invalid(
+    "DIMENSIONS_REQUIRED",
+    &[
+        "/ground",
+        "/crank",
+        "/coupler",
+        "/rocker",
+        "/coupler_point",
+        "/joints",
+    ],
+    "Without `joints`, `ground`, `crank`, `coupler`, `rocker` and `coupler_point` are all given.",
+);
+/// The ground is given by exactly one of its far pivot and its length. (Not a `one_of` of the
+/// schema: its failures point at `/ground/length` (both) or `/ground/B` (neither), as before.)
+pub const GROUND_B_OR_LENGTH: CrossRule = CrossRule::invalid(
+    "GROUND_B_OR_LENGTH",
+    &["/ground/B", "/ground/length"],
+    "Exactly one of `ground.B` and `ground.length` is given.",
+);
+/// The ground direction goes with its length.
+pub const GROUND_ANGLE_WITH_LENGTH: CrossRule = CrossRule::invalid(
+    "GROUND_ANGLE_WITH_LENGTH",
+    &["/ground/angle_deg", "/ground/B"],
+    "`ground.angle_deg` is given only with `ground.length` (not with `ground.B`).",
+);
+/// The ground pivots are distinct next to the linkage's size.
+pub const COINCIDENT_PIVOTS: CrossRule = CrossRule::invalid(
+    super::error::COINCIDENT_PIVOTS,
+    &["/ground/B", "/ground/length", "/joints/B"],
+    "|B − A| > 1e-12·L, L the largest length of the linkage.",
+);
+/// Every link is non-zero next to the linkage's size.
+pub const LENGTH_FLOOR: CrossRule = CrossRule::invalid(
+    super::error::NON_POSITIVE_LENGTH,
+    &[
+        "/crank",
+        "/coupler",
+        "/rocker",
+        "/joints/D",
+        "/joints/E",
+        "/joints",
+    ],
+    "Crank, coupler and rocker are each ≥ 1e-12·L, L the largest length of the linkage (in \
+     `joints` mode: the joints do not all coincide).",
+);
+/// The coupler triangle closes.
+pub const COUPLER_TRIANGLE_INVALID: CrossRule = CrossRule::invalid(
+    super::error::COUPLER_TRIANGLE_INVALID,
+    &["/coupler_point", "/coupler"],
+    "(b, d, e) satisfy the triangle inequality within 1e-12·max(b, d, e).",
+);
+/// The coupler point is not on a coupler joint.
+pub const COUPLER_POINT_AT_JOINT: CrossRule = CrossRule::invalid(
+    super::error::COUPLER_POINT_AT_JOINT,
+    &["/coupler_point", "/joints/P"],
+    "P is off the coupler joints: |k| > 1e-9 and |1 − k| > 1e-9, k = (P − D)/(E − D).",
+);
+/// The linkage assembles somewhere (found while computing).
+pub const NOT_ASSEMBLABLE: CrossRule = CrossRule::infeasible(
+    "NOT_ASSEMBLABLE",
+    &["/ground", "/crank", "/coupler", "/rocker"],
+    "The four-bar assembles for some input angle.",
+);
+/// The curves fit the point limit (found while computing).
+pub const TOO_MANY_POINTS: CrossRule = CrossRule::too_large(
+    "TOO_MANY_POINTS",
+    &[
+        "/options/points_per_circuit",
+        "/options/curves",
+        "/options/verify",
+    ],
+    "The sampled points of every requested output stay within the service's point limit.",
+);
+/// The work fits the time budget (found while computing).
+pub const DEADLINE_EXCEEDED: CrossRule = CrossRule::too_large(
+    "DEADLINE_EXCEEDED",
+    &["/time_limit_ms", "/options"],
+    "The requested outputs are computed within the request's time limit.",
+);
+
+/// The rules between fields of `POST /v1/cognates`, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    JOINTS_EXCLUSIVE,
+    DIMENSIONS_REQUIRED,
+    GROUND_B_OR_LENGTH,
+    GROUND_ANGLE_WITH_LENGTH,
+    COINCIDENT_PIVOTS,
+    LENGTH_FLOOR,
+    COUPLER_TRIANGLE_INVALID,
+    COUPLER_POINT_AT_JOINT,
+    NOT_ASSEMBLABLE,
+    TOO_MANY_POINTS,
+    DEADLINE_EXCEEDED,
+    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
+];
 /// A ground length at or below this fraction of L is "coincident pivots" (spec §3: 1e-12).
 pub const COINCIDENT_REL: f64 = 1e-12;
 /// A link length below this fraction of L is numerically zero next to L (same bound as the pivots):
@@ -129,44 +239,6 @@ pub struct CognatesInput {
     pub options: Options,
 }
 
-/// Check `x` against `range` (a length or coordinate bound of wire.rs): below the range, or not
-/// finite, is the spec's `NON_POSITIVE_LENGTH`; above the magnitude cap (or below a negative lower
-/// end) `INVALID_INPUT`.
-fn bounded(v: &mut Validator, pointer: &str, name: &str, x: f64, range: Range) -> bool {
-    let beyond_cap = x.is_finite() && (x > range.hi || (x < range.lo && range.lo < 0.0));
-    let code = if beyond_cap {
-        INVALID_INPUT
-    } else {
-        NON_POSITIVE_LENGTH
-    };
-    v.range_code(code, pointer, name, x, range)
-}
-
-/// A check of one named value at a pointer (`v, pointer, name, value`); true when it passes.
-type Check = fn(&mut Validator, &str, &str, f64) -> bool;
-
-/// A distance that may be zero ([`NON_NEGATIVE_LENGTH`]).
-fn non_negative(v: &mut Validator, pointer: &str, name: &str, x: f64) -> bool {
-    bounded(v, pointer, name, x, NON_NEGATIVE_LENGTH)
-}
-
-/// A coordinate or signed length ([`COORDINATE`]).
-fn coordinate(v: &mut Validator, pointer: &str, name: &str, x: f64) -> bool {
-    bounded(v, pointer, name, x, COORDINATE)
-}
-
-/// A point `[x, y]` of coordinates at `pointer` (`/0`, `/1`).
-fn point(v: &mut Validator, pointer: &str, name: &str, p: [f64; 2]) -> bool {
-    let x = coordinate(v, &format!("{pointer}/0"), &format!("{name}.x"), p[0]);
-    let y = coordinate(v, &format!("{pointer}/1"), &format!("{name}.y"), p[1]);
-    x && y
-}
-
-/// A finite angle in degrees (any value: it is reduced modulo 360°).
-fn angle(v: &mut Validator, pointer: &str, name: &str, x: f64) -> bool {
-    v.range_code(NON_POSITIVE_LENGTH, pointer, name, x, Range::FINITE)
-}
-
 fn c64(p: [f64; 2]) -> C64 {
     C64::new(p[0], p[1])
 }
@@ -200,23 +272,11 @@ struct CouplerData {
     side: Option<Sign>,
 }
 
-/// Options validation (shared by both modes).
-fn validate_options(req: &CognatesRequest, v: &mut Validator) -> Options {
+/// The options (shared by both modes; their ranges are checked at the door).
+fn validate_options(req: &CognatesRequest) -> Options {
     let o = &req.options;
     // The ends of POINTS_PER_CIRCUIT are whole numbers far below 2^53: the conversions are exact.
     let (lo, hi) = (POINTS_PER_CIRCUIT.lo as u64, POINTS_PER_CIRCUIT.hi as u64);
-    v.uint(
-        "/options/points_per_circuit",
-        "points_per_circuit",
-        o.points_per_circuit,
-        POINTS_PER_CIRCUIT,
-    );
-    v.range(
-        "/options/grashof_rtol",
-        "grashof_rtol",
-        o.grashof_rtol,
-        GRASHOF_RTOL,
-    );
     Options {
         curves: o.curves,
         points_per_circuit: usize::try_from(o.points_per_circuit.clamp(lo, hi)).unwrap_or(360),
@@ -235,9 +295,8 @@ impl TryFrom<CognatesRequest> for CognatesInput {
     type Error = CalcFailure;
 
     fn try_from(req: CognatesRequest) -> Result<Self, Self::Error> {
-        let mut v = Validator::new();
-        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
-        let options = validate_options(&req, &mut v);
+        let v = Validator::new();
+        let options = validate_options(&req);
         if let Some(j) = req.joints {
             joints_mode(&req, &j, options, v)
         } else {
@@ -267,15 +326,14 @@ fn joints_mode(
 ) -> Result<CognatesInput, CalcFailure> {
     for (ptr, present) in conflicts_with_joints(req) {
         if present {
-            v.push(
+            v.rule(
+                &JOINTS_EXCLUSIVE,
                 ptr,
                 "must be omitted with `joints` (read from the drawn configuration)",
             );
         }
     }
-    for (n, p) in [("A", j.a), ("B", j.b), ("D", j.d), ("E", j.e), ("P", j.p)] {
-        point(&mut v, &format!("/joints/{n}"), n, p);
-    }
+    // Every coordinate is within ±1e100 (the door).
     v.checkpoint()?;
     let (a, b, d, e, p) = (c64(j.a), c64(j.b), c64(j.d), c64(j.e), c64(j.p));
     let l = (b - a).norm();
@@ -289,12 +347,12 @@ fn joints_mode(
         .max((p - d).norm())
         .max((p - e).norm());
     if !(big_l.is_finite() && big_l > 0.0) {
-        v.push_code(NON_POSITIVE_LENGTH, "/joints", "all joints coincide");
+        v.rule(&LENGTH_FLOOR, "/joints", "all joints coincide");
         v.checkpoint()?;
     }
     if l <= COINCIDENT_REL * big_l {
-        v.push_code(
-            COINCIDENT_PIVOTS,
+        v.rule(
+            &COINCIDENT_PIVOTS,
             "/joints/B",
             format!("B coincides with A: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"),
         );
@@ -354,8 +412,8 @@ fn length_floor(
     let floor = LENGTH_FLOOR_REL * big_l;
     for (ptr, name, len) in links {
         if too_short(len, floor) {
-            v.push_code(
-                NON_POSITIVE_LENGTH,
+            v.rule(
+                &LENGTH_FLOOR,
                 ptr,
                 format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"),
             );
@@ -368,8 +426,8 @@ fn length_floor(
 fn check_at_joint(v: &mut Validator, ptr: &str, k: C64) {
     let one = C64::new(1.0, 0.0);
     if k.norm() <= AT_JOINT_TOL {
-        v.push_code(
-            COUPLER_POINT_AT_JOINT,
+        v.rule(
+            &COUPLER_POINT_AT_JOINT,
             ptr,
             format!(
                 "P coincides with the crank joint D: |k| = {:e} ≤ 1e-9",
@@ -377,8 +435,8 @@ fn check_at_joint(v: &mut Validator, ptr: &str, k: C64) {
             ),
         );
     } else if (one - k).norm() <= AT_JOINT_TOL {
-        v.push_code(
-            COUPLER_POINT_AT_JOINT,
+        v.rule(
+            &COUPLER_POINT_AT_JOINT,
             ptr,
             format!(
                 "P coincides with the rocker joint E: |1 − k| = {:e} ≤ 1e-9",
@@ -388,45 +446,54 @@ fn check_at_joint(v: &mut Validator, ptr: &str, k: C64) {
     }
 }
 
-/// The ground pivots (A, B) of the dimension mode: B given, or A + l·(cos γ, sin γ).
+/// The ground pivots (A, B) of the dimension mode: B given, or A + l·(cos γ, sin γ) (the
+/// coordinate caps and l > 0 are checked at the door).
 fn check_ground(v: &mut Validator, ground: Option<&GroundSpec>) -> Option<([f64; 2], [f64; 2])> {
     let Some(g) = ground else {
-        v.push("/ground", "ground is required (or give `joints`)");
+        v.rule(
+            &DIMENSIONS_REQUIRED,
+            "/ground",
+            "ground is required (or give `joints`)",
+        );
         return None;
     };
     let a_raw = g.a.unwrap_or([0.0, 0.0]);
-    let a_ok = point(v, "/ground/A", "A", a_raw);
     match (g.b, g.length) {
         (Some(_), Some(_)) => {
-            v.push("/ground/length", "give either B or length, not both");
+            v.rule(
+                &GROUND_B_OR_LENGTH,
+                "/ground/length",
+                "give either B or length, not both",
+            );
             None
         }
         (None, None) => {
-            v.push("/ground/B", "B (or length) is required");
+            v.rule(
+                &GROUND_B_OR_LENGTH,
+                "/ground/B",
+                "B (or length) is required",
+            );
             None
         }
         (Some(b), None) => {
             if g.angle_deg.is_some() {
-                v.push(
+                v.rule(
+                    &GROUND_ANGLE_WITH_LENGTH,
                     "/ground/angle_deg",
                     "angle_deg goes with length, not with B",
                 );
             }
-            (point(v, "/ground/B", "B", b) && a_ok).then_some((a_raw, b))
+            Some((a_raw, b))
         }
         (None, Some(l)) => {
-            let l_ok = bounded(v, "/ground/length", "ground length l", l, LENGTH);
             let gamma = g.angle_deg.unwrap_or(0.0);
-            let g_ok = angle(v, "/ground/angle_deg", "ground angle", gamma);
-            (l_ok && g_ok && a_ok).then(|| {
-                let b = c64(a_raw) + cis(deg_to_rad(gamma)) * l;
-                (a_raw, [b.re, b.im])
-            })
+            let b = c64(a_raw) + cis(deg_to_rad(gamma)) * l;
+            Some((a_raw, [b.re, b.im]))
         }
     }
 }
 
-/// The link lengths (a, b, c), each required and a [`LENGTH`].
+/// The link lengths (a, b, c), each required (their ranges are checked at the door).
 fn check_links(v: &mut Validator, req: &CognatesRequest) -> Option<[f64; 3]> {
     let mut lens = [0.0; 3];
     let mut ok = true;
@@ -437,39 +504,29 @@ fn check_links(v: &mut Validator, req: &CognatesRequest) -> Option<[f64; 3]> {
     ]) {
         match given {
             None => {
-                v.push(ptr, format!("{name} is required (or give `joints`)"));
+                v.rule(
+                    &DIMENSIONS_REQUIRED,
+                    ptr,
+                    format!("{name} is required (or give `joints`)"),
+                );
                 ok = false;
             }
-            Some(x) => {
-                ok &= bounded(v, ptr, name, x, LENGTH);
-                *slot = x;
-            }
+            Some(x) => *slot = x,
         }
     }
     ok.then_some(lens)
 }
 
-/// The coupler point in any of its three forms.
+/// The coupler point in any of its three forms (its ranges are checked at the door).
 fn check_coupler_point(v: &mut Validator, cp: Option<CouplerPoint>) -> Option<CouplerPoint> {
-    let Some(cp) = cp else {
-        v.push(
+    if cp.is_none() {
+        v.rule(
+            &DIMENSIONS_REQUIRED,
             "/coupler_point",
             "coupler_point is required (or give `joints`)",
         );
-        return None;
-    };
-    let fields: [(&str, f64, Check); 2] = match cp {
-        CouplerPoint::Triangle { d, e, .. } => [("d", d, non_negative), ("e", e, non_negative)],
-        CouplerPoint::Frame { u, v: w } => [("u", u, coordinate), ("v", w, coordinate)],
-        CouplerPoint::Polar { p, alpha_deg } => {
-            [("p", p, non_negative), ("alpha_deg", alpha_deg, angle)]
-        }
-    };
-    let mut ok = true;
-    for (name, x, check) in fields {
-        ok &= check(v, &format!("/coupler_point/{name}"), name, x);
     }
-    ok.then_some(cp)
+    cp
 }
 
 /// The coupler ratio k = (P − D)/(E − D) and the distances d = |P − D|, e = |P − E| of a valid
@@ -486,8 +543,8 @@ fn coupler_data(v: &mut Validator, cp: CouplerPoint, coupler: f64) -> Option<Cou
             .into_iter()
             .find(|(x, s, _)| *x > *s + slack);
             if let Some((_, _, what)) = violated {
-                v.push_code(
-                    COUPLER_TRIANGLE_INVALID,
+                v.rule(
+                    &COUPLER_TRIANGLE_INVALID,
                     "/coupler_point",
                     format!("coupler triangle (b, d, e) = ({coupler}, {d}, {e}) violates the triangle inequality: {what}"),
                 );
@@ -533,13 +590,10 @@ fn dimension_mode(
     let pivots = check_ground(&mut v, req.ground.as_ref());
     let lens = check_links(&mut v, req);
     let cp = check_coupler_point(&mut v, req.coupler_point);
-    if let Some(x) = req.input_angle_deg {
-        angle(&mut v, "/input_angle_deg", "input_angle_deg", x);
-    }
     v.checkpoint()?;
     let (Some((a_raw, b_raw)), Some([crank, coupler, rocker]), Some(cp)) = (pivots, lens, cp)
     else {
-        unreachable!("every missing part recorded a problem and `checkpoint` returned it")
+        return Err(crate::calc::rules::door_skipped("/ground"));
     };
     let a = c64(a_raw);
     let b = c64(b_raw);
@@ -548,8 +602,8 @@ fn dimension_mode(
     let (d_len, e_len) = ratio.as_ref().map_or((0.0, 0.0), |c| (c.d, c.e));
     let big_l = l.max(crank).max(coupler).max(rocker).max(d_len).max(e_len);
     if l <= COINCIDENT_REL * big_l {
-        v.push_code(
-            COINCIDENT_PIVOTS,
+        v.rule(
+            &COINCIDENT_PIVOTS,
             if req.ground.as_ref().is_some_and(|g| g.length.is_some()) {
                 "/ground/length"
             } else {
@@ -573,7 +627,7 @@ fn dimension_mode(
     }
     v.finish()?;
     let Some(cd) = ratio else {
-        unreachable!("a missing coupler ratio recorded a problem and `finish` returned it")
+        return Err(crate::calc::rules::door_skipped("/coupler_point"));
     };
     Ok(normalised(
         req,

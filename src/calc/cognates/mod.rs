@@ -67,14 +67,25 @@ pub use error::CognatesError;
 pub use input::CognatesInput;
 pub use wire::{CognatesRequest, CognatesResponse};
 
-/// Entry point of `POST /v1/cognates`: validate, compute, respond.
+/// Compute and respond for a request that passed the door (the per-field rules, then the rules
+/// between fields in [`CognatesInput::try_from`]).
+///
+/// # Errors
+/// A [`CalcFailure`] (HTTP 422) for an impossible linkage, too many points or an exhausted
+/// budget.
+pub fn run_valid(input: &CognatesInput, budget: &Budget) -> Result<CognatesResponse, CalcFailure> {
+    let start = Instant::now();
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, &out, start))
+}
+
+/// The whole path of a request without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
 ///
 /// # Errors
 /// A [`CalcFailure`] (HTTP 422) for invalid input, an impossible linkage, too many points or an
 /// exhausted budget.
 pub fn run(req: CognatesRequest, budget: &Budget) -> Result<CognatesResponse, CalcFailure> {
-    let start = Instant::now();
-    let input = CognatesInput::try_from(req)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, &out, start))
+    crate::calc::rules::check(&req)?;
+    run_valid(&CognatesInput::try_from(req)?, budget)
 }

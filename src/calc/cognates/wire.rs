@@ -30,16 +30,19 @@ pub struct CognatesRequest {
     /// Crank (input link) length `a` \[length\], > 0 and ≥ 1e-12·L, L the largest length of the
     /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = LENGTH, code = "NON_POSITIVE_LENGTH")]
     #[schema(nullable = false, example = 1.13)]
     pub crank: Option<f64>,
     /// Coupler length `b` = |E − D| \[length\], > 0 and ≥ 1e-12·L, L the largest length of the
     /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = LENGTH, code = "NON_POSITIVE_LENGTH")]
     #[schema(nullable = false, example = 1.23)]
     pub coupler: Option<f64>,
     /// Rocker (output link) length `c` \[length\], > 0 and ≥ 1e-12·L, L the largest length of the
     /// linkage (dimension mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = LENGTH, code = "NON_POSITIVE_LENGTH")]
     #[schema(nullable = false, example = 1.04)]
     pub rocker: Option<f64>,
     /// Coupler point P, exactly one of three forms (dimension mode).
@@ -68,6 +71,7 @@ pub struct CognatesRequest {
     pub options: CognatesOptions,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
 }
@@ -87,14 +91,17 @@ impl crate::calc::common::TimeLimited for CognatesRequest {
 pub struct GroundSpec {
     /// Input pivot A \[length\], default `[0, 0]`.
     #[serde(rename = "A", default, skip_serializing_if = "Option::is_none")]
+    #[rule(items = COORDINATE)]
     #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([0.0, 0.0]))]
     pub a: Option<Point>,
     /// Output pivot B \[length\], ≠ A.
     #[serde(rename = "B", default, skip_serializing_if = "Option::is_none")]
+    #[rule(items = COORDINATE)]
     #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([3.1, 0.0]))]
     pub b: Option<Point>,
     /// Ground length `l` = |B − A| \[length\], > 0 (instead of `B`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = LENGTH, code = "NON_POSITIVE_LENGTH")]
     #[schema(nullable = false)]
     pub length: Option<f64>,
     /// Direction γ of A→B when `length` is used \[deg\], default 0.
@@ -111,9 +118,11 @@ pub enum CouplerPoint {
     /// Paper form: distances to the coupler joints and the side.
     Triangle {
         /// `d` = |P − D| \[length\], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
+        #[rule(range = NON_NEGATIVE_LENGTH, code = "NON_POSITIVE_LENGTH")]
         #[schema(example = 0.92)]
         d: f64,
         /// `e` = |P − E| \[length\], ≥ 0; (b, d, e) must close a triangle (within 1e-12·max).
+        #[rule(range = NON_NEGATIVE_LENGTH, code = "NON_POSITIVE_LENGTH")]
         #[schema(example = 1.56)]
         e: f64,
         /// Coupler side `t2`: 1 when P is left of the directed line D→E. Default 1.
@@ -123,13 +132,16 @@ pub enum CouplerPoint {
     /// Coupler frame: origin D, x along D→E, y to the left; `k = (u + i·v)/b`.
     Frame {
         /// Coordinate along D→E \[length\].
+        #[rule(range = COORDINATE)]
         u: f64,
         /// Coordinate to the left of D→E \[length\].
+        #[rule(range = COORDINATE)]
         v: f64,
     },
     /// Polar form from D: `k = (p/b)·e^{i·alpha}`.
     Polar {
         /// Distance |P − D| \[length\], ≥ 0.
+        #[rule(range = NON_NEGATIVE_LENGTH, code = "NON_POSITIVE_LENGTH")]
         p: f64,
         /// Angle from D→E, CCW positive \[deg\].
         alpha_deg: f64,
@@ -191,22 +203,27 @@ impl TryFrom<CouplerPointRaw> for CouplerPoint {
 pub struct JointsSpec {
     /// Input pivot A \[length\].
     #[serde(rename = "A")]
+    #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
     pub a: Point,
     /// Output pivot B \[length\].
     #[serde(rename = "B")]
+    #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
     pub b: Point,
     /// Crank joint D \[length\].
     #[serde(rename = "D")]
+    #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
     pub d: Point,
     /// Rocker joint E \[length\].
     #[serde(rename = "E")]
+    #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
     pub e: Point,
     /// Coupler point P \[length\].
     #[serde(rename = "P")]
+    #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
     pub p: Point,
 }
@@ -272,42 +289,67 @@ pub enum VerifyKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cognates::CognatesOptions)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct CognatesOptions {
     /// Return sampled coupler curves of all three mechanisms.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub curves: bool,
-    /// Samples per closed circuit per mechanism, N.
+    /// Samples per closed circuit per mechanism, N. Default 360.
+    #[serde(deserialize_with = "points_or_default")]
+    #[rule(range = POINTS_PER_CIRCUIT)]
     #[schema(example = 360)]
     pub points_per_circuit: u64,
     /// Sample spacing: `auto` (cosine on limited-range circuits, uniform on full turns) or `uniform`.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     #[schema(inline)]
     pub spacing: Spacing,
     /// Curve tracing mode: `circuits` (whole curve, branch switching at toggles) or `fixed_branch`
     /// (paper style: each input over its range on its snapshot branch).
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     #[schema(inline)]
     pub curve_mode: CurveMode,
     /// Verification methods to run.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub verify: Vec<VerifyKind>,
     /// Also return the three 1:1 geared five-bar equivalents (spec §4.10).
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub geared_fivebars: bool,
     /// Comparison metrics per mechanism (spec §4.11).
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub metrics: bool,
     /// Relative tolerance of the Grashof equality test (change point) and of the special shapes.
+    /// Default 1e-9.
+    #[serde(deserialize_with = "grashof_rtol_or_default")]
+    #[rule(range = GRASHOF_RTOL)]
     #[schema(example = 1e-9)]
     pub grashof_rtol: f64,
+}
+
+/// Default of `options.points_per_circuit` (spec §3).
+pub const DEFAULT_POINTS_PER_CIRCUIT: u64 = 360;
+/// Default of `options.grashof_rtol` (spec §3).
+pub const DEFAULT_GRASHOF_RTOL: f64 = 1e-9;
+
+/// `options.points_per_circuit`: `null` reads as the default, exactly as when absent.
+fn points_or_default<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+    Ok(Option::<u64>::deserialize(d)?.unwrap_or(DEFAULT_POINTS_PER_CIRCUIT))
+}
+
+/// `options.grashof_rtol`: `null` reads as the default, exactly as when absent.
+fn grashof_rtol_or_default<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(DEFAULT_GRASHOF_RTOL))
 }
 
 impl Default for CognatesOptions {
     fn default() -> Self {
         Self {
             curves: false,
-            points_per_circuit: 360,
+            points_per_circuit: DEFAULT_POINTS_PER_CIRCUIT,
             spacing: Spacing::Auto,
             curve_mode: CurveMode::Circuits,
             verify: Vec::new(),
             geared_fivebars: false,
             metrics: false,
-            grashof_rtol: 1e-9,
+            grashof_rtol: DEFAULT_GRASHOF_RTOL,
         }
     }
 }
@@ -916,43 +958,3 @@ pub const COORDINATE: Range = Range::FINITE.min(-MAX_MAGNITUDE).max(MAX_MAGNITUD
 pub const POINTS_PER_CIRCUIT: Range = Range::int(16, 100_000);
 /// Relative tolerance of the Grashof classification (spec §3).
 pub const GRASHOF_RTOL: Range = Range::closed(0.0, 1e-3);
-
-// The documented bounds of this module's wire types: the validator (input.rs) checks the same
-// constants, and tests/it/contract_bounds.rs probes both.
-crate::schema_bounds! {
-    CognatesRequest {
-        crank: LENGTH,
-        coupler: LENGTH,
-        rocker: LENGTH,
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    GroundSpec {
-        a @items as "A": COORDINATE,
-        b @items as "B": COORDINATE,
-        length: LENGTH,
-    },
-    JointsSpec {
-        a @items as "A": COORDINATE,
-        b @items as "B": COORDINATE,
-        d @items as "D": COORDINATE,
-        e @items as "E": COORDINATE,
-        p @items as "P": COORDINATE,
-    },
-    CognatesOptions {
-        points_per_circuit: POINTS_PER_CIRCUIT,
-        grashof_rtol: GRASHOF_RTOL,
-    },
-}
-
-/// Bounds of the coupler-point forms (fields of enum variants, rendered inline in the document).
-#[must_use]
-pub fn variant_bounds() -> Vec<crate::calc::SchemaBound> {
-    use crate::calc::SchemaBound;
-    vec![
-        SchemaBound::at::<CouplerPoint>("/oneOf/0/properties/d", NON_NEGATIVE_LENGTH),
-        SchemaBound::at::<CouplerPoint>("/oneOf/0/properties/e", NON_NEGATIVE_LENGTH),
-        SchemaBound::at::<CouplerPoint>("/oneOf/1/properties/u", COORDINATE),
-        SchemaBound::at::<CouplerPoint>("/oneOf/1/properties/v", COORDINATE),
-        SchemaBound::at::<CouplerPoint>("/oneOf/2/properties/p", NON_NEGATIVE_LENGTH),
-    ]
-}

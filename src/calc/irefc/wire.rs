@@ -57,12 +57,15 @@ impl Warning {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::Material)]
 #[serde(deny_unknown_fields)]
+#[rules(code = "BAD_RANGE")]
 pub struct Material {
     /// Young's modulus E \[MPa\].
     #[serde(rename = "E_MPa")]
+    #[rule(range = E_MPA)]
     #[schema(example = 210_000.0)]
     pub e_mpa: f64,
     /// Poisson's ratio ν [–], 0 ≤ ν < 0.5.
+    #[rule(range = NU)]
     #[schema(example = 0.3)]
     pub nu: f64,
 }
@@ -173,13 +176,4 @@ impl GeometryOut {
                     .all(|[x, y]| x.is_finite() && y.is_finite())
             })
     }
-}
-
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
-crate::schema_bounds! {
-    Material {
-        e_mpa as "E_MPa": E_MPA,
-        nu: NU,
-    },
 }

@@ -1,19 +1,43 @@
-//! Validation of a [`SpatialCouplingRequest`] into the domain input (spec §2).
-//!
-//! Every offending field is reported with its JSON pointer. Codes: `PERPENDICULAR_SHAFTS`
-//! (|cos 2α| < 1e-9), `INVALID_INPUT` otherwise. The support-plane validity test of a sweep is a
-//! property of the whole configuration and fails in `compute` (`SUPPORT_PLANE_INVALID`).
+//! The rules of a [`SpatialCouplingRequest`] that JSON Schema cannot state (spec §2), turning it
+//! into the domain input. Every range and list length is declared on the wire types and checked
+//! at the door; what is left is `PERPENDICULAR_SHAFTS` (|cos 2α| < 1e-9, a hole in α's range).
+//! The support-plane validity test of a sweep is a property of the whole configuration and fails
+//! in `compute` (`SUPPORT_PLANE_INVALID`). Every rule is listed in [`CROSS_FIELD_RULES`].
 
 use std::time::Duration;
 
-use crate::calc::common::{Sign, time_limit};
-use crate::calc::{CalcFailure, Validator};
+use crate::calc::common::Sign;
+use crate::calc::{CalcFailure, CrossRule, Validator};
 use crate::numerics::angles::sin_cos_deg;
 
-use super::wire::{
-    A_M, ALPHA_DEG, BETA_DEG, BODY3_COORD_M, DECIMATE, MAX_BODY3_POINTS, MAX_THETA1_POINTS,
-    MIN_ABS_COS_2ALPHA, N_POINTS, OMEGA1, SpatialCouplingRequest, THETA1_DEG, Vec3,
-};
+use super::wire::{MIN_ABS_COS_2ALPHA, SpatialCouplingRequest, Vec3};
+
+/// The shafts are not perpendicular.
+pub const PERPENDICULAR_SHAFTS: CrossRule = CrossRule::invalid(
+    "PERPENDICULAR_SHAFTS",
+    &["/alpha_deg"],
+    "|cos 2α| ≥ 1e-9: α = ±45° makes the shafts perpendicular (dead points, i12 = 0/0).",
+);
+/// A sweep's contact point stays finite (found while computing).
+pub const SUPPORT_PLANE_INVALID: CrossRule = CrossRule::infeasible(
+    "SUPPORT_PLANE_INVALID",
+    &["/beta_deg", "/alpha_deg", "/sweep"],
+    "With a `sweep`, cos(α−β)·cos 2α·cos(α+β) > 0 (the contact point is finite at every θ1).",
+);
+/// The work fits the time budget (found while computing).
+pub const DEADLINE_EXCEEDED: CrossRule = CrossRule::too_large(
+    "DEADLINE_EXCEEDED",
+    &["/time_limit_ms", "/sweep/n_points", "/theta1_deg"],
+    "The requested points are computed within the request's time limit.",
+);
+
+/// The rules between fields of `POST /v1/spatial-coupling`, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    PERPENDICULAR_SHAFTS,
+    SUPPORT_PLANE_INVALID,
+    DEADLINE_EXCEEDED,
+    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
+];
 
 /// Default α \[deg\] (spec §2; the paper-like case).
 pub const DEFAULT_ALPHA_DEG: f64 = 15.0;
@@ -104,82 +128,44 @@ impl TryFrom<SpatialCouplingRequest> for SpatialCouplingInput {
     type Error = CalcFailure;
 
     fn try_from(req: SpatialCouplingRequest) -> Result<Self, Self::Error> {
+        // Every range and list length is checked at the door.
         let mut v = Validator::new();
         let alpha_deg = req.alpha_deg.unwrap_or(DEFAULT_ALPHA_DEG);
-        let alpha_ok = v.range("/alpha_deg", "alpha_deg", alpha_deg, ALPHA_DEG);
-        if alpha_ok {
-            let c2a = sin_cos_deg(2.0 * alpha_deg).1;
-            v.ensure_code(
-                c2a.abs() >= MIN_ABS_COS_2ALPHA,
-                "PERPENDICULAR_SHAFTS",
-                "/alpha_deg",
-                || {
-                    format!(
-                        "|cos 2α| must be ≥ {MIN_ABS_COS_2ALPHA:e} (α = ±45° makes the shafts \
-                         perpendicular: dead points, i12 = 0/0), got |cos 2α| = {:e} at α = \
-                         {alpha_deg}°",
-                        c2a.abs()
-                    )
-                },
-            );
-        }
+        let c2a = sin_cos_deg(2.0 * alpha_deg).1;
+        v.ensure_rule(
+            c2a.abs() >= MIN_ABS_COS_2ALPHA,
+            &PERPENDICULAR_SHAFTS,
+            "/alpha_deg",
+            || {
+                format!(
+                    "|cos 2α| must be ≥ {MIN_ABS_COS_2ALPHA:e} (α = ±45° makes the shafts \
+                     perpendicular: dead points, i12 = 0/0), got |cos 2α| = {:e} at α = \
+                     {alpha_deg}°",
+                    c2a.abs()
+                )
+            },
+        );
         let a = req.a_m.unwrap_or(1.0);
-        v.range("/a_m", "a_m", a, A_M);
+        // β defaults to α.
         let beta_deg = req.beta_deg.unwrap_or(alpha_deg);
-        // β defaults to α: an invalid α is reported once, at /alpha_deg.
-        if req.beta_deg.is_some() || alpha_ok {
-            v.range("/beta_deg", "beta_deg", beta_deg, BETA_DEG);
-        }
         let omega1 = req.omega1_rad_s.unwrap_or(1.0);
-        v.range("/omega1_rad_s", "omega1_rad_s", omega1, OMEGA1);
         let points = req.theta1_deg.unwrap_or_default();
-        v.ensure(points.len() <= MAX_THETA1_POINTS, "/theta1_deg", || {
-            format!(
-                "at most {MAX_THETA1_POINTS} input angles per request (use a sweep), got {}",
-                points.len()
-            )
-        });
-        v.all_in("/theta1_deg", "theta1_deg", &points, THETA1_DEG);
-        let sweep = req.sweep.map(|s| {
-            let start_deg = s.start_deg.unwrap_or(DEFAULT_SWEEP.start_deg);
-            let end_deg = s.end_deg.unwrap_or(DEFAULT_SWEEP.end_deg);
-            let n = s.n_points.unwrap_or(721);
-            v.range("/sweep/start_deg", "start_deg", start_deg, THETA1_DEG);
-            v.range("/sweep/end_deg", "end_deg", end_deg, THETA1_DEG);
-            let n_ok = v.uint("/sweep/n_points", "n_points", n, N_POINTS);
-            Sweep {
-                start_deg,
-                end_deg,
-                n_points: if n_ok {
-                    usize::try_from(n).unwrap_or(DEFAULT_SWEEP.n_points)
-                } else {
-                    DEFAULT_SWEEP.n_points
-                },
-            }
+        let sweep = req.sweep.map(|s| Sweep {
+            start_deg: s.start_deg.unwrap_or(DEFAULT_SWEEP.start_deg),
+            end_deg: s.end_deg.unwrap_or(DEFAULT_SWEEP.end_deg),
+            // n ≤ 1e6 (checked at the door): the conversion cannot fail.
+            n_points: s.n_points.map_or(DEFAULT_SWEEP.n_points, |n| {
+                usize::try_from(n).unwrap_or(DEFAULT_SWEEP.n_points)
+            }),
         });
         let sweep = if sweep.is_none() && points.is_empty() {
             Some(DEFAULT_SWEEP)
         } else {
             sweep
         };
-        let body3 = req.body3_points_m.unwrap_or_default();
-        v.ensure(body3.len() <= MAX_BODY3_POINTS, "/body3_points_m", || {
-            format!(
-                "at most {MAX_BODY3_POINTS} body-3 points, got {}",
-                body3.len()
-            )
-        });
-        for (i, p) in body3.iter().enumerate() {
-            v.all_in(
-                &format!("/body3_points_m/{i}"),
-                "coordinate",
-                p,
-                BODY3_COORD_M,
-            );
-        }
+        let body3: Vec<Vec3> = req.body3_points_m.unwrap_or_default();
         let o = req.outputs;
-        let decimate_ok = v.uint("/outputs/decimate", "decimate", o.decimate, DECIMATE);
-        let time_limit = time_limit(&mut v, req.time_limit_ms);
+        let time_limit = req.time_limit_ms.map(Duration::from_millis);
         v.finish()?;
         Ok(Self {
             alpha_deg,
@@ -202,11 +188,8 @@ impl TryFrom<SpatialCouplingRequest> for SpatialCouplingInput {
             },
             summary: o.summary,
             series: o.series,
-            decimate: if decimate_ok {
-                usize::try_from(o.decimate).unwrap_or(1)
-            } else {
-                1
-            },
+            // decimate ≤ 1e6 (checked at the door): the conversion cannot fail.
+            decimate: usize::try_from(o.decimate).unwrap_or(1),
             time_limit,
         })
     }

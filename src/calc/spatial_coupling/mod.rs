@@ -67,7 +67,21 @@ pub use error::SpatialCouplingError;
 pub use input::SpatialCouplingInput;
 pub use wire::{SpatialCouplingRequest, SpatialCouplingResponse};
 
-/// Entry point of `POST /v1/spatial-coupling`: validate, compute, respond.
+/// Compute and respond for a request that passed the door (the per-field rules, then
+/// [`SpatialCouplingInput::try_from`]).
+///
+/// # Errors
+/// A [`CalcFailure`] (HTTP 422) for a sweep with an invalid support plane or an exhausted budget.
+pub fn run_valid(
+    input: &SpatialCouplingInput,
+    budget: &Budget,
+) -> Result<SpatialCouplingResponse, CalcFailure> {
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, &out, budget))
+}
+
+/// The whole path of a request without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
 ///
 /// # Errors
 /// A [`CalcFailure`] (HTTP 422) for invalid input, a sweep with an invalid support plane, or an
@@ -76,7 +90,6 @@ pub fn run(
     req: SpatialCouplingRequest,
     budget: &Budget,
 ) -> Result<SpatialCouplingResponse, CalcFailure> {
-    let input = SpatialCouplingInput::try_from(req)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, &out, budget))
+    crate::calc::rules::check(&req)?;
+    run_valid(&SpatialCouplingInput::try_from(req)?, budget)
 }

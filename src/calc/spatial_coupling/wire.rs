@@ -39,10 +39,12 @@ pub struct SpatialCouplingRequest {
     /// 2α). |cos 2α| ≥ 1e-9 (α = ±45°, perpendicular shafts, is a dead-point configuration and
     /// is rejected); |cos 2α| < 0.1 answers with a warning. Default 15.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = ALPHA_DEG)]
     #[schema(nullable = false, example = 15.0)]
     pub alpha_deg: Option<f64>,
     /// Half of the common-normal length `a` \[m\] (A1 = (a, 0, 0), A2 = (−a, 0, 0)). Default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = A_M)]
     #[schema(nullable = false, example = 1.0)]
     pub a_m: Option<f64>,
     /// Orientation β of the support plane P0 \[deg\] (P0 contains Ox; normal (0, −cos β, sin β)).
@@ -50,11 +52,13 @@ pub struct SpatialCouplingRequest {
     /// Requests with a `sweep` need cos(α−β)·cos 2α·cos(α+β) > 0 (contact point finite at every
     /// θ1, spec §7.2); points-only requests answer per point.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = BETA_DEG)]
     #[schema(nullable = false, example = 15.0)]
     pub beta_deg: Option<f64>,
     /// Input angular speed ω1 [rad/s] (constant). Default 1: rates are then reduced values
     /// (ω/ω1, v/ω1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = OMEGA1)]
     #[schema(nullable = false, example = 1.0)]
     pub omega1_rad_s: Option<f64>,
     /// Assembly mode σ: 1 (θ2 = 90° at θ1 = 0) or -1 (θ2 = 270° at θ1 = 0). Default 1.
@@ -64,7 +68,8 @@ pub struct SpatialCouplingRequest {
     /// Input angles θ1 \[deg\] evaluated one by one (any finite value; reduced modulo 360°).
     /// At most 100 000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(nullable = false, max_items = 100_000, example = json!([30.0]))]
+    #[rule(items = THETA1_DEG, max_items = MAX_THETA1_POINTS)]
+    #[schema(nullable = false, example = json!([30.0]))]
     pub theta1_deg: Option<Vec<f64>>,
     /// Uniform sweep of θ1 with unwrapped output angles and summaries.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -73,13 +78,15 @@ pub struct SpatialCouplingRequest {
     /// Points fixed in body 3, in frame-3 coordinates \[m\], whose paths and velocities are
     /// returned at every point (`body3_points` of each point). At most 100.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(nullable = false, max_items = 100, value_type = Vec<[f64; 3]>)]
+    #[rule(items_items = BODY3_COORD_M, max_items = MAX_BODY3_POINTS)]
+    #[schema(nullable = false, value_type = Vec<[f64; 3]>)]
     pub body3_points_m: Option<Vec<Vec3>>,
     /// Optional output groups (spec §5); each costs O(1) per point.
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: OutputsIn,
     /// Wall-clock limit for this request \[ms\] (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
 }
@@ -99,14 +106,17 @@ impl crate::calc::common::TimeLimited for SpatialCouplingRequest {
 pub struct SweepIn {
     /// First input angle \[deg\]. Default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = THETA1_DEG)]
     #[schema(nullable = false, example = 0.0)]
     pub start_deg: Option<f64>,
     /// Last input angle \[deg\] (may be below `start_deg`: a reversed sweep). Default 360.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = THETA1_DEG)]
     #[schema(nullable = false, example = 360.0)]
     pub end_deg: Option<f64>,
     /// Number of points n. Default 721.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = N_POINTS)]
     #[schema(nullable = false, example = 721)]
     pub n_points: Option<u64>,
 }
@@ -117,26 +127,39 @@ pub struct SweepIn {
 )]
 #[schema(as = spatial_coupling::OutputsIn)]
 #[serde(deny_unknown_fields, default)]
-#[rules(legacy_nulls)]
 pub struct OutputsIn {
     /// Contact point B: position, velocity, speed and the denominator D. Default false.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub contact: bool,
     /// Motion of B and rotation of body 3 relative to shaft 1. Default false.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub relative_1: bool,
     /// Motion of B and rotation of body 3 relative to shaft 2. Default false.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub relative_2: bool,
     /// Unit vectors of frames 1, 2, 3 and the transforms T13, T23. Default false.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub frames: bool,
     /// Sweep summary (spec §3.5). Default true (ignored without a sweep).
+    #[serde(deserialize_with = "crate::calc::rules::null_true")]
     pub summary: bool,
     /// Every (kept) sweep point in `series`. Default false: a sweep answers with its summary only.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub series: bool,
     /// Keep every `decimate`-th sweep point in `series` (the last point is always kept; the
     /// summary always uses every point). Default 1.
+    #[serde(deserialize_with = "decimate_or_default")]
+    #[rule(range = DECIMATE)]
     #[schema(example = 1)]
     pub decimate: u64,
     /// Closure residuals and orthonormality of frame 3 per point (debug). Default false.
+    #[serde(deserialize_with = "crate::calc::rules::null_default")]
     pub check: bool,
+}
+
+/// `outputs.decimate`: `null` reads as the default 1, exactly as when absent.
+fn decimate_or_default<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+    Ok(Option::<u64>::deserialize(d)?.unwrap_or(1))
 }
 
 impl Default for OutputsIn {
@@ -517,33 +540,3 @@ pub const MIN_ABS_COS_2ALPHA: f64 = 1e-9;
 pub const MAX_THETA1_POINTS: usize = 100_000;
 /// Most body-3 points per request (spec §2).
 pub const MAX_BODY3_POINTS: usize = 100;
-
-// The documented bounds of this module's wire types: the validator (input.rs) checks the same
-// constants, and tests/it/contract_bounds.rs probes both.
-crate::schema_bounds! {
-    SpatialCouplingRequest {
-        alpha_deg: ALPHA_DEG,
-        a_m: A_M,
-        beta_deg: BETA_DEG,
-        omega1_rad_s: OMEGA1,
-        theta1_deg @items: THETA1_DEG,
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    SweepIn {
-        start_deg: THETA1_DEG,
-        end_deg: THETA1_DEG,
-        n_points: N_POINTS,
-    },
-    OutputsIn {
-        decimate: DECIMATE,
-    },
-}
-
-/// Bounds of the body-3 point coordinates (items of items, rendered inline).
-#[must_use]
-pub fn nested_bounds() -> Vec<crate::calc::SchemaBound> {
-    vec![crate::calc::SchemaBound::at::<SpatialCouplingRequest>(
-        "/properties/body3_points_m/items/items",
-        BODY3_COORD_M,
-    )]
-}

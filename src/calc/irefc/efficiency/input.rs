@@ -2,15 +2,43 @@
 
 use std::f64::consts::PI;
 
-use super::wire::{
-    self, INPUT_TORQUE_NM, IrefcEfficiencyRequest, N_PHASE, POWER_W, ROLLING_FRICTION_MM,
-    SLIDING_FRICTION, SPEED_RPM, phase_deg_range,
-};
-use crate::calc::irefc::error::{AMBIGUOUS_LOAD, BAD_RANGE, IrefcError};
+use super::wire::{self, IrefcEfficiencyRequest, phase_deg_range};
+use crate::calc::irefc::error::{self, IrefcError};
 use crate::calc::irefc::geometry::Geometry;
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::MM;
-use crate::calc::{CalcFailure, ProblemClass};
+use crate::calc::{CalcFailure, CrossRule};
+
+/// Exactly one load: both given is ambiguous.
+pub const AMBIGUOUS_LOAD: CrossRule = CrossRule::invalid(
+    error::AMBIGUOUS_LOAD,
+    &["/power_W", "/input_torque_Nm"],
+    "At most one of `power_W` and `input_torque_Nm` is given.",
+);
+/// Exactly one load: none given is a missing field.
+pub const LOAD_MISSING: CrossRule = CrossRule::invalid(
+    error::MISSING_FIELD,
+    &["/power_W", "/input_torque_Nm"],
+    "One of `power_W` and `input_torque_Nm` is given.",
+);
+/// The cage phase lies within one element pitch.
+pub const PHASE_BELOW_PITCH: CrossRule = CrossRule::invalid(
+    error::BAD_RANGE,
+    &["/phase_deg", "/Z2"],
+    "phase_deg < 360/Z2 (one element pitch).",
+);
+
+/// The rules between fields of `POST /v1/irefc-efficiency`, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    AMBIGUOUS_LOAD,
+    LOAD_MISSING,
+    PHASE_BELOW_PITCH,
+    design::UNDERCUT,
+    design::ELEMENT_OVERLAP,
+    design::NON_FINITE,
+    design::DEADLINE,
+    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
+];
 
 /// The paper's rolling-friction lever arm μ = 0.001 m \[mm\].
 pub const ROLLING_FRICTION_PAPER_MM: f64 = 1.0;
@@ -67,76 +95,50 @@ pub struct EfficiencyInput {
 }
 
 impl EfficiencyInput {
-    /// Validate a request: ranges (`BAD_RANGE`, `MISSING_FIELD`, `AMBIGUOUS_LOAD`, all at once), then
-    /// buildability (`UNDERCUT`, `ELEMENT_OVERLAP`).
+    /// The rules between fields of a request whose ranges passed the door (`MISSING_FIELD`,
+    /// `AMBIGUOUS_LOAD`, the phase against Z2, all at once), then buildability (`UNDERCUT`,
+    /// `ELEMENT_OVERLAP`).
+    ///
+    /// # Errors
+    /// Each broken rule between fields ([`CROSS_FIELD_RULES`]).
     pub fn try_from_request(req: &IrefcEfficiencyRequest) -> Result<Self, CalcFailure> {
+        // Every range is checked at the door (`BAD_RANGE`).
         let mut v = design::validator();
-        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
-        let r2 = design::r2(&mut v, "/r2_mm", req.r2_mm);
-        let z2 = design::z2(&mut v, "/Z2", req.z2);
-        let chi = design::chi(&mut v, "/chi", req.chi);
-        let rb = design::rb(&mut v, "/rb_mm", req.rb_mm);
         match (req.power_w, req.input_torque_nm) {
-            (Some(_), Some(_)) => v.push_code(
-                AMBIGUOUS_LOAD,
+            (Some(_), Some(_)) => v.rule(
+                &AMBIGUOUS_LOAD,
                 "/input_torque_Nm",
                 "give either power_W or input_torque_Nm, not both",
             ),
-            (None, None) => design::missing(&mut v, "/power_W", "power_W (or input_torque_Nm)"),
-            (Some(p), None) => {
-                v.range("/power_W", "input power power_W", p, POWER_W);
-            }
-            (None, Some(m)) => {
-                v.range(
-                    "/input_torque_Nm",
-                    "input torque input_torque_Nm",
-                    m,
-                    INPUT_TORQUE_NM,
-                );
-            }
+            (None, None) => design::missing(
+                &mut v,
+                &LOAD_MISSING,
+                "/power_W",
+                "power_W (or input_torque_Nm)",
+            ),
+            _ => {}
         }
         let mu_mm = req.rolling_friction_mm.unwrap_or(ROLLING_FRICTION_PAPER_MM);
         let fs = req.sliding_friction.unwrap_or(SLIDING_FRICTION_PAPER);
         let n_phase = req.n_phase.unwrap_or(1);
-        for (pointer, name, x, range) in [
-            (
-                "/speed_rpm",
-                "input speed speed_rpm",
-                req.speed_rpm,
-                SPEED_RPM,
-            ),
-            (
-                "/rolling_friction_mm",
-                "rolling friction lever arm",
-                mu_mm,
-                ROLLING_FRICTION_MM,
-            ),
-            (
-                "/sliding_friction",
-                "sliding friction coefficient",
-                fs,
-                SLIDING_FRICTION,
-            ),
-            ("/n_phase", "n_phase", f64::from(n_phase), N_PHASE),
-        ] {
-            v.range(pointer, name, x, range);
-        }
+        let z2 = design::z2(req.z2);
         let phase_deg = req.phase_deg.unwrap_or(0.0);
         let mut phase_fraction = 0.0;
         if let Some(z) = z2 {
             let range = phase_deg_range(z);
-            if v.range("/phase_deg", "cage phase phase_deg", phase_deg, range) {
+            if v.ensure_rule(
+                range.contains(phase_deg),
+                &PHASE_BELOW_PITCH,
+                "/phase_deg",
+                || format!("cage phase phase_deg [deg] must be {range}, got {phase_deg}"),
+            ) {
                 phase_fraction = (phase_deg / range.hi).clamp(0.0, 1.0 - f64::EPSILON);
             }
         }
         v.finish()?;
-        let (Some(r2), Some(z2), Some(chi), Some(rb)) = (r2, z2, chi, rb) else {
-            // Unreachable: each None recorded a problem and `finish` returned it.
-            return Err(CalcFailure::general(
-                ProblemClass::InvalidInput,
-                BAD_RANGE,
-                "incomplete design",
-            ));
+        let (r2, chi, rb) = (req.r2_mm, req.chi, req.rb_mm);
+        let Some(z2) = z2 else {
+            return Err(crate::calc::rules::door_skipped("/Z2"));
         };
         let geometry = Geometry::new_unchecked(r2 / MM, z2, chi, rb / MM);
         let bad = geometry.infeasibilities();
@@ -162,5 +164,14 @@ impl EfficiencyInput {
             n_phase,
             elements: req.include.and_then(|i| i.elements).unwrap_or(true),
         })
+    }
+}
+
+impl TryFrom<IrefcEfficiencyRequest> for EfficiencyInput {
+    type Error = CalcFailure;
+
+    /// [`EfficiencyInput::try_from_request`].
+    fn try_from(req: IrefcEfficiencyRequest) -> Result<Self, CalcFailure> {
+        Self::try_from_request(&req)
     }
 }

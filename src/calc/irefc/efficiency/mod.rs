@@ -29,8 +29,20 @@ pub fn run_efficiency(
     req: IrefcEfficiencyRequest,
     budget: &Budget,
 ) -> Result<IrefcEfficiencyResponse, CalcFailure> {
+    crate::calc::rules::check(&req)?;
+    run_valid(&EfficiencyInput::try_from(req)?, budget)
+}
+
+/// Compute and respond for a request that passed the door (the per-field rules, then
+/// [`EfficiencyInput::try_from`]).
+///
+/// # Errors
+/// `NON_FINITE` / `DEADLINE` from the calculation.
+pub fn run_valid(
+    input: &EfficiencyInput,
+    budget: &Budget,
+) -> Result<IrefcEfficiencyResponse, CalcFailure> {
     let t0 = Instant::now();
-    let inp = EfficiencyInput::try_from_request(&req)?;
-    let out = compute::compute(&inp, budget)?;
-    output::respond(&inp, &out, t0).map_err(CalcFailure::from)
+    let out = compute::compute(input, budget)?;
+    output::respond(input, &out, t0).map_err(CalcFailure::from)
 }

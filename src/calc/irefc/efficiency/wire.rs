@@ -48,38 +48,48 @@ pub struct EfficiencyInclude {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::efficiency::IrefcEfficiencyRequest)]
 #[serde(deny_unknown_fields)]
+#[rules(code = "BAD_RANGE")]
 #[schema(example = json!({"r2_mm":20,"Z2":26,"chi":1.4,"rb_mm":2,"power_W":1500,"speed_rpm":1500,
     "rolling_friction_mm":1.0,"sliding_friction":0.1,"model":"paper_table","phase_deg":0,"n_phase":1,
     "include":{"elements":true}}))]
 pub struct IrefcEfficiencyRequest {
     /// Cage generating (pitch) circle radius r2 \[mm\].
+    #[rule(range = R2_MM)]
     #[schema(example = 20.0)]
     pub r2_mm: f64,
     /// Number of rolling elements Z2 [–].
     #[serde(rename = "Z2")]
+    #[rule(range = Z2)]
     #[schema(example = 26)]
     pub z2: i64,
     /// Displacement coefficient χ (rc = χ·r2) [–].
+    #[rule(range = CHI)]
     #[schema(example = 1.4)]
     pub chi: f64,
     /// Rolling element radius rb \[mm\]; must be below rb_overlap and rb_undercut.
+    #[rule(range = RB_MM)]
     #[schema(example = 2.0)]
     pub rb_mm: f64,
     /// Input (motor) power P_in \[W\]; give this or `input_torque_Nm`, not both.
     #[serde(rename = "power_W")]
+    #[rule(range = POWER_W)]
     #[schema(example = 1500.0)]
     pub power_w: Option<f64>,
     /// Input torque M_in [N·m]; alternative to `power_W`.
     #[serde(rename = "input_torque_Nm")]
+    #[rule(range = INPUT_TORQUE_NM)]
     #[schema(example = 9.549297)]
     pub input_torque_nm: Option<f64>,
     /// Input shaft (carrier) speed n \[rpm\].
+    #[rule(range = SPEED_RPM)]
     #[schema(example = 1500.0)]
     pub speed_rpm: f64,
     /// Rolling-friction lever arm μ \[mm\] (default 1.0, the paper's 0.001 m).
+    #[rule(range = ROLLING_FRICTION_MM)]
     #[schema(example = 1.0)]
     pub rolling_friction_mm: Option<f64>,
     /// Sliding friction coefficient f_s [–] (default 0.1, the paper's).
+    #[rule(range = SLIDING_FRICTION)]
     #[schema(example = 0.1)]
     pub sliding_friction: Option<f64>,
     /// "paper_table" (default), "paper_abs" or "rigid_body".
@@ -87,9 +97,11 @@ pub struct IrefcEfficiencyRequest {
     pub model: Option<EfficiencyModel>,
     /// Cage phase: element k at φ2 = phase + 360k/Z2 \[deg\], in [0, 360/Z2) (default 0, the paper);
     /// the upper end depends on `Z2`.
+    #[rule(range = PHASE_DEG)]
     #[schema(example = 0.0)]
     pub phase_deg: Option<f64>,
     /// Number of equally spaced cage phases to average over (1 = the paper; default 1).
+    #[rule(range = N_PHASE)]
     #[schema(example = 1)]
     pub n_phase: Option<u32>,
     /// Optional outputs.
@@ -97,6 +109,7 @@ pub struct IrefcEfficiencyRequest {
     pub include: Option<EfficiencyInclude>,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
 }
@@ -280,23 +293,4 @@ pub const N_PHASE: Range = Range::int(1, 10_000);
 #[must_use]
 pub fn phase_deg_range(z2: u32) -> Range {
     PHASE_DEG.lt(360.0 / f64::from(z2))
-}
-
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
-crate::schema_bounds! {
-    IrefcEfficiencyRequest {
-        r2_mm: R2_MM,
-        z2 as "Z2": Z2,
-        chi: CHI,
-        rb_mm: RB_MM,
-        power_w as "power_W": POWER_W,
-        input_torque_nm as "input_torque_Nm": INPUT_TORQUE_NM,
-        speed_rpm: SPEED_RPM,
-        rolling_friction_mm: ROLLING_FRICTION_MM,
-        sliding_friction: SLIDING_FRICTION,
-        phase_deg: PHASE_DEG,
-        n_phase: N_PHASE,
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
 }

@@ -1,14 +1,86 @@
-//! Validation of an [`IrefcStressRequest`] into SI domain input, collecting every issue.
+//! The rules between fields of an [`IrefcStressRequest`], turning it into SI domain input and
+//! collecting every issue. Every per-field range is a `#[rule]` on the wire types (`BAD_RANGE`),
+//! checked at the door; what is left here is listed in [`CROSS_FIELD_RULES`] with the spec's
+//! codes.
 
 use super::wire::{
-    self, CHI_STEP, CURVES_STRIDE, GRID_INTERVALS_MAX, IntRange, IrefcStressRequest,
-    LB_MAX_OVER_R2, LB_MM, PROFILE_POINTS, STEP_DEG, STEP_DEG_BUILDABLE, StepRange, StressInclude,
-    StressMode, TORQUE_NM,
+    self, GRID_INTERVALS_MAX, IntRange, IrefcStressRequest, LB_MAX_OVER_R2, LB_MM, STEP_DEG,
+    StepRange, StressInclude, StressMode,
 };
-use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, SWEEP_TOO_LARGE};
+use crate::calc::common::{self, Shard};
+use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, MISSING_FIELD, SWEEP_TOO_LARGE};
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::{MM, PROFILE_POINTS_DEFAULT, Warning};
-use crate::calc::{CalcFailure, ProblemClass, Range, Validator};
+use crate::calc::{CalcFailure, CrossRule, Range, Validator};
+
+/// A sweep goes with mode "sweep".
+pub const SWEEP_NEEDS_MODE: CrossRule = CrossRule::invalid(
+    BAD_RANGE,
+    &["/sweep", "/mode"],
+    "`sweep` is given only with mode \"sweep\" (the default when `sweep` is present).",
+);
+/// A shard splits a sweep.
+pub const SHARD_NEEDS_SWEEP: CrossRule = CrossRule::invalid(
+    BAD_RANGE,
+    &["/shard", "/mode"],
+    "`shard` is given only in mode \"sweep\" (mode \"single\" has one design).",
+);
+/// The fields of the chosen mode are given.
+pub const MODE_FIELDS: CrossRule = CrossRule::invalid(
+    MISSING_FIELD,
+    &[
+        "/r2_mm",
+        "/rb_mm",
+        "/Z2",
+        "/chi",
+        "/sweep",
+        "/sweep/r2_mm",
+        "/sweep/rb_mm",
+    ],
+    "Mode \"single\" needs r2_mm, rb_mm, Z2 and chi; mode \"sweep\" needs `sweep`, and r2_mm \
+     and rb_mm unless `sweep.r2_mm`/`sweep.rb_mm` are given.",
+);
+/// Sweep ranges run upwards.
+pub const SWEEP_RANGE_ORDER: CrossRule = CrossRule::invalid(
+    BAD_RANGE,
+    &["/sweep/Z2/to", "/sweep/chi/to"],
+    "sweep.Z2.to ≥ sweep.Z2.from and sweep.chi.to ≥ sweep.chi.from.",
+);
+/// The contact length is at most 100 cage radii.
+pub const LB_BELOW_R2: CrossRule = CrossRule::invalid(
+    BAD_RANGE,
+    &["/lb_mm", "/r2_mm", "/sweep/r2_mm"],
+    "lb_mm ≤ 100·r2 for every r2 of the request.",
+);
+/// The φ2 grid has at most 2·10⁶ intervals.
+pub const GRID_TOO_FINE_RULE: CrossRule = CrossRule::too_large(
+    GRID_TOO_FINE,
+    &["/step_deg"],
+    "180/step_deg ≤ 2e6 (step_deg ≥ 9e-5).",
+);
+/// The sweep's size is bounded.
+pub const SWEEP_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
+    SWEEP_TOO_LARGE,
+    &["/sweep", "/step_deg"],
+    "The sweep has at most 1e5 combinations and at most 5e8 grid points in all.",
+);
+
+/// The rules between fields of `POST /v1/irefc-stress`, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    SWEEP_NEEDS_MODE,
+    SHARD_NEEDS_SWEEP,
+    common::SHARD_INDEX_BELOW_COUNT,
+    MODE_FIELDS,
+    SWEEP_RANGE_ORDER,
+    LB_BELOW_R2,
+    GRID_TOO_FINE_RULE,
+    SWEEP_TOO_LARGE_RULE,
+    design::UNDERCUT,
+    design::ELEMENT_OVERLAP,
+    design::NON_FINITE,
+    design::DEADLINE,
+    common::RESPONSE_TOO_LARGE_RULE,
+];
 
 /// Default φ2 grid step \[deg\]: 1° + refinement is ≤ 1e-10 from the exact maximum and ~40× cheaper than the
 /// paper's 0.02° grid (whose error is 1.8e-8); see `benches/RESULTS.md` (## irefc).
@@ -193,32 +265,72 @@ pub fn chi_values(from: f64, to: f64, step: f64, max: u64) -> Option<Vec<f64>> {
 }
 
 impl StressInput {
-    /// Validate a request (spec "Inputs"); every range problem is reported at once (`BAD_RANGE`,
-    /// `MISSING_FIELD`), then grid/sweep size (`GRID_TOO_FINE`, `SWEEP_TOO_LARGE`). Feasibility (`UNDERCUT`,
-    /// `ELEMENT_OVERLAP`) is checked on the geometry by the caller.
+    /// The rules between fields of a request whose ranges passed the door (spec "Inputs"):
+    /// `MISSING_FIELD` and the range rules between fields (`BAD_RANGE`) at once, then grid/sweep
+    /// size (`GRID_TOO_FINE`, `SWEEP_TOO_LARGE`). Feasibility (`UNDERCUT`, `ELEMENT_OVERLAP`) is
+    /// checked on the geometry by the caller.
+    ///
+    /// # Errors
+    /// Each broken rule ([`CROSS_FIELD_RULES`]).
     pub fn try_from_request(req: &IrefcStressRequest) -> Result<Self, CalcFailure> {
         let mut v = design::validator();
-        let _ = crate::calc::common::time_limit(&mut v, req.time_limit_ms);
-        let mode = match (req.mode, req.sweep.is_some()) {
-            (Some(m), _) => m,
-            (None, true) => StressMode::Sweep,
-            (None, false) => StressMode::Single,
-        };
+        let mode = mode_of(req);
         if mode == StressMode::Single && req.sweep.is_some() {
-            v.push("/sweep", "sweep is only allowed with mode \"sweep\"");
+            v.rule(
+                &SWEEP_NEEDS_MODE,
+                "/sweep",
+                "sweep is only allowed with mode \"sweep\"",
+            );
         }
         let include = req.include.unwrap_or_default();
         let checked = Checked {
             req,
             params: check_params(&mut v, req, &include),
             include,
-            r2: req.r2_mm.and_then(|x| design::r2(&mut v, "/r2_mm", x)),
-            rb: req.rb_mm.and_then(|x| design::rb(&mut v, "/rb_mm", x)),
+            r2: req.r2_mm,
+            rb: req.rb_mm,
         };
         match mode {
             StressMode::Single => single(checked, v).map(Self::Single),
             StressMode::Sweep => sweep(checked, v).map(Self::Sweep),
         }
+    }
+}
+
+/// The request's mode: as given, else "sweep" when `sweep` is present, else "single".
+fn mode_of(req: &IrefcStressRequest) -> StressMode {
+    match (req.mode, req.sweep.is_some()) {
+        (Some(m), _) => m,
+        (None, true) => StressMode::Sweep,
+        (None, false) => StressMode::Single,
+    }
+}
+
+/// What `POST /v1/irefc-stress` runs: the validated input and, for a sweep, the shard.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StressJob {
+    /// The validated input.
+    pub input: StressInput,
+    /// The block of the sweep to compute (`None`: the whole sweep, or a single design).
+    pub shard: Option<Shard>,
+}
+
+impl TryFrom<IrefcStressRequest> for StressJob {
+    type Error = CalcFailure;
+
+    /// The rules between fields ([`StressInput::try_from_request`]) and those of `shard`.
+    fn try_from(req: IrefcStressRequest) -> Result<Self, CalcFailure> {
+        let mut v = Validator::new();
+        let shard = common::shard_rule(&mut v, req.shard);
+        if req.shard.is_some() && mode_of(&req) == StressMode::Single {
+            v.rule(
+                &SHARD_NEEDS_SWEEP,
+                "/shard",
+                "shard splits a sweep; mode \"single\" has one design",
+            );
+        }
+        let input = common::with_issues(v, StressInput::try_from_request(&req))?;
+        Ok(Self { input, shard })
     }
 }
 
@@ -228,49 +340,23 @@ struct Checked<'a> {
     include: StressInclude,
     /// The shared settings (`lb` is checked per mode, against the r2 values).
     params: StressParams,
-    /// Top-level r2 (mm) when given and valid.
+    /// Top-level r2 (mm) when given.
     r2: Option<f64>,
-    /// Top-level rb (mm) when given and valid.
+    /// Top-level rb (mm) when given.
     rb: Option<f64>,
 }
 
-/// The settings shared by every design (`lb` is checked per mode, against the r2 values).
+/// The settings shared by every design (`lb` is checked per mode, against the r2 values; the
+/// ranges at the door).
 fn check_params(
     v: &mut Validator,
     req: &IrefcStressRequest,
     include: &StressInclude,
 ) -> StressParams {
-    v.range(
-        "/torque_Nm",
-        "output torque torque_Nm",
-        req.torque_nm,
-        TORQUE_NM,
-    );
     let wm = req.wheel_material.unwrap_or_default();
     let rm = req.roller_material.unwrap_or_default();
-    design::material(v, "/wheel_material", &wm);
-    design::material(v, "/roller_material", &rm);
     let step_deg = req.step_deg.unwrap_or(STEP_DEG_DEFAULT);
     let n_intervals = grid_intervals(v, step_deg).unwrap_or(0);
-    let counts = [
-        (
-            "/curves_stride",
-            "curves_stride",
-            req.curves_stride,
-            CURVES_STRIDE,
-        ),
-        (
-            "/profile_points",
-            "profile_points",
-            req.profile_points,
-            PROFILE_POINTS,
-        ),
-    ];
-    for (pointer, name, n, range) in counts {
-        if let Some(n) = n {
-            v.range(pointer, name, f64::from(n), range);
-        }
-    }
     StressParams {
         torque: req.torque_nm,
         output_link: req.output_link.unwrap_or_default().into(),
@@ -284,20 +370,12 @@ fn check_params(
     }
 }
 
-/// Grid intervals N = round(180/step) of a valid step: `BAD_RANGE` outside
-/// [`STEP_DEG_BUILDABLE`], `GRID_TOO_FINE` below [`STEP_DEG`].
+/// Grid intervals N = round(180/step) of a step in (0, 10] (the door): `GRID_TOO_FINE` below
+/// [`STEP_DEG`].
 fn grid_intervals(v: &mut Validator, step_deg: f64) -> Option<usize> {
-    if !v.range(
-        "/step_deg",
-        "grid step step_deg",
-        step_deg,
-        STEP_DEG_BUILDABLE,
-    ) {
-        return None;
-    }
     if !STEP_DEG.contains(step_deg) {
-        v.push_code(
-            GRID_TOO_FINE,
+        v.rule(
+            &GRID_TOO_FINE_RULE,
             "/step_deg",
             format!(
                 "grid step {step_deg} deg gives 180/step = {} intervals > {GRID_INTERVALS_MAX}",
@@ -324,17 +402,11 @@ fn single(checked: Checked<'_>, mut v: Validator) -> Result<SingleInput, CalcFai
         ("/rb_mm", "rb_mm", req.rb_mm.is_some()),
     ] {
         if !given {
-            design::missing(&mut v, pointer, name);
+            design::missing(&mut v, &MODE_FIELDS, pointer, name);
         }
     }
-    let z2 = required(&mut v, req.z2, "/Z2", "Z2 (mode \"single\")", design::z2);
-    let chi = required(
-        &mut v,
-        req.chi,
-        "/chi",
-        "chi (mode \"single\")",
-        design::chi,
-    );
+    let z2 = required(&mut v, req.z2, "/Z2", "Z2 (mode \"single\")").and_then(design::z2);
+    let chi = required(&mut v, req.chi, "/chi", "chi (mode \"single\")");
     params.lb = check_lb(&mut v, req.lb_mm, r2.as_slice()).map(|x| x / MM);
     v.finish()?;
     let (Some(r2), Some(z2), Some(chi), Some(rb)) = (r2, z2, chi, rb) else {
@@ -372,37 +444,16 @@ fn sweep(checked: Checked<'_>, mut v: Validator) -> Result<SweepInput, CalcFailu
         rb,
     } = checked;
     let Some(sw) = req.sweep.as_ref() else {
-        design::missing(&mut v, "/sweep", "sweep (mode \"sweep\")");
+        design::missing(&mut v, &MODE_FIELDS, "/sweep", "sweep (mode \"sweep\")");
         v.finish()?;
         return Err(unreachable_incomplete());
     };
-    // Ignored, but still held to their documented ranges: a request the published
-    // schema rejects is rejected here too.
-    if let Some(x) = req.z2 {
-        design::z2(&mut v, "/Z2", x);
-    }
-    if let Some(x) = req.chi {
-        design::chi(&mut v, "/chi", x);
-    }
+    // Scalar Z2 and χ are ignored here, but were held to their documented ranges at the door.
     let warnings = ignored_fields(req, &include);
     let z2s = z2_values(&mut v, &sw.z2);
     let chis = chi_sweep(&mut v, &sw.chi);
-    let rbs = sweep_list(
-        &mut v,
-        "rb_mm",
-        sw.rb_mm.as_deref(),
-        req.rb_mm,
-        rb,
-        design::rb,
-    );
-    let r2s = sweep_list(
-        &mut v,
-        "r2_mm",
-        sw.r2_mm.as_deref(),
-        req.r2_mm,
-        r2,
-        design::r2,
-    );
+    let rbs = sweep_list(&mut v, "rb_mm", sw.rb_mm.as_deref(), rb);
+    let r2s = sweep_list(&mut v, "r2_mm", sw.r2_mm.as_deref(), r2);
     params.lb = check_lb(&mut v, req.lb_mm, &r2s).map(|x| x / MM);
     v.checkpoint()?;
     // Sizes (only once the ranges are valid).
@@ -424,27 +475,18 @@ fn sweep(checked: Checked<'_>, mut v: Validator) -> Result<SweepInput, CalcFailu
     })
 }
 
-/// A required field: checked when given, else `MISSING_FIELD`.
-fn required<T, U>(
-    v: &mut Validator,
-    value: Option<T>,
-    pointer: &str,
-    what: &str,
-    check: fn(&mut Validator, &str, T) -> Option<U>,
-) -> Option<U> {
-    match value {
-        Some(x) => check(v, pointer, x),
-        None => {
-            design::missing(v, pointer, what);
-            None
-        }
+/// A required field of the mode: `MISSING_FIELD` when absent.
+fn required<T>(v: &mut Validator, value: Option<T>, pointer: &str, what: &str) -> Option<T> {
+    if value.is_none() {
+        design::missing(v, &MODE_FIELDS, pointer, what);
     }
+    value
 }
 
 /// The failure of a design that validation left incomplete (cannot happen: every missing value
 /// recorded a problem and `finish` returned it).
 fn unreachable_incomplete() -> CalcFailure {
-    CalcFailure::general(ProblemClass::InvalidInput, BAD_RANGE, "incomplete design")
+    crate::calc::rules::door_skipped("/Z2")
 }
 
 /// `FIELD_IGNORED` warnings for the single-design fields of a sweep request.
@@ -465,13 +507,15 @@ fn ignored_fields(req: &IrefcStressRequest, include: &StressInclude) -> Vec<Warn
     warnings
 }
 
-/// Z2 values of the sweep, ascending (empty when the range is invalid).
+/// Z2 values of the sweep, ascending (empty when the range is invalid; its ends were checked
+/// at the door).
 fn z2_values(v: &mut Validator, r: &IntRange) -> Vec<u32> {
-    let from = design::z2(v, "/sweep/Z2/from", r.from);
-    let to = design::z2(v, "/sweep/Z2/to", r.to);
+    let from = design::z2(r.from);
+    let to = design::z2(r.to);
     match (from, to) {
         (Some(a), Some(b)) if a > b => {
-            v.push(
+            v.rule(
+                &SWEEP_RANGE_ORDER,
                 "/sweep/Z2/to",
                 format!("Z2.to = {b} must be >= Z2.from = {a}"),
             );
@@ -482,51 +526,36 @@ fn z2_values(v: &mut Validator, r: &IntRange) -> Vec<u32> {
     }
 }
 
-/// χ values of the sweep (empty when the range is invalid); `None` when there would be more
-/// than [`SWEEP_COMBINATIONS_MAX`] of them.
+/// χ values of the sweep (empty when the range is invalid; its ends and step were checked at the
+/// door); `None` when there would be more than [`SWEEP_COMBINATIONS_MAX`] of them.
 fn chi_sweep(v: &mut Validator, r: &StepRange) -> Option<Vec<f64>> {
-    let from = design::chi(v, "/sweep/chi/from", r.from);
-    let to = design::chi(v, "/sweep/chi/to", r.to);
-    let step_ok = v.range("/sweep/chi/step", "chi.step", r.step, CHI_STEP);
-    match (from, to, step_ok) {
-        (Some(a), Some(b), true) if a > b => {
-            v.push(
-                "/sweep/chi/to",
-                format!("chi.to = {b} must be >= chi.from = {a}"),
-            );
-            Some(Vec::new())
-        }
-        (Some(a), Some(b), true) => chi_values(a, b, r.step, SWEEP_COMBINATIONS_MAX),
-        _ => Some(Vec::new()),
+    let (a, b) = (r.from, r.to);
+    if a > b {
+        v.rule(
+            &SWEEP_RANGE_ORDER,
+            "/sweep/chi/to",
+            format!("chi.to = {b} must be >= chi.from = {a}"),
+        );
+        return Some(Vec::new());
     }
+    chi_values(a, b, r.step, SWEEP_COMBINATIONS_MAX)
 }
 
-/// The valid values of a sweep list `sweep.<name>` (mm) (each item checked), or without the
-/// list the top-level `<name>` (`top`, already checked; required then).
-fn sweep_list(
-    v: &mut Validator,
-    name: &str,
-    list: Option<&[f64]>,
-    top_given: Option<f64>,
-    top: Option<f64>,
-    check: fn(&mut Validator, &str, f64) -> Option<f64>,
-) -> Vec<f64> {
+/// The values of a sweep list `sweep.<name>` (mm; its items and length were checked at the
+/// door), or without the list the top-level `<name>` (`top`; required then).
+fn sweep_list(v: &mut Validator, name: &str, list: Option<&[f64]>, top: Option<f64>) -> Vec<f64> {
     let Some(list) = list else {
-        if top_given.is_none() {
-            design::missing(v, &format!("/{name}"), &format!("{name} (or sweep.{name})"));
+        if top.is_none() {
+            design::missing(
+                v,
+                &MODE_FIELDS,
+                &format!("/{name}"),
+                &format!("{name} (or sweep.{name})"),
+            );
         }
         return top.into_iter().collect();
     };
-    if list.is_empty() {
-        v.push(
-            format!("/sweep/{name}"),
-            format!("{name} list must not be empty"),
-        );
-    }
-    list.iter()
-        .enumerate()
-        .filter_map(|(i, &x)| check(v, &format!("/sweep/{name}/{i}"), x))
-        .collect()
+    list.to_vec()
 }
 
 /// `SWEEP_TOO_LARGE` when the sweep has more than [`SWEEP_COMBINATIONS_MAX`] combinations
@@ -539,8 +568,8 @@ fn check_size(
     n_intervals: usize,
 ) {
     let Some(chis) = chis else {
-        v.push_code(
-            SWEEP_TOO_LARGE,
+        v.rule(
+            &SWEEP_TOO_LARGE_RULE,
             "/sweep",
             format!("the sweep has more than 100000 combinations > {SWEEP_COMBINATIONS_MAX}"),
         );
@@ -550,8 +579,8 @@ fn check_size(
         .saturating_mul(chis.len() as u64)
         .saturating_mul(n_lists as u64);
     if combos > SWEEP_COMBINATIONS_MAX {
-        v.push_code(
-            SWEEP_TOO_LARGE,
+        v.rule(
+            &SWEEP_TOO_LARGE_RULE,
             "/sweep",
             format!("the sweep has {combos} combinations > {SWEEP_COMBINATIONS_MAX}"),
         );
@@ -560,8 +589,8 @@ fn check_size(
     // combos ≤ 1e5, n_intervals ≤ 2e6: both exact in f64.
     let work = combos as f64 * (n_intervals as f64 + 1.0);
     if work > SWEEP_WORK_MAX {
-        v.push_code(
-            SWEEP_TOO_LARGE,
+        v.rule(
+            &SWEEP_TOO_LARGE_RULE,
             "/sweep",
             format!(
                 "combinations x grid points = {combos} x {} = {work} > {SWEEP_WORK_MAX}; use a coarser step_deg",
@@ -571,8 +600,8 @@ fn check_size(
     }
 }
 
-/// Validate lb (mm) against 0 < lb ≤ 100·r2 for every r2 given ([`LB_MM`], the upper end a
-/// cross-field rule); returns it when valid.
+/// Check lb (mm) against lb ≤ 100·r2 for every r2 given ([`LB_BELOW_R2`]; lb > 0 is checked at
+/// the door); returns it when valid.
 fn check_lb(v: &mut Validator, lb: Option<f64>, r2s_mm: &[f64]) -> Option<f64> {
     let x = lb?;
     let r2_min = r2s_mm.iter().copied().fold(f64::INFINITY, f64::min);
@@ -581,6 +610,8 @@ fn check_lb(v: &mut Validator, lb: Option<f64>, r2s_mm: &[f64]) -> Option<f64> {
     } else {
         LB_MM
     };
-    v.range("/lb_mm", "contact length lb_mm", x, range)
-        .then_some(x)
+    v.ensure_rule(range.contains(x), &LB_BELOW_R2, "/lb_mm", || {
+        format!("contact length lb_mm [mm] must be {range}, got {x}")
+    })
+    .then_some(x)
 }

@@ -10,12 +10,11 @@ pub mod wire;
 use std::time::Instant;
 
 use compute::{GridTrig, compute_design, compute_sweep};
-use input::StressInput;
+use input::{StressInput, StressJob};
 use wire::{IrefcStressRequest, IrefcStressResponse};
 
-use super::error::BAD_RANGE;
-use crate::calc::common::{self, Shard};
-use crate::calc::{CalcFailure, ProblemClass, Validator};
+use crate::calc::CalcFailure;
+use crate::calc::common::Shard;
 use crate::numerics::Budget;
 
 /// Validate, compute and build the response of `POST /v1/irefc-stress` (run on the blocking pool).
@@ -30,19 +29,20 @@ pub fn run_stress(
     req: IrefcStressRequest,
     budget: &Budget,
 ) -> Result<IrefcStressResponse, CalcFailure> {
-    let mut v = Validator::new();
-    let shard = common::shard(&mut v, req.shard);
-    match common::with_issues(v, StressInput::try_from_request(&req))? {
+    crate::calc::rules::check(&req)?;
+    run_valid(&StressJob::try_from(req)?, budget)
+}
+
+/// Compute and respond for a request that passed the door (the per-field rules, then
+/// [`StressJob::try_from`]).
+///
+/// # Errors
+/// `RESPONSE_TOO_LARGE` before computing; `UNDERCUT`/`ELEMENT_OVERLAP`/`NON_FINITE`/`DEADLINE`
+/// of a single design.
+pub fn run_valid(job: &StressJob, budget: &Budget) -> Result<IrefcStressResponse, CalcFailure> {
+    match &job.input {
         StressInput::Single(s) => {
-            if req.shard.is_some() {
-                return Err(CalcFailure::field(
-                    ProblemClass::InvalidInput,
-                    BAD_RANGE,
-                    "/shard",
-                    "shard splits a sweep; mode \"single\" has one design",
-                ));
-            }
-            output::single_size(&s).check(budget)?;
+            output::single_size(s).check(budget)?;
             let t0 = Instant::now();
             let r = compute_design(
                 &s.design,
@@ -51,19 +51,19 @@ pub fn run_stress(
                 s.curves_stride,
                 Some(budget),
             )?;
-            let resp = output::respond_single(&s, &r, t0)?;
+            let resp = output::respond_single(s, &r, t0)?;
             Ok(IrefcStressResponse::Single(Box::new(resp)))
         }
         StressInput::Sweep(s) => {
-            let shard = shard.unwrap_or(Shard::WHOLE);
-            output::sweep_size(&s, shard).check(budget)?;
+            let shard = job.shard.unwrap_or(Shard::WHOLE);
+            output::sweep_size(s, shard).check(budget)?;
             let items = shard.range(s.len());
             let t0 = Instant::now();
             let offset = items.start;
-            let res = compute_sweep(&s, items, budget);
-            let shard_out = req.shard.map(|_| shard.out(s.len()));
+            let res = compute_sweep(s, items, budget);
+            let shard_out = job.shard.map(|_| shard.out(s.len()));
             Ok(IrefcStressResponse::Sweep(output::respond_sweep(
-                &s, offset, &res, shard_out, t0,
+                s, offset, &res, shard_out, t0,
             )))
         }
     }

@@ -81,11 +81,14 @@ pub struct StressInclude {
 #[derive(Debug, Clone, Copy, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::IntRange)]
 #[serde(deny_unknown_fields)]
+#[rules(code = "BAD_RANGE")]
 pub struct IntRange {
     /// First value (inclusive).
+    #[rule(range = Z2)]
     #[schema(example = 10)]
     pub from: i64,
-    /// Last value (inclusive).
+    /// Last value (inclusive), ≥ `from`.
+    #[rule(range = Z2)]
     #[schema(example = 40)]
     pub to: i64,
 }
@@ -94,14 +97,18 @@ pub struct IntRange {
 #[derive(Debug, Clone, Copy, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::StepRange)]
 #[serde(deny_unknown_fields)]
+#[rules(code = "BAD_RANGE")]
 pub struct StepRange {
     /// First value (inclusive).
+    #[rule(range = CHI)]
     #[schema(example = 1.25)]
     pub from: f64,
-    /// Last value (inclusive within 1e-12).
+    /// Last value (inclusive within 1e-12), ≥ `from`.
+    #[rule(range = CHI)]
     #[schema(example = 1.67)]
     pub to: f64,
     /// Step (> 0).
+    #[rule(range = CHI_STEP)]
     #[schema(example = 0.01)]
     pub step: f64,
 }
@@ -110,15 +117,18 @@ pub struct StepRange {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::SweepSpec)]
 #[serde(deny_unknown_fields)]
+#[rules(code = "BAD_RANGE")]
 pub struct SweepSpec {
     /// Number of rolling elements Z2, step 1.
     #[serde(rename = "Z2")]
     pub z2: IntRange,
     /// Displacement coefficient χ.
     pub chi: StepRange,
-    /// Rolling element radii \[mm\]; default: the top-level `rb_mm`.
+    /// Rolling element radii \[mm\] (at least one); default: the top-level `rb_mm`.
+    #[rule(items = RB_MM, min_items = 1)]
     pub rb_mm: Option<Vec<f64>>,
-    /// Cage pitch radii \[mm\]; default: the top-level `r2_mm`.
+    /// Cage pitch radii \[mm\] (at least one); default: the top-level `r2_mm`.
+    #[rule(items = R2_MM, min_items = 1)]
     pub r2_mm: Option<Vec<f64>>,
 }
 
@@ -126,6 +136,7 @@ pub struct SweepSpec {
 #[derive(Debug, Clone, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = irefc::stress::IrefcStressRequest)]
 #[serde(deny_unknown_fields)]
+#[rules(code = "BAD_RANGE")]
 #[schema(example = json!({"mode":"single","r2_mm":20,"Z2":26,"chi":1.4,"rb_mm":2,"lb_mm":4,"torque_Nm":119.366207,
     "output_link":"cam","wheel_material":{"E_MPa":210000,"nu":0.3},"roller_material":{"E_MPa":210000,"nu":0.3},
     "step_deg":1,"refine":true,"load_sharing":"paper_phase0","include":{"elements":true,"curves":false}}))]
@@ -134,27 +145,33 @@ pub struct IrefcStressRequest {
     #[schema(nullable = false)]
     pub mode: Option<StressMode>,
     /// Cage generating (pitch) circle radius r2 \[mm\]; required unless `sweep.r2_mm` is given.
+    #[rule(range = R2_MM)]
     #[schema(example = 20.0)]
     pub r2_mm: Option<f64>,
     /// Number of rolling elements Z2 [–]; required in mode "single".
     #[serde(rename = "Z2")]
+    #[rule(range = Z2)]
     #[schema(example = 26)]
     pub z2: Option<i64>,
     /// Displacement coefficient χ (element-centre circle rc = χ·r2) [–]; required in mode "single".
+    #[rule(range = CHI)]
     #[schema(example = 1.4)]
     pub chi: Option<f64>,
     /// Rolling element radius rb \[mm\]; must be below rb_overlap and rb_undercut. Required unless
     /// `sweep.rb_mm` is given.
+    #[rule(range = RB_MM)]
     #[schema(example = 2.0)]
     pub rb_mm: Option<f64>,
     /// Output torque T_out [N·m].
     #[serde(rename = "torque_Nm")]
+    #[rule(range = TORQUE_NM)]
     #[schema(example = 119.366207)]
     pub torque_nm: f64,
     /// Output link: "cam" (crown fixed, default) or "crown" (cam rotation locked).
     #[schema(nullable = false)]
     pub output_link: Option<OutputLink>,
     /// Contact (roller) length lb \[mm\]; default 2·rb ("equal to the diameter"). 0 < lb ≤ 100·r2.
+    #[rule(range = LB_MM)]
     #[schema(example = 4.0)]
     pub lb_mm: Option<f64>,
     /// Cam and crown material; default steel {210000, 0.3}.
@@ -166,6 +183,7 @@ pub struct IrefcStressRequest {
     /// φ2 grid step over [0°, 180°] \[deg\]; 0 < step ≤ 10 and 180/step ≤ 2·10⁶ (a finer step than
     /// 9e-5 is `GRID_TOO_FINE`). Default 1 with refine (see the module docs; the paper used 0.02
     /// without refinement).
+    #[rule(range = STEP_DEG_BUILDABLE)]
     #[schema(example = 1.0)]
     pub step_deg: Option<f64>,
     /// Polish each grid maximum with a bounded Brent search to |Δφ2| ≤ 1e-10 rad (default true).
@@ -179,9 +197,11 @@ pub struct IrefcStressRequest {
     #[schema(nullable = false)]
     pub include: Option<StressInclude>,
     /// Keep every n-th grid point in `curves` (the last point is always kept; default 1).
+    #[rule(range = CURVES_STRIDE)]
     #[schema(example = 1)]
     pub curves_stride: Option<u32>,
     /// Points per wheel in `geometry.profiles` (default 720).
+    #[rule(range = PROFILE_POINTS)]
     #[schema(example = 720)]
     pub profile_points: Option<u32>,
     /// The structured array (mode "sweep").
@@ -194,6 +214,7 @@ pub struct IrefcStressRequest {
     pub shard: Option<Shard>,
     /// Wall-clock limit for this request \[ms\], queueing included (capped by the service limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false, example = 2000)]
     pub time_limit_ms: Option<u64>,
 }
@@ -495,9 +516,9 @@ pub const LB_MM: Range = Range::FINITE.gt(0.0);
 pub const GRID_INTERVALS_MAX: f64 = 2e6;
 /// Grid steps a φ2 grid can be built from \[deg\]: 0 < step ≤ 10 (spec; `BAD_RANGE` outside).
 pub const STEP_DEG_BUILDABLE: Range = Range::FINITE.gt(0.0).max(10.0);
-/// The documented φ2 grid step \[deg\]: 180/step ≤ 2·10⁶ (step ≥ 9e-5) and step ≤ 10. A positive
-/// step below the lower end is `GRID_TOO_FINE` (a size limit), outside [`STEP_DEG_BUILDABLE`]
-/// `BAD_RANGE`. (Division is correctly rounded and monotone, so `step ≥ 180/2e6` is exactly
+/// The φ2 grid steps within the size limit \[deg\]: 180/step ≤ 2·10⁶ (step ≥ 9e-5) and step ≤ 10.
+/// The per-field rule is [`STEP_DEG_BUILDABLE`] (`BAD_RANGE`); a positive step below this range's
+/// lower end is `GRID_TOO_FINE` (a size limit, a rule of the operation). (Division is correctly rounded and monotone, so `step ≥ 180/2e6` is exactly
 /// `180/step ≤ 2e6`.)
 pub const STEP_DEG: Range = STEP_DEG_BUILDABLE.min(180.0 / GRID_INTERVALS_MAX);
 /// Sweep χ step [–]: > 0.
@@ -506,33 +527,3 @@ pub const CHI_STEP: Range = Range::FINITE.gt(0.0);
 pub const CURVES_STRIDE: Range = Range::INTEGER.min(1.0);
 /// Profile points per wheel [–].
 pub const PROFILE_POINTS: Range = Range::int(PROFILE_POINTS_MIN as i64, PROFILE_POINTS_MAX as i64);
-
-// The documented bounds of this module's wire types (one source: the validator checks
-// the same ranges, and tests/it/contract_bounds.rs probes both).
-crate::schema_bounds! {
-    IntRange {
-        from: Z2,
-        to: Z2,
-    },
-    StepRange {
-        from: CHI,
-        to: CHI,
-        step: CHI_STEP,
-    },
-    SweepSpec {
-        rb_mm @items: RB_MM,
-        r2_mm @items: R2_MM,
-    },
-    IrefcStressRequest {
-        r2_mm: R2_MM,
-        z2 as "Z2": Z2,
-        chi: CHI,
-        rb_mm: RB_MM,
-        torque_nm as "torque_Nm": TORQUE_NM,
-        lb_mm: LB_MM,
-        step_deg: STEP_DEG,
-        curves_stride: CURVES_STRIDE,
-        profile_points: PROFILE_POINTS,
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-}
