@@ -91,7 +91,8 @@ impl FieldRules {
 struct ContainerRules {
     code: Option<LitStr>,
     legacy_nulls: bool,
-    one_of: Vec<Vec<LitStr>>,
+    /// Groups of exactly-one fields, and whether a failure points at the object (else the field).
+    one_of: Vec<(Vec<LitStr>, bool)>,
 }
 
 fn serde_metas(attrs: &[Attribute]) -> syn::Result<Vec<Meta>> {
@@ -189,11 +190,12 @@ fn container_rules(attrs: &[Attribute]) -> syn::Result<ContainerRules> {
             } else if m.path.is_ident("legacy_nulls") {
                 r.legacy_nulls = true;
                 Ok(())
-            } else if m.path.is_ident("one_of") {
+            } else if m.path.is_ident("one_of") || m.path.is_ident("one_of_object") {
                 let content;
                 syn::parenthesized!(content in m.input);
                 let names = Punctuated::<LitStr, Token![,]>::parse_terminated(&content)?;
-                r.one_of.push(names.into_iter().collect());
+                r.one_of
+                    .push((names.into_iter().collect(), m.path.is_ident("one_of_object")));
                 Ok(())
             } else {
                 Err(m.error("unknown container rule: expected code or one_of(\"a\", \"b\", ...)"))
@@ -453,7 +455,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                 "",
             )?;
             let mut one_of_pushes = Vec::new();
-            for group in &cr.one_of {
+            for (group, at_object) in &cr.one_of {
                 let mut entries = Vec::new();
                 let mut wires = Vec::new();
                 for name in group {
@@ -468,7 +470,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                     wires.push(name.clone());
                 }
                 let code = code_tokens(None, cr.code.as_ref());
-                checks.push(quote!(crate::calc::rules::one_of(&[#(#entries),*], #code, __at, __v);));
+                checks.push(quote!(crate::calc::rules::one_of(&[#(#entries),*], #code, #at_object, __at, __v);));
                 one_of_pushes.push(quote!(out.push(&schema, "", crate::calc::rules::Kind::OneOf(&[#(#wires),*]));));
             }
             for f in &specs {

@@ -14,7 +14,8 @@
 //!
 //! and on the type: `#[rules(code = "...")]` (the code of every rule of the type) and
 //! `#[rules(one_of("a", "b"))]` (exactly one of the optional fields `a`, `b` is given; written as
-//! a `oneOf` of the alternatives). `R` is a [`Range`] constant of the module's `wire.rs`.
+//! a `oneOf` of the alternatives; a failure points at the field to remove or to add;
+//! `one_of_object(...)`: at the object itself). `R` is a [`Range`] constant of the module's `wire.rs`.
 //!
 //! * [`Rules::check_rules`] walks a decoded request once and records every broken rule with the
 //!   field's JSON pointer (from the wire names), its quantity, its unit (from the field's doc) and
@@ -512,6 +513,7 @@ pub fn len<T: HasLen + ?Sized>(
 pub fn one_of(
     given: &[(&'static str, bool)],
     code: Option<&'static str>,
+    at_object: bool,
     at: At<'_>,
     v: &mut Validator,
 ) {
@@ -544,9 +546,14 @@ pub fn one_of(
             .find(|(_, p)| *p)
             .map_or(given[0].0, |g| g.0)
     };
+    let pointer = if at_object {
+        at.pointer()
+    } else {
+        at.key(field).pointer()
+    };
     v.push_code(
         code.unwrap_or(super::INVALID_INPUT),
-        at.key(field).pointer(),
+        pointer,
         format!("give exactly one of {list}, got {got}"),
     );
 }

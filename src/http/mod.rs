@@ -205,19 +205,55 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
 pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRule])> {
     use crate::calc;
     vec![
-        ("/v1/bus-fuel-economy", calc::bus_fuel_economy::input::CROSS_FIELD_RULES),
-        ("/v1/bus-fuel-economy/motor-map", calc::bus_fuel_economy::input::MOTOR_MAP_RULES),
-        ("/v1/cam-law/evaluate", calc::cam_law::input::CROSS_FIELD_RULES),
+        (
+            "/v1/bus-fuel-economy",
+            calc::bus_fuel_economy::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/bus-fuel-economy/motor-map",
+            calc::bus_fuel_economy::input::MOTOR_MAP_RULES,
+        ),
+        (
+            "/v1/cam-law/evaluate",
+            calc::cam_law::input::CROSS_FIELD_RULES,
+        ),
         ("/v1/cognates", calc::cognates::input::CROSS_FIELD_RULES),
-        ("/v1/component-importance", calc::component_importance::input::CROSS_FIELD_RULES),
-        ("/v1/continuum-workspace", calc::continuum_workspace::input::CROSS_FIELD_RULES),
-        ("/v1/fit-cam-law", calc::cam_law_fit::input::CROSS_FIELD_RULES),
-        ("/v1/irefc-efficiency", calc::irefc::efficiency::input::CROSS_FIELD_RULES),
-        ("/v1/irefc-stress", calc::irefc::stress::input::CROSS_FIELD_RULES),
-        ("/v1/machining-size/analyze", calc::machining_size::input::ANALYZE_RULES),
-        ("/v1/machining-size/predict", calc::machining_size::input::PREDICT_RULES),
-        ("/v1/machining-size/train", calc::machining_size::input::TRAIN_RULES),
-        ("/v1/spatial-coupling", calc::spatial_coupling::input::CROSS_FIELD_RULES),
+        (
+            "/v1/component-importance",
+            calc::component_importance::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/continuum-workspace",
+            calc::continuum_workspace::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/fit-cam-law",
+            calc::cam_law_fit::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/irefc-efficiency",
+            calc::irefc::efficiency::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/irefc-stress",
+            calc::irefc::stress::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/machining-size/analyze",
+            calc::machining_size::input::ANALYZE_RULES,
+        ),
+        (
+            "/v1/machining-size/predict",
+            calc::machining_size::input::PREDICT_RULES,
+        ),
+        (
+            "/v1/machining-size/train",
+            calc::machining_size::input::TRAIN_RULES,
+        ),
+        (
+            "/v1/spatial-coupling",
+            calc::spatial_coupling::input::CROSS_FIELD_RULES,
+        ),
     ]
 }
 

@@ -234,7 +234,9 @@ pub struct OutputsIn {
 }
 
 /// Baseline move of the shaper comparison.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bezier_motion::Baseline)]
 #[serde(rename_all = "snake_case")]
 pub enum BaselineIn {
@@ -247,7 +249,9 @@ pub enum BaselineIn {
 
 /// An input shaper (impulse train designed for the nominal drive: `Td = 2π/ωd`,
 /// `K = exp(−ξπ/√(1−ξ²))`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bezier_motion::Shaper)]
 #[serde(rename_all = "snake_case")]
 pub enum ShaperIn {

@@ -114,7 +114,7 @@ pub struct ConstraintsIn {
 #[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law::AbscissaIn)]
 #[serde(deny_unknown_fields)]
-#[rules(one_of("values", "grid"))]
+#[rules(one_of_object("values", "grid"))]
 pub struct AbscissaIn {
     /// Explicit abscissae \[x\], strictly increasing, 1..200 000 values, all inside
     /// `[t_a − 1e-9·Δt, t_b + 1e-9·Δt]` (values within that tolerance are clamped).

@@ -101,7 +101,7 @@ impl crate::calc::common::TimeLimited for FitCamLawRequest {
 #[derive(Debug, Clone, Default, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = cam_law_fit::FitAbscissa)]
 #[serde(deny_unknown_fields)]
-#[rules(one_of("values", "grid"))]
+#[rules(one_of_object("values", "grid"))]
 pub struct FitAbscissa {
     /// Explicit abscissae \[x\]: strictly increasing, finite, 8..200 000 values, inside
     /// `[t_a − 1e-9·Δt, t_b + 1e-9·Δt]`.
