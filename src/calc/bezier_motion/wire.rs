@@ -234,7 +234,9 @@ pub struct OutputsIn {
 }
 
 /// Baseline move of the shaper comparison.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bezier_motion::Baseline)]
 #[serde(rename_all = "snake_case")]
 pub enum BaselineIn {
@@ -247,7 +249,9 @@ pub enum BaselineIn {
 
 /// An input shaper (impulse train designed for the nominal drive: `Td = 2π/ωd`,
 /// `K = exp(−ξπ/√(1−ξ²))`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema, crate::calc::Rules,
+)]
 #[schema(as = bezier_motion::Shaper)]
 #[serde(rename_all = "snake_case")]
 pub enum ShaperIn {
@@ -271,9 +275,10 @@ fn default_ei_tolerance() -> f64 {
 
 /// The shaper comparison: each shaper convolved with the baseline, whose duration is
 /// `T0 = T − (last impulse time)`, so every shaped move ends at T like the Bezier law.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::ShaperComparisonIn)]
 #[serde(deny_unknown_fields)]
+#[rules(legacy_nulls)]
 pub struct ShaperComparisonIn {
     /// Baseline move. Default `trapezoid`.
     #[serde(default)]
