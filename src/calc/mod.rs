@@ -67,7 +67,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
         machining_size::schema_bounds(),
         spatial_coupling::wire::schema_bounds(),
         spatial_coupling::wire::nested_bounds(),
-        vibration_absorber::wire::schema_bounds(),
     ]
     .concat()
 }
