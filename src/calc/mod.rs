@@ -57,7 +57,6 @@ pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         common::schema_bounds(),
         bezier_motion::wire::schema_bounds(),
-        vibration_absorber::wire::schema_bounds(),
     ]
     .concat()
 }

@@ -194,7 +194,7 @@ fn api_router() -> (OpenApiRouter<AppState>, Vec<String>) {
         .route(routes!(machining_size::predict))
         .route(routes!(machining_size::analyze))
         .route(routes!(spatial_coupling::evaluate))
-        .route(routes!(vibration_absorber::analyse))
+        .route(routes!(vibration_absorber::analyze))
         .route(routes!(bezier_motion::solve))
         .finish()
 }
@@ -253,6 +253,10 @@ pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRul
         (
             "/v1/spatial-coupling",
             calc::spatial_coupling::input::CROSS_FIELD_RULES,
+        ),
+        (
+            "/v1/vibration-absorber",
+            calc::vibration_absorber::input::CROSS_FIELD_RULES,
         ),
     ]
 }

@@ -4,9 +4,10 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::common::TimeLimited;
-use crate::calc::vibration_absorber::{self, VibrationAbsorberRequest, VibrationAbsorberResponse};
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
+use crate::calc::vibration_absorber::{
+    self, VibrationAbsorberInput, VibrationAbsorberRequest, VibrationAbsorberResponse,
+};
 
 /// Active vibration absorber on a cantilever: gains, eigenvalues, FRF and exact time response.
 ///
@@ -24,20 +25,19 @@ use crate::calc::vibration_absorber::{self, VibrationAbsorberRequest, VibrationA
     post,
     path = "/v1/vibration-absorber",
     tag = "vibration",
-    operation_id = "analyse_vibration_absorber",
+    operation_id = "analyze_vibration_absorber",
     request_body = VibrationAbsorberRequest,
     responses(
         (status = 200, description = "Modal data, gains and the requested analyses", body = VibrationAbsorberResponse),
         ProblemResponses
     )
 )]
-pub async fn analyse(
+pub async fn analyze(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<VibrationAbsorberRequest>,
+    Valid { input, limit, .. }: Valid<VibrationAbsorberRequest, VibrationAbsorberInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
     run_calc(&state, limit, move |budget| {
-        vibration_absorber::run(req, budget)
+        vibration_absorber::run_valid(&input, budget)
     })
     .await
 }

@@ -352,3 +352,269 @@ async fn a_section_whose_second_moment_underflows_is_refused_not_a_500() {
         );
     }
 }
+
+/// The document's `x-cross-field-rules` of this operation: their codes.
+fn documented_rule_codes() -> Vec<String> {
+    let doc = serde_json::to_value(mechcalc::http::openapi()).expect("openapi");
+    let rules = doc
+        .pointer("/paths/~1v1~1vibration-absorber/post/x-cross-field-rules")
+        .and_then(Value::as_array)
+        .expect("x-cross-field-rules");
+    rules
+        .iter()
+        .map(|r| r["code"].as_str().expect("code").to_owned())
+        .collect()
+}
+
+/// Each rule between fields the operation lists is reachable: a request that passes every
+/// per-field rule and breaks that one rule gets a 422 with the rule's code at the rule's pointer.
+#[tokio::test]
+async fn every_cross_field_rule_is_reachable() {
+    let one = json!([{"amplitude_n": 1.0, "frequency_hz": 5.0}]);
+    let grid = |lo: f64, hi: f64| json!({"f_min_hz": lo, "f_max_hz": hi, "n_points": 10});
+    let cases: [(&str, &str, Value); 16] = [
+        (
+            "SECTION_CONFLICT",
+            "/beam/section",
+            json!({"beam": {"section": {"width_m": 0.05, "thickness_m": 0.005}, "area_m2": 1e-4}}),
+        ),
+        (
+            "SECTION_PAIR",
+            "/beam/second_moment_m4",
+            json!({"beam": {"area_m2": 1e-4}}),
+        ),
+        (
+            "SECTION_PAIR",
+            "/beam/area_m2",
+            json!({"beam": {"second_moment_m4": 1e-9}}),
+        ),
+        (
+            "STIFFNESS_CONFLICT",
+            "/absorber/stiffness_n_m",
+            json!({"absorber": {"stiffness_n_m": 30.0}}),
+        ),
+        (
+            "MODE_OUT_OF_RANGE",
+            "/absorber/passive_tuning_mode",
+            json!({"absorber": {"passive_tuning_hz": null, "passive_tuning_mode": 4}}),
+        ),
+        (
+            "MODE_OUT_OF_RANGE",
+            "/control/tuning_mode",
+            json!({"control": {"tuning_hz": null, "tuning_mode": 4}}),
+        ),
+        (
+            "POSITION_OUT_OF_BEAM",
+            "/outputs/time_response/points_m/0",
+            json!({"beam": {"length_m": 0.8},
+                   "outputs": {"time_response": {"t_end_s": 0.1, "dt_s": 0.01, "points_m": [0.9]}}}),
+        ),
+        (
+            "ZERO_FORCE_CONSTANT",
+            "/actuator/force_constant_n_a",
+            json!({"actuator": {"force_constant_n_a": 0.0}}),
+        ),
+        (
+            "TUNING_CONFLICT",
+            "/control/tuning_mode",
+            json!({"control": {"tuning_mode": 2}}),
+        ),
+        (
+            "GAIN_PAIR",
+            "/control/kd_v_s_m",
+            json!({"control": {"kp_v_m": 600.0}}),
+        ),
+        (
+            "FREQUENCY_CONFLICT",
+            "/excitation/resonance_of_mode",
+            json!({"excitation": {"frequency_hz": 5.0, "resonance_of_mode": 1}}),
+        ),
+        (
+            "HARMONICS_CONFLICT",
+            "/excitation/phase_rad",
+            json!({"excitation": {"phase_rad": 0.1, "harmonics": one}}),
+        ),
+        (
+            "HARMONICS_TYPE",
+            "/excitation/harmonics",
+            json!({"excitation": {"type": "impulse", "harmonics": one}}),
+        ),
+        (
+            "GRID_ORDER",
+            "/outputs/ava_frequency_response/f_max_hz",
+            json!({"outputs": {"ava_frequency_response": grid(10.0, 5.0)}}),
+        ),
+        (
+            "TOO_MANY_SAMPLES",
+            "/outputs/time_response/dt_s",
+            json!({"outputs": {"time_response": {"t_end_s": 100.0, "dt_s": 1e-5}}}),
+        ),
+        (
+            "RESPONSE_TOO_LARGE",
+            "/outputs/time_response/decimate",
+            json!({"outputs": {"time_response": {"t_end_s": 2000.0, "dt_s": 1e-3,
+                                                 "return_series": true}}}),
+        ),
+    ];
+    for (code, pointer, patch) in &cases {
+        let r = post_json(PATH, &patched(patch)).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], *code, "{p}");
+        assert_eq!(r.pointers(), [*pointer], "{code}: {p}");
+    }
+    // Every listed code is one of these, or a failure of the computation: NON_FINITE_RESPONSE
+    // (reached by `a_section_whose_second_moment_underflows_is_refused_not_a_500`), a failed
+    // eigen-iteration and a spent time budget.
+    let computed = [
+        "NON_FINITE_RESPONSE",
+        "EIGEN_NOT_CONVERGED",
+        "DEADLINE_EXCEEDED",
+    ];
+    let mut want: Vec<String> = cases
+        .iter()
+        .map(|c| c.0)
+        .chain(computed)
+        .map(str::to_owned)
+        .collect();
+    want.sort();
+    want.dedup();
+    let mut got = documented_rule_codes();
+    got.sort();
+    assert_eq!(got, want);
+}
+
+/// Set every optional member of `obj` that is absent to `null`.
+fn null_absent(obj: &mut Value, keys: &[&str]) {
+    let o = obj.as_object_mut().expect("object");
+    for k in keys {
+        o.entry(*k).or_insert(Value::Null);
+    }
+}
+
+/// The answer without its timing.
+fn untimed(r: &common::Reply) -> Value {
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+    let mut v = r.json();
+    v["report"]
+        .as_object_mut()
+        .expect("report")
+        .remove("elapsed_ms");
+    v
+}
+
+/// `null` for an optional field is the same as leaving it out, at every depth: each `api/`
+/// example with every optional member it omits set to `null` gets the example's answer, and
+/// `null` for a whole optional object answers as its defaults.
+#[tokio::test]
+async fn null_means_absent() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/api/vibration_absorber");
+    for name in ["paper_case", "frequency_sweep", "two_harmonics"] {
+        let text = std::fs::read_to_string(format!("{dir}/{name}.json")).expect("example");
+        let example: Value = serde_json::from_str(&text).expect("JSON");
+        let plain = untimed(&post_json(PATH, &example).await);
+
+        let mut b = example.clone();
+        null_absent(&mut b, &["time_limit_ms", "actuator"]);
+        null_absent(
+            &mut b["beam"],
+            &[
+                "length_m",
+                "youngs_modulus_pa",
+                "density_kg_m3",
+                "area_m2",
+                "second_moment_m4",
+                "section",
+                "n_modes",
+                "modal_damping_ratio",
+            ],
+        );
+        null_absent(
+            &mut b["absorber"],
+            &[
+                "mass_kg",
+                "stiffness_n_m",
+                "passive_tuning_hz",
+                "passive_tuning_mode",
+                "damping_n_s_m",
+                "position_m",
+            ],
+        );
+        if b["actuator"].is_object() {
+            null_absent(
+                &mut b["actuator"],
+                &[
+                    "resistance_ohm",
+                    "inductance_h",
+                    "force_constant_n_a",
+                    "back_emf_v_s_m",
+                ],
+            );
+        }
+        null_absent(
+            &mut b["control"],
+            &["mode", "tuning_hz", "tuning_mode", "kp_v_m", "kd_v_s_m"],
+        );
+        null_absent(
+            &mut b["excitation"],
+            &[
+                "type",
+                "position_m",
+                "amplitude_n",
+                "frequency_hz",
+                "resonance_of_mode",
+                "phase_rad",
+                "harmonics",
+            ],
+        );
+        if let Some(list) = b["excitation"]["harmonics"].as_array_mut() {
+            for h in list {
+                null_absent(h, &["frequency_hz", "resonance_of_mode", "phase_rad"]);
+            }
+        }
+        null_absent(
+            &mut b["outputs"],
+            &[
+                "natural_frequencies",
+                "eigenvalues",
+                "ava_step",
+                "ava_step_series",
+                "ava_frequency_response",
+                "frequency_response",
+                "time_response",
+                "mode_shapes",
+            ],
+        );
+        if b["outputs"]["frequency_response"].is_object() {
+            null_absent(
+                &mut b["outputs"]["frequency_response"],
+                &["log", "points_m"],
+            );
+        }
+        if b["outputs"]["time_response"].is_object() {
+            null_absent(
+                &mut b["outputs"]["time_response"],
+                &["points_m", "return_series", "decimate"],
+            );
+        }
+        assert_ne!(b, example, "{name}: nothing was set to null");
+        assert_eq!(untimed(&post_json(PATH, &b).await), plain, "{name}");
+    }
+
+    // A whole optional object as null is its defaults, the same as leaving it out.
+    let mut nulls = json!({});
+    let mut empty = json!({});
+    for k in [
+        "beam",
+        "absorber",
+        "actuator",
+        "control",
+        "excitation",
+        "outputs",
+    ] {
+        nulls[k] = Value::Null;
+        empty[k] = json!({});
+    }
+    let defaults = untimed(&post_json(PATH, &json!({})).await);
+    assert_eq!(untimed(&post_json(PATH, &nulls).await), defaults);
+    assert_eq!(untimed(&post_json(PATH, &empty).await), defaults);
+}

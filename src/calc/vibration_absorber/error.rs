@@ -3,7 +3,7 @@
 
 use thiserror::Error;
 
-use crate::calc::{CalcFailure, ProblemClass};
+use crate::calc::{CalcFailure, CrossRule};
 
 /// Error of [`super::compute::compute`].
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -35,19 +35,41 @@ pub enum VibrationAbsorberError {
     },
 }
 
+/// The response stays finite in double precision.
+pub const NON_FINITE_RULE: CrossRule = CrossRule::infeasible(
+    "NON_FINITE_RESPONSE",
+    &[
+        "/beam",
+        "/absorber",
+        "/actuator",
+        "/control",
+        "/outputs/time_response/t_end_s",
+    ],
+    "The model's matrices, exponentials and responses stay finite in double precision (an \
+     unstable design over a long horizon or extreme unit scales overflow).",
+);
+/// The eigenvalue iteration converges.
+pub const EIGEN_NOT_CONVERGED_RULE: CrossRule = CrossRule::not_converged(
+    "EIGEN_NOT_CONVERGED",
+    &["/outputs/eigenvalues"],
+    "The QR iteration for the eigenvalues of the coupled state matrix converges.",
+);
+/// The work finishes within the request's time budget.
+pub const DEADLINE_RULE: CrossRule = CrossRule::too_large(
+    "DEADLINE_EXCEEDED",
+    &["/time_limit_ms"],
+    "The analyses finish within the request's time_limit_ms (capped by the service).",
+);
+
 impl From<VibrationAbsorberError> for CalcFailure {
     fn from(e: VibrationAbsorberError) -> Self {
         let detail = e.to_string();
         match e {
-            VibrationAbsorberError::NonFinite { .. } => {
-                CalcFailure::general(ProblemClass::Infeasible, "NON_FINITE_RESPONSE", detail)
-            }
+            VibrationAbsorberError::NonFinite { .. } => NON_FINITE_RULE.fail_general(detail),
             VibrationAbsorberError::EigenNotConverged { .. } => {
-                CalcFailure::general(ProblemClass::NotConverged, "EIGEN_NOT_CONVERGED", detail)
+                EIGEN_NOT_CONVERGED_RULE.fail_general(detail)
             }
-            VibrationAbsorberError::Deadline { .. } => {
-                CalcFailure::general(ProblemClass::TooLarge, "DEADLINE_EXCEEDED", detail)
-            }
+            VibrationAbsorberError::Deadline { .. } => DEADLINE_RULE.fail_general(detail),
         }
     }
 }

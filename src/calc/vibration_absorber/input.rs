@@ -1,26 +1,149 @@
-//! The validated request in SI units (spec §2): defaults filled in, every problem collected with
-//! its JSON pointer.
+//! The validated request in SI units (spec §2): defaults filled in and the rules between fields
+//! checked (the per-field rules are `#[rule]`s on the wire types, checked at the door).
 
 use std::time::Duration;
 
-use crate::calc::common::{TimeLimited, time_limit};
-use crate::calc::{CalcFailure, Validator};
+use crate::calc::common::{RESPONSE_TOO_LARGE_RULE, TimeLimited};
+use crate::calc::{CalcFailure, CrossRule, Validator};
 
+use super::error::{DEADLINE_RULE, EIGEN_NOT_CONVERGED_RULE, NON_FINITE_RULE};
 use super::wire::{
-    self, ControlMode, ExcitationIn, ExcitationType, FrequencyResponseIn, GridIn, HarmonicIn,
-    TimeResponseIn, VibrationAbsorberRequest,
+    self, ControlMode, ExcitationIn, ExcitationType, GridIn, HarmonicIn, TimeResponseIn,
+    VibrationAbsorberRequest,
 };
 
-/// Code of a `{mode: k}` reference beyond `beam.n_modes`.
-pub const MODE_OUT_OF_RANGE: &str = "MODE_OUT_OF_RANGE";
-/// Code of `K_c = 0` with `active`.
-pub const ZERO_FORCE_CONSTANT: &str = "ZERO_FORCE_CONSTANT";
-/// Code of a position outside (0, L].
-pub const POSITION_OUT_OF_BEAM: &str = "POSITION_OUT_OF_BEAM";
-/// Code of a time grid with more than 2e6 samples.
-pub const TOO_MANY_SAMPLES: &str = "TOO_MANY_SAMPLES";
-/// Code of `excitation.harmonics` given together with a single-harmonic member.
-pub const HARMONICS_CONFLICT: &str = "HARMONICS_CONFLICT";
+/// A `{mode: k}` reference names a mode the model keeps.
+pub const MODE_OUT_OF_RANGE: CrossRule = CrossRule::invalid(
+    "MODE_OUT_OF_RANGE",
+    &[
+        "/beam/n_modes",
+        "/absorber/passive_tuning_mode",
+        "/control/tuning_mode",
+        "/excitation/resonance_of_mode",
+        "/excitation/harmonics/*/resonance_of_mode",
+    ],
+    "Every mode reference (passive_tuning_mode, tuning_mode, resonance_of_mode) is at most \
+     beam.n_modes (default 3).",
+);
+/// `K_c ≠ 0` with `active`.
+pub const ZERO_FORCE_CONSTANT: CrossRule = CrossRule::invalid(
+    "ZERO_FORCE_CONSTANT",
+    &["/actuator/force_constant_n_a", "/control/mode"],
+    "With control.mode = active (the default), actuator.force_constant_n_a is not 0 (the gains \
+     divide by K_c).",
+);
+/// Positions and output abscissae lie on the beam.
+pub const POSITION_OUT_OF_BEAM: CrossRule = CrossRule::invalid(
+    "POSITION_OUT_OF_BEAM",
+    &[
+        "/beam/length_m",
+        "/absorber/position_m",
+        "/excitation/position_m",
+        "/outputs/frequency_response/points_m/*",
+        "/outputs/time_response/points_m/*",
+    ],
+    "absorber.position_m, excitation.position_m and every output abscissa points_m are at most \
+     beam.length_m (default 1 m).",
+);
+/// A time grid of at most 2e6 samples.
+pub const TOO_MANY_SAMPLES: CrossRule = CrossRule::too_large(
+    "TOO_MANY_SAMPLES",
+    &[
+        "/outputs/time_response/t_end_s",
+        "/outputs/time_response/dt_s",
+    ],
+    "outputs.time_response.t_end_s / dt_s is at most 2e6 samples.",
+);
+/// `excitation.harmonics` excludes the single-harmonic members.
+pub const HARMONICS_CONFLICT: CrossRule = CrossRule::invalid(
+    "HARMONICS_CONFLICT",
+    &[
+        "/excitation/harmonics",
+        "/excitation/amplitude_n",
+        "/excitation/frequency_hz",
+        "/excitation/resonance_of_mode",
+        "/excitation/phase_rad",
+    ],
+    "With excitation.harmonics, the single harmonic's amplitude_n, frequency_hz, \
+     resonance_of_mode and phase_rad are absent.",
+);
+/// `excitation.harmonics` only with `type = harmonic`.
+pub const HARMONICS_TYPE: CrossRule = CrossRule::invalid(
+    "HARMONICS_TYPE",
+    &["/excitation/harmonics", "/excitation/type"],
+    "excitation.harmonics is given only with excitation.type = harmonic (the default).",
+);
+/// The beam section is given one way.
+pub const SECTION_CONFLICT: CrossRule = CrossRule::invalid(
+    "SECTION_CONFLICT",
+    &["/beam/section", "/beam/area_m2", "/beam/second_moment_m4"],
+    "beam.section and beam.area_m2 / beam.second_moment_m4 are not given together.",
+);
+/// Area and second moment go together.
+pub const SECTION_PAIR: CrossRule = CrossRule::invalid(
+    "SECTION_PAIR",
+    &["/beam/area_m2", "/beam/second_moment_m4"],
+    "beam.area_m2 and beam.second_moment_m4 are given together or not at all.",
+);
+/// One source of the absorber stiffness.
+pub const STIFFNESS_CONFLICT: CrossRule = CrossRule::invalid(
+    "STIFFNESS_CONFLICT",
+    &[
+        "/absorber/stiffness_n_m",
+        "/absorber/passive_tuning_hz",
+        "/absorber/passive_tuning_mode",
+    ],
+    "At most one of absorber.stiffness_n_m, passive_tuning_hz and passive_tuning_mode is given.",
+);
+/// One tuning target of the PD law.
+pub const TUNING_CONFLICT: CrossRule = CrossRule::invalid(
+    "TUNING_CONFLICT",
+    &["/control/tuning_hz", "/control/tuning_mode"],
+    "At most one of control.tuning_hz and control.tuning_mode is given.",
+);
+/// Explicit gains come in pairs.
+pub const GAIN_PAIR: CrossRule = CrossRule::invalid(
+    "GAIN_PAIR",
+    &["/control/kp_v_m", "/control/kd_v_s_m"],
+    "control.kp_v_m and control.kd_v_s_m are given together or not at all.",
+);
+/// One excitation frequency.
+pub const FREQUENCY_CONFLICT: CrossRule = CrossRule::invalid(
+    "FREQUENCY_CONFLICT",
+    &["/excitation/frequency_hz", "/excitation/resonance_of_mode"],
+    "At most one of excitation.frequency_hz and excitation.resonance_of_mode is given.",
+);
+/// A frequency grid runs upwards.
+pub const GRID_ORDER: CrossRule = CrossRule::invalid(
+    "GRID_ORDER",
+    &[
+        "/outputs/ava_frequency_response/f_max_hz",
+        "/outputs/frequency_response/f_max_hz",
+    ],
+    "A frequency grid's f_max_hz is greater than its f_min_hz (equal only with n_points = 1).",
+);
+
+/// The rules between fields of `POST /v1/vibration-absorber` and the failures of its
+/// computation, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    SECTION_CONFLICT,
+    SECTION_PAIR,
+    STIFFNESS_CONFLICT,
+    MODE_OUT_OF_RANGE,
+    POSITION_OUT_OF_BEAM,
+    ZERO_FORCE_CONSTANT,
+    TUNING_CONFLICT,
+    GAIN_PAIR,
+    FREQUENCY_CONFLICT,
+    HARMONICS_CONFLICT,
+    HARMONICS_TYPE,
+    GRID_ORDER,
+    TOO_MANY_SAMPLES,
+    RESPONSE_TOO_LARGE_RULE,
+    NON_FINITE_RULE,
+    EIGEN_NOT_CONVERGED_RULE,
+    DEADLINE_RULE,
+];
 
 /// Configuration (which states the model has).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -234,104 +357,63 @@ impl TimeLimited for VibrationAbsorberRequest {
     }
 }
 
-/// A mode reference `k` checked against `1…n_modes` (the `MODE_INDEX` bound and the cross-field
-/// rule `k ≤ beam.n_modes`).
+/// A mode reference `k` (already in `MODE_INDEX` at the door) against `beam.n_modes`.
 fn mode_ref(v: &mut Validator, pointer: &str, name: &str, k: u32, n_modes: usize) -> usize {
-    if v.uint(pointer, name, u64::from(k), wire::MODE_INDEX) {
-        v.ensure_code(k as usize <= n_modes, MODE_OUT_OF_RANGE, pointer, || {
-            format!("{name} must be ≤ beam.n_modes = {n_modes}, got {k}")
-        });
-    }
+    v.ensure_rule(k as usize <= n_modes, &MODE_OUT_OF_RANGE, pointer, || {
+        format!("{name} must be ≤ beam.n_modes = {n_modes}, got {k}")
+    });
     (k as usize).clamp(1, n_modes.max(1))
 }
 
-/// One optional number with a default, checked against its range.
-fn opt(
+/// A frequency given as `hz` or as mode `k`, at most one (`default` when neither).
+fn freq_or_mode(
     v: &mut Validator,
-    pointer: &str,
-    x: Option<f64>,
-    default: f64,
-    r: crate::calc::Range,
-) -> f64 {
-    let name = pointer.rsplit('/').next().unwrap_or("");
-    match x {
-        Some(x) => {
-            v.range(pointer, name, x, r);
-            x
-        }
-        None => default,
+    hz: Option<f64>,
+    (mode, mode_pointer, mode_name): (Option<u32>, &str, &str),
+    n_modes: usize,
+    default: FreqRef,
+) -> FreqRef {
+    match (hz, mode) {
+        (Some(f), _) => FreqRef::Hz(f),
+        (None, Some(k)) => FreqRef::Mode(mode_ref(v, mode_pointer, mode_name, k, n_modes)),
+        (None, None) => default,
     }
 }
 
-/// A position in (0, L].
+/// A position in (0, L] (the lower end and `LENGTH` are checked at the door).
 fn position(v: &mut Validator, pointer: &str, x: Option<f64>, length: f64) -> f64 {
-    let p = opt(v, pointer, x, length, wire::LENGTH);
-    if wire::LENGTH.contains(p) && length.is_finite() {
-        v.ensure_code(p <= length, POSITION_OUT_OF_BEAM, pointer, || {
-            format!("must be ≤ beam.length_m = {length}, got {p}")
-        });
-    }
+    let p = x.unwrap_or(length);
+    v.ensure_rule(p <= length, &POSITION_OUT_OF_BEAM, pointer, || {
+        format!("must be ≤ beam.length_m = {length} m, got {p}")
+    });
     p
 }
 
-/// Output abscissae in [0, L] (default: the tip).
+/// Output abscissae in [0, L] (default: the tip; count and `ABSCISSA` checked at the door).
 fn abscissae(v: &mut Validator, pointer: &str, xs: Option<&Vec<f64>>, length: f64) -> Vec<f64> {
     let Some(xs) = xs else {
         return vec![length];
     };
-    v.ensure(
-        !xs.is_empty() && xs.len() <= wire::MAX_POINTS,
-        pointer,
-        || {
-            format!(
-                "must list 1…{} abscissae, got {}",
-                wire::MAX_POINTS,
-                xs.len()
-            )
-        },
-    );
-    if v.all_in(pointer, "points_m", xs, wire::ABSCISSA) {
-        for (i, x) in xs.iter().enumerate() {
-            v.ensure_code(
-                *x <= length,
-                POSITION_OUT_OF_BEAM,
-                format!("{pointer}/{i}"),
-                || format!("points_m[{i}] must be ≤ beam.length_m = {length}, got {x}"),
-            );
-        }
+    for (i, x) in xs.iter().enumerate() {
+        v.ensure_rule(
+            *x <= length,
+            &POSITION_OUT_OF_BEAM,
+            format!("{pointer}/{i}"),
+            || format!("points_m[{i}] [m] must be ≤ beam.length_m = {length} m, got {x}"),
+        );
     }
     xs.clone()
 }
 
-/// A frequency grid: `f_min ≤ f_max` (strictly below unless one point).
+/// A frequency grid: `f_min < f_max` (equal only with one point).
 fn grid(v: &mut Validator, base: &str, g: &GridIn) -> Grid {
-    v.range(
-        &format!("{base}/f_min_hz"),
-        "f_min_hz",
-        g.f_min_hz,
-        wire::FREQUENCY,
-    );
-    let ok_max = v.range(
-        &format!("{base}/f_max_hz"),
-        "f_max_hz",
-        g.f_max_hz,
-        wire::FREQUENCY,
-    );
-    v.uint(
-        &format!("{base}/n_points"),
-        "n_points",
-        u64::from(g.n_points),
-        wire::FREQ_POINTS,
-    );
-    if ok_max && g.f_min_hz.is_finite() {
-        let ok = g.f_max_hz > g.f_min_hz || (g.n_points == 1 && g.f_max_hz >= g.f_min_hz);
-        v.ensure(ok, format!("{base}/f_max_hz"), || {
-            format!(
-                "f_max_hz must be > f_min_hz = {}, got {}",
-                g.f_min_hz, g.f_max_hz
-            )
-        });
-    }
+    let ok = g.f_max_hz > g.f_min_hz || (g.n_points == 1 && g.f_max_hz >= g.f_min_hz);
+    v.ensure_rule(ok, &GRID_ORDER, format!("{base}/f_max_hz"), || {
+        format!(
+            "f_max_hz [Hz] must be > f_min_hz = {} Hz, got {}",
+            g.f_min_hz, g.f_max_hz
+        )
+    });
     Grid {
         f_min: g.f_min_hz,
         f_max: g.f_max_hz,
@@ -340,51 +422,23 @@ fn grid(v: &mut Validator, base: &str, g: &GridIn) -> Grid {
     }
 }
 
-fn frf(v: &mut Validator, f: &FrequencyResponseIn, length: f64) -> (Grid, Vec<f64>) {
-    let base = "/outputs/frequency_response";
-    let g = grid(
-        v,
-        base,
-        &GridIn {
-            f_min_hz: f.f_min_hz,
-            f_max_hz: f.f_max_hz,
-            n_points: f.n_points,
-            log: f.log,
-        },
-    );
-    (
-        g,
-        abscissae(v, &format!("{base}/points_m"), f.points_m.as_ref(), length),
-    )
-}
-
 fn time(v: &mut Validator, t: &TimeResponseIn, length: f64) -> TimeRequest {
     let base = "/outputs/time_response";
-    let ok_t = v.range(
-        &format!("{base}/t_end_s"),
-        "t_end_s",
-        t.t_end_s,
-        wire::T_END,
-    );
-    let ok_dt = v.range(&format!("{base}/dt_s"), "dt_s", t.dt_s, wire::DT);
     let ratio = t.t_end_s / t.dt_s;
-    if ok_t && ok_dt {
-        v.ensure_code(ratio <= wire::MAX_SAMPLES, TOO_MANY_SAMPLES, format!("{base}/dt_s"), || {
+    v.ensure_rule(
+        ratio <= wire::MAX_SAMPLES,
+        &TOO_MANY_SAMPLES,
+        format!("{base}/dt_s"),
+        || {
             format!(
-                "t_end_s / dt_s must be ≤ {:e} samples, got {ratio:.6e} (t_end_s = {}, dt_s = {})",
+                "t_end_s / dt_s must be ≤ {:e} samples, got {ratio:.6e} (t_end_s = {} s, dt_s = {} s)",
                 wire::MAX_SAMPLES,
                 t.t_end_s,
                 t.dt_s
             )
-        });
-    }
-    let decimate = t.decimate.unwrap_or(1);
-    v.uint(
-        &format!("{base}/decimate"),
-        "decimate",
-        u64::from(decimate),
-        wire::DECIMATE,
+        },
     );
+    let decimate = t.decimate.unwrap_or(1);
     // Steps: t_end/dt rounded (a ratio within 1e-9 of an integer is that integer).
     let steps = if ratio.is_finite() && ratio > 0.0 {
         (ratio - 1e-9 * ratio).ceil().max(1.0) as usize
@@ -400,87 +454,32 @@ fn time(v: &mut Validator, t: &TimeResponseIn, length: f64) -> TimeRequest {
     }
 }
 
-/// A frequency given as `frequency_hz` or `resonance_of_mode` (at most one; `default` when
-/// neither is given, `None` = required).
-fn freq_ref(
-    v: &mut Validator,
-    base: &str,
-    (hz, mode): (Option<f64>, Option<u32>),
-    n_modes: usize,
-    default: Option<FreqRef>,
-) -> FreqRef {
-    let both = hz.is_some() && mode.is_some();
-    v.ensure(!both, format!("{base}/resonance_of_mode"), || {
-        "give at most one of frequency_hz and resonance_of_mode".to_owned()
-    });
-    match (hz, mode, default) {
-        (Some(f), _, _) => FreqRef::Hz(opt(
-            v,
-            &format!("{base}/frequency_hz"),
-            Some(f),
-            1.0,
-            wire::FREQUENCY,
-        )),
-        (None, Some(k), _) => FreqRef::Mode(mode_ref(
-            v,
-            &format!("{base}/resonance_of_mode"),
-            "resonance_of_mode",
-            k,
-            n_modes,
-        )),
-        (None, None, Some(d)) => d,
-        (None, None, None) => {
-            v.push(
-                format!("{base}/frequency_hz"),
-                "give frequency_hz or resonance_of_mode",
-            );
-            FreqRef::Hz(1.0)
-        }
-    }
-}
-
-/// The components of `excitation.harmonics` (spec §3.D.4 "several harmonics").
+/// The components of `excitation.harmonics` (spec §3.D.4 "several harmonics"; count, ranges and
+/// "exactly one of `frequency_hz`, `resonance_of_mode`" are checked at the door).
 fn harmonics(v: &mut Validator, list: &[HarmonicIn], n_modes: usize) -> Vec<Harmonic> {
-    let base = "/excitation/harmonics";
-    v.ensure(
-        !list.is_empty() && list.len() <= wire::MAX_HARMONICS,
-        base,
-        || {
-            format!(
-                "must list 1…{} components, got {}",
-                wire::MAX_HARMONICS,
-                list.len()
-            )
-        },
-    );
     list.iter()
         .enumerate()
-        .map(|(j, h)| {
-            let at = format!("{base}/{j}");
-            v.range(
-                &format!("{at}/amplitude_n"),
-                "amplitude_n",
-                h.amplitude_n,
-                wire::AMPLITUDE,
-            );
-            Harmonic {
-                amplitude: h.amplitude_n,
-                freq: freq_ref(v, &at, (h.frequency_hz, h.resonance_of_mode), n_modes, None),
-                phase: opt(v, &format!("{at}/phase_rad"), h.phase_rad, 0.0, wire::PHASE),
-            }
+        .map(|(j, h)| Harmonic {
+            amplitude: h.amplitude_n,
+            freq: freq_or_mode(
+                v,
+                h.frequency_hz,
+                (
+                    h.resonance_of_mode,
+                    &format!("/excitation/harmonics/{j}/resonance_of_mode"),
+                    "resonance_of_mode",
+                ),
+                n_modes,
+                FreqRef::Hz(1.0),
+            ),
+            phase: h.phase_rad.unwrap_or(0.0),
         })
         .collect()
 }
 
 /// The force law and its amplitude `P0` (impulse, step, single harmonic).
 fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, f64) {
-    let amplitude = opt(
-        v,
-        "/excitation/amplitude_n",
-        e.amplitude_n,
-        1.0,
-        wire::AMPLITUDE,
-    );
+    let amplitude = e.amplitude_n.unwrap_or(1.0);
     if let Some(list) = &e.harmonics {
         let single = [
             ("amplitude_n", e.amplitude_n.is_some()),
@@ -489,9 +488,9 @@ fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, 
             ("phase_rad", e.phase_rad.is_some()),
         ];
         for (name, given) in single {
-            v.ensure_code(
+            v.ensure_rule(
                 !given,
-                HARMONICS_CONFLICT,
+                &HARMONICS_CONFLICT,
                 format!("/excitation/{name}"),
                 || {
                     format!(
@@ -500,8 +499,9 @@ fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, 
                 },
             );
         }
-        v.ensure(
+        v.ensure_rule(
             e.kind == ExcitationType::Harmonic,
+            &HARMONICS_TYPE,
             "/excitation/harmonics",
             || "harmonics needs excitation.type = harmonic".to_owned(),
         );
@@ -514,14 +514,24 @@ fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, 
             amplitude,
         );
     }
-    let freq = freq_ref(
-        v,
-        "/excitation",
-        (e.frequency_hz, e.resonance_of_mode),
-        n_modes,
-        Some(FreqRef::Mode(2.min(n_modes))),
+    v.ensure_rule(
+        e.frequency_hz.is_none() || e.resonance_of_mode.is_none(),
+        &FREQUENCY_CONFLICT,
+        "/excitation/resonance_of_mode",
+        || "give at most one of frequency_hz and resonance_of_mode".to_owned(),
     );
-    let phase = opt(v, "/excitation/phase_rad", e.phase_rad, 0.0, wire::PHASE);
+    let freq = freq_or_mode(
+        v,
+        e.frequency_hz,
+        (
+            e.resonance_of_mode,
+            "/excitation/resonance_of_mode",
+            "resonance_of_mode",
+        ),
+        n_modes,
+        FreqRef::Mode(2.min(n_modes)),
+    );
+    let phase = e.phase_rad.unwrap_or(0.0);
     let forcing = match e.kind {
         ExcitationType::Harmonic => Forcing::Harmonic {
             components: vec![Harmonic {
@@ -541,6 +551,8 @@ fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, 
 impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
     type Error = CalcFailure;
 
+    /// The rules between fields (the per-field rules passed at the door, `rules::check`), with
+    /// the defaults of spec §2 filled in.
     #[expect(
         clippy::too_many_lines,
         reason = "one flat pass over the request's fields in wire order: splitting it would only \
@@ -548,50 +560,20 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
     )]
     fn try_from(req: VibrationAbsorberRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        time_limit(&mut v, req.time_limit_ms);
         let b = &req.beam;
-        let length = opt(&mut v, "/beam/length_m", b.length_m, 1.0, wire::LENGTH);
-        let youngs = opt(
-            &mut v,
-            "/beam/youngs_modulus_pa",
-            b.youngs_modulus_pa,
-            210e9,
-            wire::MODULUS,
-        );
-        let density = opt(
-            &mut v,
-            "/beam/density_kg_m3",
-            b.density_kg_m3,
-            7850.0,
-            wire::DENSITY,
-        );
+        let length = b.length_m.unwrap_or(1.0);
+        let youngs = b.youngs_modulus_pa.unwrap_or(210e9);
+        let density = b.density_kg_m3.unwrap_or(7850.0);
         let (area, inertia) = match (&b.section, b.area_m2, b.second_moment_m4) {
-            (Some(s), None, None) => {
-                v.range("/beam/section/width_m", "width_m", s.width_m, wire::SECTION);
-                v.range(
-                    "/beam/section/thickness_m",
-                    "thickness_m",
-                    s.thickness_m,
-                    wire::SECTION,
-                );
-                (
-                    s.width_m * s.thickness_m,
-                    s.width_m * s.thickness_m.powi(3) / 12.0,
-                )
-            }
-            (None, Some(a), Some(i)) => {
-                v.range("/beam/area_m2", "area_m2", a, wire::SECTION);
-                v.range(
-                    "/beam/second_moment_m4",
-                    "second_moment_m4",
-                    i,
-                    wire::SECTION,
-                );
-                (a, i)
-            }
+            (Some(s), None, None) => (
+                s.width_m * s.thickness_m,
+                s.width_m * s.thickness_m.powi(3) / 12.0,
+            ),
+            (None, Some(a), Some(i)) => (a, i),
             (None, None, None) => (0.05 * 0.005, 0.05 * 0.005_f64.powi(3) / 12.0),
             (Some(_), _, _) => {
-                v.push(
+                v.rule(
+                    &SECTION_CONFLICT,
                     "/beam/section",
                     "give either section or area_m2 + second_moment_m4, not both",
                 );
@@ -603,106 +585,54 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
                 } else {
                     "/beam/area_m2"
                 };
-                v.push(missing, "area_m2 and second_moment_m4 go together");
+                v.rule(
+                    &SECTION_PAIR,
+                    missing,
+                    "area_m2 and second_moment_m4 go together",
+                );
                 (1.0, 1.0)
             }
         };
-        let n_modes = b.n_modes.unwrap_or(3);
-        v.uint(
-            "/beam/n_modes",
-            "n_modes",
-            u64::from(n_modes),
-            wire::N_MODES,
-        );
-        let n_modes = (n_modes as usize).clamp(1, 50);
-        let zeta = opt(
-            &mut v,
-            "/beam/modal_damping_ratio",
-            b.modal_damping_ratio,
-            0.0,
-            wire::DAMPING_RATIO,
-        );
+        let n_modes = (b.n_modes.unwrap_or(3) as usize).clamp(1, 50);
+        let zeta = b.modal_damping_ratio.unwrap_or(0.0);
 
         let a = &req.absorber;
-        let mass = opt(&mut v, "/absorber/mass_kg", a.mass_kg, 0.05, wire::MASS);
+        let mass = a.mass_kg.unwrap_or(0.05);
         let given = [
             a.stiffness_n_m.is_some(),
             a.passive_tuning_hz.is_some(),
             a.passive_tuning_mode.is_some(),
         ];
-        v.ensure(
+        v.ensure_rule(
             given.iter().filter(|g| **g).count() <= 1,
+            &STIFFNESS_CONFLICT,
             "/absorber/stiffness_n_m",
             || {
                 "give at most one of stiffness_n_m, passive_tuning_hz, passive_tuning_mode"
                     .to_owned()
             },
         );
-        let stiffness = a.stiffness_n_m.map(|k| {
-            opt(
-                &mut v,
-                "/absorber/stiffness_n_m",
-                Some(k),
-                0.0,
-                wire::STIFFNESS,
-            )
-        });
-        let passive_tuning = match (a.passive_tuning_hz, a.passive_tuning_mode) {
-            (Some(f), _) => FreqRef::Hz(opt(
-                &mut v,
-                "/absorber/passive_tuning_hz",
-                Some(f),
-                1.0,
-                wire::FREQUENCY,
-            )),
-            (None, Some(k)) => FreqRef::Mode(mode_ref(
-                &mut v,
+        let stiffness = a.stiffness_n_m;
+        let passive_tuning = freq_or_mode(
+            &mut v,
+            a.passive_tuning_hz,
+            (
+                a.passive_tuning_mode,
                 "/absorber/passive_tuning_mode",
                 "passive_tuning_mode",
-                k,
-                n_modes,
-            )),
-            (None, None) => FreqRef::Mode(1),
-        };
-        let damping = opt(
-            &mut v,
-            "/absorber/damping_n_s_m",
-            a.damping_n_s_m,
-            0.01,
-            wire::DAMPING,
+            ),
+            n_modes,
+            FreqRef::Mode(1),
         );
+        let damping = a.damping_n_s_m.unwrap_or(0.01);
         let xa = position(&mut v, "/absorber/position_m", a.position_m, length);
 
         let act = &req.actuator;
         let actuator = Actuator {
-            r: opt(
-                &mut v,
-                "/actuator/resistance_ohm",
-                act.resistance_ohm,
-                1.6,
-                wire::RESISTANCE,
-            ),
-            lc: opt(
-                &mut v,
-                "/actuator/inductance_h",
-                act.inductance_h,
-                0.75e-3,
-                wire::INDUCTANCE,
-            ),
-            kc: opt(
-                &mut v,
-                "/actuator/force_constant_n_a",
-                act.force_constant_n_a,
-                3.5,
-                wire::FORCE_CONSTANT,
-            ),
-            kb: opt(
-                &mut v,
-                "/actuator/back_emf_v_s_m",
-                act.back_emf_v_s_m,
-                3.5,
-                wire::BACK_EMF,
-            ),
+            r: act.resistance_ohm.unwrap_or(1.6),
+            lc: act.inductance_h.unwrap_or(0.75e-3),
+            kc: act.force_constant_n_a.unwrap_or(3.5),
+            kb: act.back_emf_v_s_m.unwrap_or(3.5),
         };
 
         let c = &req.control;
@@ -713,40 +643,38 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
             ControlMode::Active => Config::Active,
         };
         if config == Config::Active {
-            v.ensure_code(actuator.kc != 0.0, ZERO_FORCE_CONSTANT, "/actuator/force_constant_n_a", || {
-                "force_constant_n_a must be ≠ 0 with control.mode = active (the gains divide by K_c)".to_owned()
-            });
+            v.ensure_rule(
+                actuator.kc != 0.0,
+                &ZERO_FORCE_CONSTANT,
+                "/actuator/force_constant_n_a",
+                || {
+                    "force_constant_n_a [N/A] must be ≠ 0 with control.mode = active (the gains \
+                     divide by K_c)"
+                        .to_owned()
+                },
+            );
         }
-        v.ensure(
+        v.ensure_rule(
             c.tuning_hz.is_none() || c.tuning_mode.is_none(),
+            &TUNING_CONFLICT,
             "/control/tuning_mode",
             || "give at most one of tuning_hz and tuning_mode".to_owned(),
         );
-        v.ensure(
+        v.ensure_rule(
             c.kp_v_m.is_some() == c.kd_v_s_m.is_some(),
+            &GAIN_PAIR,
             "/control/kd_v_s_m",
             || "kp_v_m and kd_v_s_m go together".to_owned(),
         );
-        let gains = match (c.kp_v_m, c.kd_v_s_m, c.tuning_hz, c.tuning_mode) {
-            (Some(kp), Some(kd), _, _) => GainSource::Explicit {
-                kp: opt(&mut v, "/control/kp_v_m", Some(kp), 0.0, wire::GAIN),
-                kd: opt(&mut v, "/control/kd_v_s_m", Some(kd), 0.0, wire::GAIN),
-            },
-            (_, _, Some(f), _) => GainSource::Tuning(FreqRef::Hz(opt(
+        let gains = match (c.kp_v_m, c.kd_v_s_m) {
+            (Some(kp), Some(kd)) => GainSource::Explicit { kp, kd },
+            _ => GainSource::Tuning(freq_or_mode(
                 &mut v,
-                "/control/tuning_hz",
-                Some(f),
-                1.0,
-                wire::FREQUENCY,
-            ))),
-            (_, _, None, Some(k)) => GainSource::Tuning(FreqRef::Mode(mode_ref(
-                &mut v,
-                "/control/tuning_mode",
-                "tuning_mode",
-                k,
+                c.tuning_hz,
+                (c.tuning_mode, "/control/tuning_mode", "tuning_mode"),
                 n_modes,
-            ))),
-            _ => GainSource::Tuning(FreqRef::Mode(2.min(n_modes))),
+                FreqRef::Mode(2.min(n_modes)),
+            )),
         };
 
         let e = &req.excitation;
@@ -763,20 +691,30 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
                 .ava_frequency_response
                 .as_ref()
                 .map(|g| grid(&mut v, "/outputs/ava_frequency_response", g)),
-            frf: o
-                .frequency_response
-                .as_ref()
-                .map(|f| frf(&mut v, f, length)),
-            time: o.time_response.as_ref().map(|t| time(&mut v, t, length)),
-            mode_shapes: o.mode_shapes.map(|m| {
-                v.uint(
-                    "/outputs/mode_shapes/n_points",
-                    "n_points",
-                    u64::from(m.n_points),
-                    wire::SHAPE_POINTS,
+            frf: o.frequency_response.as_ref().map(|f| {
+                let base = "/outputs/frequency_response";
+                let g = grid(
+                    &mut v,
+                    base,
+                    &GridIn {
+                        f_min_hz: f.f_min_hz,
+                        f_max_hz: f.f_max_hz,
+                        n_points: f.n_points,
+                        log: f.log,
+                    },
                 );
-                m.n_points.max(2) as usize
+                (
+                    g,
+                    abscissae(
+                        &mut v,
+                        &format!("{base}/points_m"),
+                        f.points_m.as_ref(),
+                        length,
+                    ),
+                )
             }),
+            time: o.time_response.as_ref().map(|t| time(&mut v, t, length)),
+            mode_shapes: o.mode_shapes.map(|m| m.n_points.max(2) as usize),
         };
         v.finish()?;
         Ok(Self {

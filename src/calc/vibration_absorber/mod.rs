@@ -95,17 +95,31 @@ pub use error::VibrationAbsorberError;
 pub use input::VibrationAbsorberInput;
 pub use wire::{VibrationAbsorberRequest, VibrationAbsorberResponse};
 
-/// Entry point of `POST /v1/vibration-absorber`: validate, compute, respond.
+/// Compute and build the wire response of `POST /v1/vibration-absorber` for a request that
+/// passed the door (per-field rules, then the rules between fields in
+/// [`VibrationAbsorberInput::try_from`]).
 ///
 /// # Errors
-/// A [`CalcFailure`] (HTTP 422) for invalid input, a non-finite result, a failed eigen-iteration
-/// or an exhausted budget.
+/// `RESPONSE_TOO_LARGE` before computing when the answer would exceed the budget's limit; a
+/// non-finite result, a failed eigen-iteration or an exhausted budget.
+pub fn run_valid(
+    input: &VibrationAbsorberInput,
+    budget: &Budget,
+) -> Result<VibrationAbsorberResponse, CalcFailure> {
+    output::response_size(input).check(budget)?;
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, &out, budget))
+}
+
+/// The whole path of a request without HTTP (tests, benchmarks): the per-field rules, the rules
+/// between fields, then [`run_valid`].
+///
+/// # Errors
+/// As the endpoint: every offending field with its JSON pointer, or the calculation's failure.
 pub fn run(
     req: VibrationAbsorberRequest,
     budget: &Budget,
 ) -> Result<VibrationAbsorberResponse, CalcFailure> {
-    let input = VibrationAbsorberInput::try_from(req)?;
-    output::response_size(&input).check(budget)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, &out, budget))
+    crate::calc::rules::check(&req)?;
+    run_valid(&VibrationAbsorberInput::try_from(req)?, budget)
 }

@@ -92,6 +92,7 @@ pub struct VibrationAbsorberRequest {
     /// Wall-clock budget of this request \[ms\] (capped by the service).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 10000)]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     pub time_limit_ms: Option<u64>,
 }
 
@@ -104,22 +105,27 @@ pub struct BeamIn {
     /// Length `L` \[m\], default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
+    #[rule(range = LENGTH)]
     pub length_m: Option<f64>,
     /// Young's modulus `E` \[Pa\], default 2.1e11.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 2.1e11)]
+    #[rule(range = MODULUS)]
     pub youngs_modulus_pa: Option<f64>,
     /// Density `ρ` [kg/m³], default 7850.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 7850.0)]
+    #[rule(range = DENSITY)]
     pub density_kg_m3: Option<f64>,
     /// Cross-section area `A` \[m²\] (with `second_moment_m4`; exclusive with `section`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = SECTION)]
     pub area_m2: Option<f64>,
     /// Second moment of area `I` \[m⁴\] (with `area_m2`; exclusive with `section`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = SECTION)]
     pub second_moment_m4: Option<f64>,
     /// Rectangular section: `A = b·e`, `I = b·e³/12` (exclusive with `area_m2`/`second_moment_m4`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -129,10 +135,12 @@ pub struct BeamIn {
     /// other error (spec §8): 0.14 % static compliance at n = 3, 0.004 % at n = 10.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 3)]
+    #[rule(range = N_MODES)]
     pub n_modes: Option<u32>,
     /// Modal damping ratio `ζ` (all modes), 0 ≤ ζ < 1, default 0 (the paper has none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.0)]
+    #[rule(range = DAMPING_RATIO)]
     pub modal_damping_ratio: Option<f64>,
 }
 
@@ -143,9 +151,11 @@ pub struct BeamIn {
 pub struct SectionIn {
     /// Width `b` \[m\].
     #[schema(example = 0.05)]
+    #[rule(range = SECTION)]
     pub width_m: f64,
     /// Thickness `e` \[m\] (bending direction).
     #[schema(example = 0.005)]
+    #[rule(range = SECTION)]
     pub thickness_m: f64,
 }
 
@@ -157,27 +167,33 @@ pub struct AbsorberIn {
     /// Mass `m_a` \[kg\], default 0.05.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.05)]
+    #[rule(range = MASS)]
     pub mass_kg: Option<f64>,
     /// Spring stiffness `k_a` [N/m]; when omitted, `k_a = m_a (2π f)²` from the passive tuning.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = STIFFNESS)]
     pub stiffness_n_m: Option<f64>,
     /// Passive tuning frequency `f` \[Hz\] setting `k_a` (exclusive with `stiffness_n_m` and
     /// `passive_tuning_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 4.14)]
+    #[rule(range = FREQUENCY)]
     pub passive_tuning_hz: Option<f64>,
     /// Passive tuning to the bare-beam mode `k` (≤ `beam.n_modes`); the default is mode 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = MODE_INDEX)]
     pub passive_tuning_mode: Option<u32>,
     /// Viscous damping `b_a` [N·s/m], default 0.01 (spec §4 item 3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.01)]
+    #[rule(range = DAMPING)]
     pub damping_n_s_m: Option<f64>,
     /// Attachment abscissa `x_a` from the clamp \[m\], 0 < x_a ≤ `beam.length_m`, default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
+    #[rule(range = LENGTH)]
     pub position_m: Option<f64>,
 }
 
@@ -189,18 +205,22 @@ pub struct ActuatorIn {
     /// Coil resistance `R` \[Ω\], default 1.6.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.6)]
+    #[rule(range = RESISTANCE)]
     pub resistance_ohm: Option<f64>,
     /// Coil inductance `L_c` \[H\], default 0.75e-3.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.00075)]
+    #[rule(range = INDUCTANCE)]
     pub inductance_h: Option<f64>,
     /// Force constant `K_c` [N/A], default 3.5; must not be 0 with `control.mode = active`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 3.5)]
+    #[rule(range = FORCE_CONSTANT)]
     pub force_constant_n_a: Option<f64>,
     /// Back-EMF constant `K_b` [V·s/m], default 3.5.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 3.5)]
+    #[rule(range = BACK_EMF)]
     pub back_emf_v_s_m: Option<f64>,
 }
 
@@ -235,18 +255,22 @@ pub struct ControlIn {
     /// Target frequency `f_c` \[Hz\] of the tuning (exclusive with `tuning_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 26.26)]
+    #[rule(range = FREQUENCY)]
     pub tuning_hz: Option<f64>,
     /// Tune to the bare-beam mode `k` (≤ `beam.n_modes`); the default is mode 2.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = MODE_INDEX)]
     pub tuning_mode: Option<u32>,
     /// Explicit proportional gain `K_p` [V/m] (with `kd_v_s_m`; overrides the tuning).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = GAIN)]
     pub kp_v_m: Option<f64>,
     /// Explicit derivative gain `K_d` [V·s/m] (with `kp_v_m`; overrides the tuning).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = GAIN)]
     pub kd_v_s_m: Option<f64>,
 }
 
@@ -286,28 +310,34 @@ pub struct ExcitationIn {
     /// Force abscissa `x_p` \[m\], 0 < x_p ≤ `beam.length_m`, default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
+    #[rule(range = LENGTH)]
     pub position_m: Option<f64>,
     /// Amplitude `P0` \[N\] (impulse: [N·s]), default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 1.0)]
+    #[rule(range = AMPLITUDE)]
     pub amplitude_n: Option<f64>,
     /// Excitation frequency `Ω/2π` \[Hz\] (exclusive with `resonance_of_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = FREQUENCY)]
     pub frequency_hz: Option<f64>,
     /// Excite at the bare-beam resonance of mode `k` (≤ `beam.n_modes`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 2)]
+    #[rule(range = MODE_INDEX)]
     pub resonance_of_mode: Option<u32>,
     /// Phase `φ0` \[rad\], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = 0.0)]
+    #[rule(range = PHASE)]
     pub phase_rad: Option<f64>,
     /// Several harmonic components at `position_m`, 1…16, each simulated exactly with its own 2×2
     /// exosystem block (type `harmonic` only; exclusive with the single-harmonic members
     /// `amplitude_n`, `frequency_hz`, `resonance_of_mode`, `phase_rad`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(min_items = 1, max_items = MAX_HARMONICS)]
     pub harmonics: Option<Vec<HarmonicIn>>,
 }
 
@@ -316,21 +346,26 @@ pub struct ExcitationIn {
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::HarmonicIn)]
 #[serde(deny_unknown_fields)]
+#[rules(one_of("frequency_hz", "resonance_of_mode"))]
 pub struct HarmonicIn {
     /// Amplitude `P_j` \[N\].
     #[schema(example = 1.0)]
+    #[rule(range = AMPLITUDE)]
     pub amplitude_n: f64,
     /// Frequency `Ω_j/2π` \[Hz\] (exclusive with `resonance_of_mode`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = FREQUENCY)]
     pub frequency_hz: Option<f64>,
     /// At the bare-beam resonance of mode `k` (≤ `beam.n_modes`; exclusive with `frequency_hz`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = MODE_INDEX)]
     pub resonance_of_mode: Option<u32>,
     /// Phase `φ_j` \[rad\], default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = PHASE)]
     pub phase_rad: Option<f64>,
 }
 
@@ -376,6 +411,7 @@ pub struct OutputsIn {
 pub struct ModeShapesIn {
     /// Equally spaced abscissae from the clamp to the tip, 2…10001.
     #[schema(example = 101)]
+    #[rule(range = SHAPE_POINTS)]
     pub n_points: u32,
 }
 
@@ -396,12 +432,15 @@ pub struct ModeShapesOut {
 pub struct GridIn {
     /// Lowest frequency \[Hz\].
     #[schema(example = 0.5)]
+    #[rule(range = FREQUENCY)]
     pub f_min_hz: f64,
     /// Highest frequency \[Hz\], > `f_min_hz` (equal only with `n_points` = 1).
     #[schema(example = 100.0)]
+    #[rule(range = FREQUENCY)]
     pub f_max_hz: f64,
     /// Number of frequencies, 1…1e5.
     #[schema(example = 400)]
+    #[rule(range = FREQ_POINTS)]
     pub n_points: u32,
     /// Logarithmic spacing (default linear).
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
@@ -415,12 +454,15 @@ pub struct GridIn {
 pub struct FrequencyResponseIn {
     /// Lowest frequency \[Hz\].
     #[schema(example = 0.5)]
+    #[rule(range = FREQUENCY)]
     pub f_min_hz: f64,
     /// Highest frequency \[Hz\], > `f_min_hz` (equal only with `n_points` = 1).
     #[schema(example = 100.0)]
+    #[rule(range = FREQUENCY)]
     pub f_max_hz: f64,
     /// Number of frequencies, 1…1e5. Cost n_points · O(N³).
     #[schema(example = 400)]
+    #[rule(range = FREQ_POINTS)]
     pub n_points: u32,
     /// Logarithmic spacing (default linear).
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
@@ -428,6 +470,7 @@ pub struct FrequencyResponseIn {
     /// Output abscissae `x_o` \[m\], each in [0, `beam.length_m`], at most 64; default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = json!([1.0]))]
+    #[rule(items = ABSCISSA, min_items = 1, max_items = MAX_POINTS)]
     pub points_m: Option<Vec<f64>>,
 }
 
@@ -438,15 +481,18 @@ pub struct FrequencyResponseIn {
 pub struct TimeResponseIn {
     /// Horizon \[s\].
     #[schema(example = 10.0)]
+    #[rule(range = T_END)]
     pub t_end_s: f64,
     /// Output step `h` \[s\] (the result is exact for any h; `t_end_s/dt_s` ≤ 2e6 samples). Samples
     /// are `t = k·h`, `k = 0…K`, `K = ⌈t_end_s/dt_s⌉` (a ratio within 1e-9 of an integer is that
     /// integer).
     #[schema(example = 0.001)]
+    #[rule(range = DT)]
     pub dt_s: f64,
     /// Output abscissae `x_o` \[m\], each in [0, `beam.length_m`], at most 64; default the tip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false, example = json!([1.0]))]
+    #[rule(items = ABSCISSA, min_items = 1, max_items = MAX_POINTS)]
     pub points_m: Option<Vec<f64>>,
     /// Return the sampled series (the biggest payload): `t_s`, `w_m` per abscissa, and with an
     /// absorber `stroke_m`, with a coil `force_n` and `current_a`, with `active` `voltage_v`.
@@ -455,6 +501,7 @@ pub struct TimeResponseIn {
     /// Keep every k-th sample in the series (default 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
+    #[rule(range = DECIMATE)]
     pub decimate: Option<u32>,
 }
 
@@ -763,55 +810,4 @@ pub struct TimeOut {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     pub voltage_v: Option<Vec<f64>>,
-}
-
-crate::schema_bounds! {
-    VibrationAbsorberRequest { time_limit_ms: crate::calc::common::TIME_LIMIT_MS },
-    BeamIn {
-        length_m: LENGTH,
-        youngs_modulus_pa: MODULUS,
-        density_kg_m3: DENSITY,
-        area_m2: SECTION,
-        second_moment_m4: SECTION,
-        n_modes: N_MODES,
-        modal_damping_ratio: DAMPING_RATIO,
-    },
-    SectionIn { width_m: SECTION, thickness_m: SECTION },
-    AbsorberIn {
-        mass_kg: MASS,
-        stiffness_n_m: STIFFNESS,
-        passive_tuning_hz: FREQUENCY,
-        passive_tuning_mode: MODE_INDEX,
-        damping_n_s_m: DAMPING,
-        position_m: LENGTH,
-    },
-    ActuatorIn {
-        resistance_ohm: RESISTANCE,
-        inductance_h: INDUCTANCE,
-        force_constant_n_a: FORCE_CONSTANT,
-        back_emf_v_s_m: BACK_EMF,
-    },
-    ControlIn { tuning_hz: FREQUENCY, tuning_mode: MODE_INDEX, kp_v_m: GAIN, kd_v_s_m: GAIN },
-    ExcitationIn {
-        position_m: LENGTH,
-        amplitude_n: AMPLITUDE,
-        frequency_hz: FREQUENCY,
-        resonance_of_mode: MODE_INDEX,
-        phase_rad: PHASE,
-    },
-    HarmonicIn {
-        amplitude_n: AMPLITUDE,
-        frequency_hz: FREQUENCY,
-        resonance_of_mode: MODE_INDEX,
-        phase_rad: PHASE,
-    },
-    GridIn { f_min_hz: FREQUENCY, f_max_hz: FREQUENCY, n_points: FREQ_POINTS },
-    FrequencyResponseIn {
-        f_min_hz: FREQUENCY,
-        f_max_hz: FREQUENCY,
-        n_points: FREQ_POINTS,
-        points_m @items: ABSCISSA,
-    },
-    TimeResponseIn { t_end_s: T_END, dt_s: DT, points_m @items: ABSCISSA, decimate: DECIMATE },
-    ModeShapesIn { n_points: SHAPE_POINTS },
 }
