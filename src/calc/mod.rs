@@ -55,7 +55,6 @@ pub fn document_rules() -> rules::DocRules {
 pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         common::schema_bounds(),
-        bezier_motion::wire::schema_bounds(),
         cam_law_fit::wire::schema_bounds(),
         cognates::wire::schema_bounds(),
         cognates::wire::variant_bounds(),
