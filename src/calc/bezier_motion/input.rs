@@ -241,34 +241,11 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
             .sensitivity
             .as_ref()
             .map(|s| s.stiffness_factors.clone());
-        let shapers = req.outputs.shaper_comparison.as_ref().map(|sc| {
-            for (i, s) in sc.shapers.iter().enumerate() {
-                if sc.shapers[..i].contains(s) {
-                    v.rule(
-                        &SHAPER_REPEATED,
-                        format!("/outputs/shaper_comparison/shapers/{i}"),
-                        format!("shapers[{i}] repeats an earlier entry; list each shaper once"),
-                    );
-                }
-            }
-            ShaperSpec {
-                baseline: match sc.baseline {
-                    BaselineIn::Trapezoid => Baseline::Trapezoid,
-                    BaselineIn::Cycloidal => Baseline::Cycloidal,
-                },
-                shapers: sc
-                    .shapers
-                    .iter()
-                    .map(|s| match s {
-                        ShaperIn::None => Shaper::None,
-                        ShaperIn::Zv => Shaper::Zv,
-                        ShaperIn::Zvd => Shaper::Zvd,
-                        ShaperIn::Ei => Shaper::Ei,
-                    })
-                    .collect(),
-                ei_tolerance: sc.ei_tolerance,
-            }
-        });
+        let shapers = req
+            .outputs
+            .shaper_comparison
+            .as_ref()
+            .map(|sc| shaper_spec(sc, &mut v));
 
         v.finish()?;
         Ok(Self {
@@ -287,5 +264,35 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
             shapers,
             warnings,
         })
+    }
+}
+
+/// The shaper comparison's settings; each shaper at most once ([`SHAPER_REPEATED`]).
+fn shaper_spec(sc: &wire::ShaperComparisonIn, v: &mut Validator) -> ShaperSpec {
+    for (i, s) in sc.shapers.iter().enumerate() {
+        if sc.shapers[..i].contains(s) {
+            v.rule(
+                &SHAPER_REPEATED,
+                format!("/outputs/shaper_comparison/shapers/{i}"),
+                format!("shapers[{i}] repeats an earlier entry; list each shaper once"),
+            );
+        }
+    }
+    ShaperSpec {
+        baseline: match sc.baseline {
+            BaselineIn::Trapezoid => Baseline::Trapezoid,
+            BaselineIn::Cycloidal => Baseline::Cycloidal,
+        },
+        shapers: sc
+            .shapers
+            .iter()
+            .map(|s| match s {
+                ShaperIn::None => Shaper::None,
+                ShaperIn::Zv => Shaper::Zv,
+                ShaperIn::Zvd => Shaper::Zvd,
+                ShaperIn::Ei => Shaper::Ei,
+            })
+            .collect(),
+        ei_tolerance: sc.ei_tolerance,
     }
 }
