@@ -56,7 +56,6 @@ pub fn document_rules() -> rules::DocRules {
 pub fn schema_bounds() -> Vec<SchemaBound> {
     [
         common::schema_bounds(),
-        bezier_motion::wire::schema_bounds(),
     ]
     .concat()
 }

@@ -3,9 +3,8 @@
 use axum::extract::State;
 use axum::response::Response;
 
-use super::{ApiError, ApiJson, AppState, ProblemResponses, run_calc};
-use crate::calc::bezier_motion::{self, BezierMotionRequest, BezierMotionResponse};
-use crate::calc::common::TimeLimited;
+use super::{ApiError, AppState, ProblemResponses, Valid, run_calc};
+use crate::calc::bezier_motion::{self, BezierInput, BezierMotionRequest, BezierMotionResponse};
 
 /// Bezier motion law of a servo move through a compliant joint: residual vibration in closed form,
 /// and the zero-vibration law.
@@ -33,8 +32,10 @@ use crate::calc::common::TimeLimited;
 )]
 pub async fn solve(
     State(state): State<AppState>,
-    ApiJson(req): ApiJson<BezierMotionRequest>,
+    Valid { input, limit, .. }: Valid<BezierMotionRequest, BezierInput>,
 ) -> Result<Response, ApiError> {
-    let limit = req.time_limit();
-    run_calc(&state, limit, move |budget| bezier_motion::run(req, budget)).await
+    run_calc(&state, limit, move |budget| {
+        bezier_motion::run_valid(&input, budget)
+    })
+    .await
 }

@@ -206,6 +206,10 @@ pub fn cross_field_rules() -> Vec<(&'static str, &'static [crate::calc::CrossRul
     use crate::calc;
     vec![
         (
+            "/v1/bezier-motion-law",
+            calc::bezier_motion::input::CROSS_FIELD_RULES,
+        ),
+        (
             "/v1/bus-fuel-economy",
             calc::bus_fuel_economy::input::CROSS_FIELD_RULES,
         ),

@@ -315,3 +315,177 @@ async fn shaper_comparison_rules_and_answer() {
     v["outputs"]["shaper_comparison"]["shapers"] = json!(["mzv"]);
     assert_eq!(post_json(PATH, &v).await.status, 422);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Issue 26: the rules between fields are listed and reachable; `null` means absent.
+
+/// The codes the document lists under this operation's `x-cross-field-rules`.
+fn documented_rule_codes() -> Vec<String> {
+    let doc = serde_json::to_value(mechcalc::http::openapi()).expect("openapi");
+    doc.pointer("/paths/~1v1~1bezier-motion-law/post/x-cross-field-rules")
+        .and_then(Value::as_array)
+        .expect("x-cross-field-rules")
+        .iter()
+        .map(|r| r["code"].as_str().expect("code").to_owned())
+        .collect()
+}
+
+/// Each rule between fields the operation lists is reachable: a request that passes every
+/// per-field rule and breaks that one rule gets a 422 with the rule's code at the rule's pointer
+/// (and so are the two size refusals of the computation).
+#[tokio::test]
+async fn every_cross_field_rule_is_reachable() {
+    type Edit = fn(&mut Value);
+    let cases: [(&str, &str, Edit); 9] = [
+        ("INERTIA_SUM_ZERO", "/system/inertias_kgm2", |b| {
+            b["system"]["inertias_kgm2"] = json!([0.0, 0.0]);
+        }),
+        ("ZERO_RATIO", "/system/z", |b| b["system"]["z"] = json!(0.0)),
+        ("ZERO_ROTATION", "/motion/Phi_rev", |b| {
+            b["motion"]["Phi_rev"] = json!(0.0);
+        }),
+        ("DEGREE_TOO_HIGH", "/motion/p", |b| {
+            b["motion"]["m"] = json!(6);
+            b["motion"]["p"] = json!(20);
+        }),
+        ("GAMMA_LENGTH", "/motion/gamma_rad", |b| {
+            b["motion"]["gamma_rad"] = json!([1.0, 2.0]);
+        }),
+        ("GAMMA_OUT_OF_SCALE", "/motion/gamma_rad/1", |b| {
+            b["motion"]["gamma_rad"] = json!([1.0, 2.0e6, 3.0]);
+        }),
+        (
+            "SHAPER_REPEATED",
+            "/outputs/shaper_comparison/shapers/2",
+            |b| {
+                b["outputs"] = json!({"shaper_comparison": {"shapers": ["zv", "ei", "zv"]}});
+            },
+        ),
+        ("RHO_TOO_LARGE", "/system/c_Nms_per_rad", |b| {
+            b["system"] =
+                json!({"J_eq_kgm2": 1.0, "k_Nm_per_rad": 1.0, "c_Nms_per_rad": 1e6, "z": 1.0});
+        }),
+        (
+            "HISTORY_TOO_LARGE",
+            "/outputs/time_history/n_samples",
+            |b| {
+                b["system"] =
+                    json!({"J_eq_kgm2": 1.0, "k_Nm_per_rad": 1e13, "c_Nms_per_rad": 0.0, "z": 1.0});
+                b["outputs"] = json!({"time_history": {"n_samples": 100}});
+            },
+        ),
+    ];
+    for (code, pointer, edit) in cases {
+        let mut b = paper();
+        edit(&mut b);
+        let r = post_json(PATH, &b).await;
+        let p = r.problem(422);
+        assert_eq!(p["code"], code, "{p}");
+        assert_eq!(r.pointers(), [pointer], "{code}: {p}");
+    }
+    // Every listed code is one of these, or a failure of the computation that only extreme
+    // inputs reach (an L2 Hessian without a Cholesky factor, an overflow, the time budget, the
+    // answer's size).
+    let computed = [
+        "OBJECTIVE_SINGULAR",
+        "NON_FINITE_RESULT",
+        "DEADLINE_EXCEEDED",
+        "RESPONSE_TOO_LARGE",
+    ];
+    let mut want: Vec<String> = cases
+        .iter()
+        .map(|c| c.0)
+        .chain(computed)
+        .map(str::to_owned)
+        .collect();
+    want.sort();
+    let mut got = documented_rule_codes();
+    got.sort();
+    assert_eq!(got, want);
+}
+
+/// `null` for an optional field is the same as leaving it out, at every depth: the api example
+/// with every optional field it omits set to `null` gets the example's answer, and `null` for an
+/// optional field it gives gets the answer of that field's default.
+#[tokio::test]
+async fn null_means_absent() {
+    let answer = |r: &common::Reply| {
+        assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+        let mut v = r.json();
+        v["report"]
+            .as_object_mut()
+            .expect("report")
+            .retain(|k, _| k != "elapsed_ms");
+        v
+    };
+    let base = example("optimize_paper");
+    let plain = answer(&post_json(PATH, &base).await);
+    let mut b = base.clone();
+    b["time_limit_ms"] = Value::Null;
+    b["system"]["J_eq_kgm2"] = Value::Null;
+    b["motion"]["Phi_rad"] = Value::Null;
+    b["motion"]["gamma_rad"] = Value::Null;
+    b["optimize"]["robust_stiffness_rel"] = Value::Null;
+    b["outputs"]["shaper_comparison"] = Value::Null;
+    assert_eq!(answer(&post_json(PATH, &b).await), plain);
+
+    // Null for every defaulted member it gives = each member absent (the example's values are
+    // the defaults, except the time history's counts, which default to 0).
+    let mut nulls = base.clone();
+    let mut gone = base.clone();
+    for p in [
+        "/mode",
+        "/motion/m",
+        "/motion/p",
+        "/optimize/objective",
+        "/outputs/kinematic_peaks",
+        "/outputs/time_history/n_samples",
+        "/outputs/time_history/t_after_s",
+    ] {
+        *nulls.pointer_mut(p).expect(p) = Value::Null;
+        let (parent, key) = p.rsplit_once('/').expect("pointer");
+        gone.pointer_mut(parent)
+            .and_then(Value::as_object_mut)
+            .expect(parent)
+            .remove(key);
+    }
+    let absent = answer(&post_json(PATH, &gone).await);
+    assert_eq!(answer(&post_json(PATH, &nulls).await), absent);
+    assert_ne!(
+        absent, plain,
+        "the time history's counts changed the answer"
+    );
+
+    // The shaper comparison's members: null = absent = the defaults the example gives.
+    let shaped = example("shaper_comparison_paper");
+    let plain = answer(&post_json(PATH, &shaped).await);
+    let mut nulls = shaped.clone();
+    for k in ["baseline", "shapers", "ei_tolerance"] {
+        nulls["outputs"]["shaper_comparison"][k] = Value::Null;
+    }
+    assert_eq!(answer(&post_json(PATH, &nulls).await), plain);
+    let mut gone = shaped.clone();
+    gone["outputs"]["shaper_comparison"] = json!({});
+    assert_eq!(answer(&post_json(PATH, &gone).await), plain);
+
+    // Top-level optional objects as null = absent.
+    let mut top = base.clone();
+    let mut gone = base;
+    for k in ["optimize", "outputs"] {
+        top[k] = Value::Null;
+        gone.as_object_mut().expect("request").remove(k);
+    }
+    assert_eq!(
+        answer(&post_json(PATH, &top).await),
+        answer(&post_json(PATH, &gone).await)
+    );
+
+    // A required member stays required: null is a 422 naming it.
+    let r = post_json(PATH, &with("/motion/T_s", Value::Null)).await;
+    r.problem(422);
+    assert!(
+        String::from_utf8_lossy(&r.bytes).contains("T_s"),
+        "{}",
+        String::from_utf8_lossy(&r.bytes)
+    );
+}

@@ -31,9 +31,17 @@ use crate::support::bezier_ode::{
 use crate::support::finite::assert_finite;
 use crate::support::proptest_cfg::cases;
 
-/// Codes a request of this endpoint may be refused with (all HTTP 422).
+/// Codes a request of this endpoint may be refused with (all HTTP 422): a per-field rule
+/// (`INVALID_INPUT`), a rule between fields, or a refusal of the computation.
 const TYPED: &[&str] = &[
     "INVALID_INPUT",
+    "INERTIA_SUM_ZERO",
+    "ZERO_RATIO",
+    "ZERO_ROTATION",
+    "DEGREE_TOO_HIGH",
+    "GAMMA_LENGTH",
+    "GAMMA_OUT_OF_SCALE",
+    "SHAPER_REPEATED",
     "RHO_TOO_LARGE",
     "HISTORY_TOO_LARGE",
     "OBJECTIVE_SINGULAR",

@@ -1,9 +1,10 @@
-//! Failures of the Bezier-motion computation that depend on derived quantities (field-level
-//! validation problems are collected in `input.rs`).
+//! Failures of the Bezier-motion computation that depend on derived quantities (the request's
+//! rules are checked at the door: `wire.rs`, `input.rs`), each a [`CrossRule`] listed under the
+//! operation's `x-cross-field-rules`.
 
 use thiserror::Error;
 
-use crate::calc::{CalcFailure, ProblemClass};
+use crate::calc::{CalcFailure, CrossRule};
 
 /// Error of [`super::compute::compute`].
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -55,31 +56,62 @@ pub enum BezierMotionError {
     },
 }
 
+/// The drive's fastest pole stays within the Gauss–Legendre path's limit (`RHO_TOO_LARGE`).
+pub const RHO_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
+    "RHO_TOO_LARGE",
+    &[
+        "/system/c_Nms_per_rad",
+        "/optimize/robust_stiffness_rel",
+        "/outputs/sensitivity/stiffness_factors/*",
+    ],
+    "When the end state needs the Gauss–Legendre path, rho_max = T·|fastest pole| ≤ 2e5 (for the \
+     nominal drive, the robust k·(1±δ) and every sensitivity factor k·f).",
+);
+
+/// A time history fits the sub-step budget (`HISTORY_TOO_LARGE`).
+pub const HISTORY_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
+    "HISTORY_TOO_LARGE",
+    &["/outputs/time_history/n_samples"],
+    "A time history is asked for only when rho_max = T·|fastest pole| ≤ 1.6e6 (sub-step budget).",
+);
+
+/// The L2 objective's Hessian has a Cholesky factor (`OBJECTIVE_SINGULAR`).
+pub const OBJECTIVE_SINGULAR_RULE: CrossRule = CrossRule::not_converged(
+    "OBJECTIVE_SINGULAR",
+    &["/optimize/objective"],
+    "The min_accel_l2 / min_jerk_l2 objective's Hessian is numerically positive definite.",
+);
+
+/// Every result is finite (`NON_FINITE_RESULT`).
+pub const NON_FINITE_RESULT_RULE: CrossRule = CrossRule::infeasible(
+    "NON_FINITE_RESULT",
+    &["/system", "/outputs/sensitivity/stiffness_factors/*"],
+    "Every computed quantity is finite in f64 (inputs at the extremes of their ranges, or a \
+     stiffness factor whose k·f underflows to 0, can overflow).",
+);
+
+/// The work fits the request's time budget (`DEADLINE_EXCEEDED`).
+pub const DEADLINE_RULE: CrossRule = CrossRule::too_large(
+    "DEADLINE_EXCEEDED",
+    &["/time_limit_ms"],
+    "The computation finishes within the request's time budget.",
+);
+
 impl From<BezierMotionError> for CalcFailure {
     fn from(e: BezierMotionError) -> Self {
         let detail = e.to_string();
         match e {
             BezierMotionError::RhoTooLarge { pointer, .. } => {
-                CalcFailure::field(ProblemClass::TooLarge, "RHO_TOO_LARGE", pointer, detail)
+                RHO_TOO_LARGE_RULE.fail(pointer, detail)
             }
-            BezierMotionError::HistoryTooLarge { .. } => CalcFailure::field(
-                ProblemClass::TooLarge,
-                "HISTORY_TOO_LARGE",
-                "/outputs/time_history/n_samples",
-                detail,
-            ),
-            BezierMotionError::ObjectiveSingular { .. } => CalcFailure::field(
-                ProblemClass::NotConverged,
-                "OBJECTIVE_SINGULAR",
-                "/optimize/objective",
-                detail,
-            ),
-            BezierMotionError::NonFinite { .. } => {
-                CalcFailure::general(ProblemClass::Infeasible, "NON_FINITE_RESULT", detail)
+            BezierMotionError::HistoryTooLarge { .. } => {
+                HISTORY_TOO_LARGE_RULE.fail("/outputs/time_history/n_samples", detail)
             }
-            BezierMotionError::Deadline { .. } => {
-                CalcFailure::general(ProblemClass::TooLarge, "DEADLINE_EXCEEDED", detail)
+            BezierMotionError::ObjectiveSingular { .. } => {
+                OBJECTIVE_SINGULAR_RULE.fail("/optimize/objective", detail)
             }
+            BezierMotionError::NonFinite { .. } => NON_FINITE_RESULT_RULE.fail_general(detail),
+            BezierMotionError::Deadline { .. } => DEADLINE_RULE.fail_general(detail),
         }
     }
 }

@@ -1,19 +1,81 @@
-//! Validation of a [`BezierMotionRequest`] into a [`BezierInput`] (spec §2), collecting every
-//! offending field with its JSON pointer.
+//! Conversion of a [`BezierMotionRequest`] into a [`BezierInput`] (spec §2). The per-field rules
+//! (ranges, list lengths, exactly one of `inertias_kgm2`/`J_eq_kgm2` and of `Phi_rad`/`Phi_rev`)
+//! are `#[rule]`s on the wire types, checked at the door; this file keeps only what JSON Schema
+//! cannot state, each rule with its own code ([`CROSS_FIELD_RULES`]).
 
 use super::compute::BezierWarning;
+use super::error::{
+    DEADLINE_RULE, HISTORY_TOO_LARGE_RULE, NON_FINITE_RESULT_RULE, OBJECTIVE_SINGULAR_RULE,
+    RHO_TOO_LARGE_RULE,
+};
 use super::history::HistorySpec;
 use super::optimize::Objective;
 use super::plant::Plant;
 use super::shaper::{Baseline, Shaper, ShaperSpec};
 use super::wire::{
-    self, BezierMotionRequest, DAMPING, FREE_P, GAMMA, GAMMA_OVER_PHI_MAX, HISTORY_SAMPLES,
-    INERTIA, J_EQ, MAX_ACCEL_DEGREE, MAX_FACTORS, MAX_INERTIAS, MOTION_TIME, ORDER_M, ObjectiveIn,
-    PHI, RATIO, ROBUST_REL, STIFFNESS, STIFFNESS_FACTOR, WINDOW_AFTER,
+    self, BaselineIn, BezierMotionRequest, FREE_P, GAMMA_OVER_PHI_MAX, MAX_ACCEL_DEGREE, ORDER_M,
+    ObjectiveIn, ShaperIn,
 };
-use super::wire::{BaselineIn, EI_TOLERANCE, MAX_SHAPERS, ShaperIn};
-use crate::calc::common::time_limit;
-use crate::calc::{CalcFailure, Validator};
+use crate::calc::rules::door_skipped;
+use crate::calc::{CalcFailure, CrossRule, Validator};
+
+/// The inertias of `inertias_kgm2` sum to > 0.
+pub const INERTIA_SUM: CrossRule = CrossRule::invalid(
+    "INERTIA_SUM_ZERO",
+    &["/system/inertias_kgm2"],
+    "The inertias in inertias_kgm2 sum to > 0 (each is ≥ 0).",
+);
+/// The reducer ratio is not 0.
+pub const RATIO_NONZERO: CrossRule =
+    CrossRule::invalid("ZERO_RATIO", &["/system/z"], "The reducer ratio z is ≠ 0.");
+/// The total rotation is not 0.
+pub const ROTATION_NONZERO: CrossRule = CrossRule::invalid(
+    "ZERO_ROTATION",
+    &["/motion/Phi_rad", "/motion/Phi_rev"],
+    "The total motor rotation (Phi_rad or Phi_rev) is ≠ 0.",
+);
+/// The degree of φ'' stays within Bernstein conditioning.
+pub const DEGREE: CrossRule = CrossRule::invalid(
+    "DEGREE_TOO_HIGH",
+    &["/motion/m", "/motion/p"],
+    "N = 2m + p − 1 ≤ 30 (Bernstein conditioning, spec §6).",
+);
+/// γ holds p ordinates.
+pub const GAMMA_LENGTH: CrossRule = CrossRule::invalid(
+    "GAMMA_LENGTH",
+    &["/motion/gamma_rad", "/motion/p"],
+    "gamma_rad holds exactly p ordinates.",
+);
+/// γ is on the scale of the move.
+pub const GAMMA_SCALE: CrossRule = CrossRule::invalid(
+    "GAMMA_OUT_OF_SCALE",
+    &["/motion/gamma_rad/*", "/motion/Phi_rad", "/motion/Phi_rev"],
+    "Each |gamma_rad[j]| ≤ 1e3·|Phi| (Phi in rad).",
+);
+/// Each shaper at most once.
+pub const SHAPER_REPEATED: CrossRule = CrossRule::invalid(
+    "SHAPER_REPEATED",
+    &["/outputs/shaper_comparison/shapers/*"],
+    "Each shaper of shaper_comparison.shapers is listed at most once.",
+);
+
+/// The rules between fields of `POST /v1/bezier-motion-law`, and every code its computation can
+/// answer a schema-valid request with, as the document lists them.
+pub const CROSS_FIELD_RULES: &[CrossRule] = &[
+    INERTIA_SUM,
+    RATIO_NONZERO,
+    ROTATION_NONZERO,
+    DEGREE,
+    GAMMA_LENGTH,
+    GAMMA_SCALE,
+    SHAPER_REPEATED,
+    RHO_TOO_LARGE_RULE,
+    HISTORY_TOO_LARGE_RULE,
+    OBJECTIVE_SINGULAR_RULE,
+    NON_FINITE_RESULT_RULE,
+    DEADLINE_RULE,
+    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
+];
 
 /// What a request computes (the request's `mode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -74,133 +136,89 @@ fn small(x: u64) -> usize {
 impl TryFrom<BezierMotionRequest> for BezierInput {
     type Error = CalcFailure;
 
-    #[expect(
-        clippy::too_many_lines,
-        reason = "one flat list of field checks in request order, each a line or two; splitting \
-                  it would scatter the pointers"
-    )]
     fn try_from(req: BezierMotionRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        let _ = time_limit(&mut v, req.time_limit_ms);
         let mut warnings = Vec::new();
 
-        // System.
+        // System: exactly one inertia form and every range were checked at the door.
         let sys = &req.system;
         let j_eq = match (&sys.inertias_kgm2, sys.j_eq_kgm2) {
-            (Some(_), Some(_)) | (None, None) => {
-                v.push(
-                    "/system/J_eq_kgm2",
-                    "give exactly one of `inertias_kgm2` and `J_eq_kgm2`",
-                );
-                None
-            }
             (Some(list), None) => {
-                let n = list.len();
-                if !(1..=MAX_INERTIAS).contains(&n) {
-                    v.push(
-                        "/system/inertias_kgm2",
-                        format!("must hold 1..={MAX_INERTIAS} inertias, got {n}"),
-                    );
-                    None
-                } else if v.all_in("/system/inertias_kgm2", "inertias_kgm2", list, INERTIA) {
-                    let sum: f64 = list.iter().sum();
-                    v.ensure(sum > 0.0, "/system/inertias_kgm2", || {
-                        "the inertias must sum to > 0, got 0".to_owned()
-                    })
-                    .then_some(sum)
-                } else {
-                    None
-                }
+                let sum: f64 = list.iter().sum();
+                v.ensure_rule(sum > 0.0, &INERTIA_SUM, "/system/inertias_kgm2", || {
+                    "the inertias must sum to > 0 kg m², got 0".to_owned()
+                });
+                sum
             }
-            (None, Some(j)) => v
-                .range("/system/J_eq_kgm2", "J_eq_kgm2", j, J_EQ)
-                .then_some(j),
+            (None, Some(j)) => j,
+            _ => return Err(door_skipped("/system/J_eq_kgm2")),
         };
-        let k = sys.k_nm_per_rad;
-        let ok_k = v.range("/system/k_Nm_per_rad", "k_Nm_per_rad", k, STIFFNESS);
-        let c = sys.c_nms_per_rad;
-        let ok_c = v.range("/system/c_Nms_per_rad", "c_Nms_per_rad", c, DAMPING);
-        let z = sys.z;
-        let ok_z = v.range("/system/z", "z", z, RATIO)
-            && v.ensure(z != 0.0, "/system/z", || "z must be ≠ 0, got 0".to_owned());
+        let (k, c, z) = (sys.k_nm_per_rad, sys.c_nms_per_rad, sys.z);
+        v.ensure_rule(z != 0.0, &RATIO_NONZERO, "/system/z", || {
+            "z must be ≠ 0, got 0".to_owned()
+        });
 
         // Motion.
         let mo = &req.motion;
-        let phi = match (mo.phi_rad, mo.phi_rev) {
-            (Some(_), Some(_)) | (None, None) => {
-                v.push(
-                    "/motion/Phi_rad",
-                    "give exactly one of `Phi_rad` and `Phi_rev`",
-                );
-                None
-            }
-            (Some(x), None) => nonzero(&mut v, "/motion/Phi_rad", "Phi_rad", x),
-            (None, Some(x)) => {
-                nonzero(&mut v, "/motion/Phi_rev", "Phi_rev", x).map(|r| r * std::f64::consts::TAU)
-            }
+        let (phi, phi_pointer, phi_name) = match (mo.phi_rad, mo.phi_rev) {
+            (Some(x), None) => (x, "/motion/Phi_rad", "Phi_rad"),
+            (None, Some(x)) => (x * std::f64::consts::TAU, "/motion/Phi_rev", "Phi_rev"),
+            _ => return Err(door_skipped("/motion/Phi_rad")),
         };
-        let ok_t = v.range("/motion/T_s", "T_s", mo.t_s, MOTION_TIME);
-        let ok_m = v.uint("/motion/m", "m", mo.m, ORDER_M);
-        let ok_p = v.uint("/motion/p", "p", mo.p, FREE_P);
+        let ok_phi = v.ensure_rule(phi != 0.0, &ROTATION_NONZERO, phi_pointer, || {
+            format!("{phi_name} must be ≠ 0, got 0")
+        });
+        if !(ORDER_M.contains(mo.m as f64) && FREE_P.contains(mo.p as f64)) {
+            return Err(door_skipped("/motion/m"));
+        }
         let (m, p) = (small(mo.m), small(mo.p));
-        let ok_n =
-            ok_m && ok_p && v.ensure(2 * m + p - 1 <= MAX_ACCEL_DEGREE, "/motion/p", || {
+        v.ensure_rule(
+            2 * m + p - 1 <= MAX_ACCEL_DEGREE,
+            &DEGREE,
+            "/motion/p",
+            || {
                 format!(
                     "N = 2m + p − 1 must be ≤ {MAX_ACCEL_DEGREE} (Bernstein conditioning), got {} \
-                     (m = {m}, p = {p})",
+                 (m = {m}, p = {p})",
                     2 * m + p - 1
                 )
-            });
-        let gamma = match (&mo.gamma_rad, phi) {
-            (Some(g), _) if ok_p && g.len() != p => {
-                v.push(
+            },
+        );
+        let gamma = match &mo.gamma_rad {
+            Some(g) if g.len() != p => {
+                v.rule(
+                    &GAMMA_LENGTH,
                     "/motion/gamma_rad",
                     format!("must hold p = {p} ordinates, got {}", g.len()),
                 );
-                None
+                Vec::new()
             }
-            (Some(g), Some(phi)) if ok_p => {
-                if v.all_in("/motion/gamma_rad", "gamma_rad", g, GAMMA) {
-                    let lim = GAMMA_OVER_PHI_MAX * phi.abs();
-                    if let Some(i) = g.iter().position(|x| x.abs() > lim) {
-                        v.push(
-                            format!("/motion/gamma_rad/{i}"),
-                            format!("|gamma_rad[{i}]| must be ≤ 1e3·|Phi| = {lim}, got {}", g[i]),
-                        );
-                        None
-                    } else {
-                        Some(g.clone())
-                    }
-                } else {
-                    None
+            Some(g) => {
+                let lim = GAMMA_OVER_PHI_MAX * phi.abs();
+                if ok_phi && let Some(i) = g.iter().position(|x| x.abs() > lim) {
+                    v.rule(
+                        &GAMMA_SCALE,
+                        format!("/motion/gamma_rad/{i}"),
+                        format!(
+                            "|gamma_rad[{i}]| [rad] must be ≤ 1e3·|Phi| = {lim}, got {}",
+                            g[i]
+                        ),
+                    );
                 }
+                g.clone()
             }
-            (None, Some(phi)) if ok_p => Some(
-                (1..=p)
-                    .map(|j| phi * j as f64 / (p + 1) as f64)
-                    .collect::<Vec<_>>(),
-            ),
-            _ => None,
+            None => (1..=p)
+                .map(|j| phi * j as f64 / (p + 1) as f64)
+                .collect::<Vec<_>>(),
         };
 
         // Optimisation.
         let robust = match req.optimize.robust_stiffness_rel {
-            Some(d)
-                if v.range(
-                    "/optimize/robust_stiffness_rel",
-                    "robust_stiffness_rel",
-                    d,
-                    ROBUST_REL,
-                ) =>
-            {
-                if req.mode == wire::Mode::Simulate {
-                    warnings.push(BezierWarning::RobustIgnored);
-                    None
-                } else {
-                    Some(d)
-                }
+            Some(_) if req.mode == wire::Mode::Simulate => {
+                warnings.push(BezierWarning::RobustIgnored);
+                None
             }
-            _ => None,
+            d => d,
         };
         let objective = match req.optimize.objective {
             ObjectiveIn::MinDeviation => Objective::MinDeviation,
@@ -209,121 +227,72 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
         };
 
         // Outputs.
-        let history = req.outputs.time_history.and_then(|h| {
-            let a = v.uint(
-                "/outputs/time_history/n_samples",
-                "n_samples",
-                h.n_samples,
-                HISTORY_SAMPLES,
-            );
-            let b = v.range(
-                "/outputs/time_history/t_after_s",
-                "t_after_s",
-                h.t_after_s,
-                WINDOW_AFTER,
-            );
-            let c = v.uint(
-                "/outputs/time_history/n_after",
-                "n_after",
-                h.n_after,
-                HISTORY_SAMPLES,
-            );
-            (a && b && c && (h.n_samples > 0 || h.n_after > 0)).then_some(HistorySpec {
+        let history = req
+            .outputs
+            .time_history
+            .filter(|h| h.n_samples > 0 || h.n_after > 0)
+            .map(|h| HistorySpec {
                 n_samples: small(h.n_samples),
                 t_after: h.t_after_s,
                 n_after: small(h.n_after),
-            })
-        });
-        let sensitivity = req.outputs.sensitivity.as_ref().and_then(|s| {
-            let f = &s.stiffness_factors;
-            if f.len() > MAX_FACTORS {
-                v.push(
-                    "/outputs/sensitivity/stiffness_factors",
-                    format!("must hold at most {MAX_FACTORS} factors, got {}", f.len()),
-                );
-                return None;
-            }
-            v.all_in(
-                "/outputs/sensitivity/stiffness_factors",
-                "stiffness_factors",
-                f,
-                STIFFNESS_FACTOR,
-            )
-            .then(|| f.clone())
-        });
-
-        let shapers = req.outputs.shaper_comparison.as_ref().and_then(|sc| {
-            let pointer = "/outputs/shaper_comparison/shapers";
-            let n = sc.shapers.len();
-            let mut ok = v.ensure((1..=MAX_SHAPERS).contains(&n), pointer, || {
-                format!("must hold 1..={MAX_SHAPERS} shapers, got {n}")
             });
-            for (i, s) in sc.shapers.iter().enumerate() {
-                if sc.shapers[..i].contains(s) {
-                    v.push(
-                        format!("{pointer}/{i}"),
-                        format!("shapers[{i}] repeats an earlier entry; list each shaper once"),
-                    );
-                    ok = false;
-                }
-            }
-            let ok_v = v.range(
-                "/outputs/shaper_comparison/ei_tolerance",
-                "ei_tolerance",
-                sc.ei_tolerance,
-                EI_TOLERANCE,
-            );
-            (ok && ok_v).then(|| ShaperSpec {
-                baseline: match sc.baseline {
-                    BaselineIn::Trapezoid => Baseline::Trapezoid,
-                    BaselineIn::Cycloidal => Baseline::Cycloidal,
-                },
-                shapers: sc
-                    .shapers
-                    .iter()
-                    .map(|s| match s {
-                        ShaperIn::None => Shaper::None,
-                        ShaperIn::Zv => Shaper::Zv,
-                        ShaperIn::Zvd => Shaper::Zvd,
-                        ShaperIn::Ei => Shaper::Ei,
-                    })
-                    .collect(),
-                ei_tolerance: sc.ei_tolerance,
-            })
-        });
+        let sensitivity = req
+            .outputs
+            .sensitivity
+            .as_ref()
+            .map(|s| s.stiffness_factors.clone());
+        let shapers = req
+            .outputs
+            .shaper_comparison
+            .as_ref()
+            .map(|sc| shaper_spec(sc, &mut v));
 
         v.finish()?;
-        match (j_eq, phi, gamma) {
-            (Some(j_eq), Some(phi), Some(gamma)) if ok_k && ok_c && ok_z && ok_t && ok_n => {
-                Ok(Self {
-                    mode: req.mode.into(),
-                    plant: Plant::new(j_eq, k, c, z),
-                    phi,
-                    t: mo.t_s,
-                    m,
-                    p,
-                    gamma,
-                    objective,
-                    robust,
-                    kinematics: req.outputs.kinematic_peaks,
-                    history,
-                    sensitivity,
-                    shapers,
-                    warnings,
-                })
-            }
-            // Every path to here pushed an issue, so `finish` has already failed.
-            _ => Err(CalcFailure::general(
-                crate::calc::ProblemClass::InvalidInput,
-                crate::calc::INVALID_INPUT,
-                "invalid request",
-            )),
-        }
+        Ok(Self {
+            mode: req.mode.into(),
+            plant: Plant::new(j_eq, k, c, z),
+            phi,
+            t: mo.t_s,
+            m,
+            p,
+            gamma,
+            objective,
+            robust,
+            kinematics: req.outputs.kinematic_peaks,
+            history,
+            sensitivity,
+            shapers,
+            warnings,
+        })
     }
 }
 
-fn nonzero(v: &mut Validator, pointer: &str, name: &str, x: f64) -> Option<f64> {
-    (v.range(pointer, name, x, PHI)
-        && v.ensure(x != 0.0, pointer, || format!("{name} must be ≠ 0, got 0")))
-    .then_some(x)
+/// The shaper comparison's settings; each shaper at most once ([`SHAPER_REPEATED`]).
+fn shaper_spec(sc: &wire::ShaperComparisonIn, v: &mut Validator) -> ShaperSpec {
+    for (i, s) in sc.shapers.iter().enumerate() {
+        if sc.shapers[..i].contains(s) {
+            v.rule(
+                &SHAPER_REPEATED,
+                format!("/outputs/shaper_comparison/shapers/{i}"),
+                format!("shapers[{i}] repeats an earlier entry; list each shaper once"),
+            );
+        }
+    }
+    ShaperSpec {
+        baseline: match sc.baseline {
+            BaselineIn::Trapezoid => Baseline::Trapezoid,
+            BaselineIn::Cycloidal => Baseline::Cycloidal,
+        },
+        shapers: sc
+            .shapers
+            .iter()
+            .map(|s| match s {
+                ShaperIn::None => Shaper::None,
+                ShaperIn::Zv => Shaper::Zv,
+                ShaperIn::Zvd => Shaper::Zvd,
+                ShaperIn::Ei => Shaper::Ei,
+            })
+            .collect(),
+        ei_tolerance: sc.ei_tolerance,
+    }
 }

@@ -92,13 +92,27 @@ pub use wire::{BezierMotionRequest, BezierMotionResponse};
 use crate::calc::CalcFailure;
 use crate::numerics::Budget;
 
-/// Entry point of `POST /v1/bezier-motion-law`: validate, compute, respond.
+/// The job of `POST /v1/bezier-motion-law` once the request passed the door: size check,
+/// compute, respond.
+///
+/// # Errors
+/// A [`CalcFailure`] (HTTP 422) for a request beyond the method's limits (the codes of
+/// [`input::CROSS_FIELD_RULES`]).
+pub fn run_valid(
+    input: &BezierInput,
+    budget: &Budget,
+) -> Result<BezierMotionResponse, CalcFailure> {
+    output::response_size(input).check(budget)?;
+    let out = compute(input, budget)?;
+    Ok(output::respond(input, &out, budget))
+}
+
+/// The whole path of `POST /v1/bezier-motion-law` without HTTP (tests, benchmarks, the CLI):
+/// the per-field rules, the rules between fields, then [`run_valid`].
 ///
 /// # Errors
 /// A [`CalcFailure`] (HTTP 422) for invalid input or a request beyond the method's limits.
 pub fn run(req: BezierMotionRequest, budget: &Budget) -> Result<BezierMotionResponse, CalcFailure> {
-    let input = BezierInput::try_from(req)?;
-    output::response_size(&input).check(budget)?;
-    let out = compute(&input, budget)?;
-    Ok(output::respond(&input, &out, budget))
+    crate::calc::rules::check(&req)?;
+    run_valid(&BezierInput::try_from(req)?, budget)
 }

@@ -2,7 +2,7 @@
 //! angles in rad (motor side unless said otherwise); paper symbols keep their capitals on the
 //! wire (`J_eq_kgm2`, `Phi_rad`, `T_s`).
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
 use utoipa::ToSchema;
 
 use crate::calc::Range;
@@ -71,6 +71,7 @@ pub struct BezierMotionRequest {
     pub outputs: OutputsIn,
     /// Wall-clock budget of this request \[ms\] (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = crate::calc::common::TIME_LIMIT_MS)]
     #[schema(nullable = false)]
     pub time_limit_ms: Option<u64>,
 }
@@ -99,25 +100,31 @@ pub enum Mode {
 #[derive(Debug, Clone, Default, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::SystemIn)]
 #[serde(deny_unknown_fields)]
+#[rules(one_of("inertias_kgm2", "J_eq_kgm2"))]
 pub struct SystemIn {
     /// Inertias downstream of the joint, summed to `J_eq` [kg m²] (paper J1, J2, J3): 1..16
     /// items, each ≥ 0, sum > 0. Exactly one of this and `J_eq_kgm2`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(nullable = false, min_items = 1, max_items = 16, example = json!([0.005, 0.005, 2.8]))]
+    #[rule(items = INERTIA, min_items = 1, max_items = MAX_INERTIAS)]
+    #[schema(nullable = false, example = json!([0.005, 0.005, 2.8]))]
     pub inertias_kgm2: Option<Vec<f64>>,
     /// Equivalent inertia `J_eq` [kg m²]. Exactly one of this and `inertias_kgm2`.
     #[serde(rename = "J_eq_kgm2", default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = J_EQ)]
     #[schema(nullable = false, example = 2.81)]
     pub j_eq_kgm2: Option<f64>,
     /// Joint torsional stiffness `k` [N m/rad].
     #[serde(rename = "k_Nm_per_rad")]
+    #[rule(range = STIFFNESS)]
     #[schema(example = 8000.0)]
     pub k_nm_per_rad: f64,
     /// Joint viscous damping `c` [N m s/rad].
     #[serde(rename = "c_Nms_per_rad")]
+    #[rule(range = DAMPING)]
     #[schema(example = 35.0)]
     pub c_nms_per_rad: f64,
     /// Reducer ratio `z` = α/φ (output/motor), ≠ 0.
+    #[rule(range = RATIO)]
     #[schema(example = 0.05)]
     pub z: f64,
 }
@@ -126,32 +133,38 @@ pub struct SystemIn {
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::MotionIn)]
 #[serde(deny_unknown_fields)]
-#[rules(legacy_nulls)]
+#[rules(one_of("Phi_rad", "Phi_rev"))]
 pub struct MotionIn {
     /// Total motor rotation `Phi` \[rad\], ≠ 0. Exactly one of this and `Phi_rev`.
     #[serde(rename = "Phi_rad", default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = PHI)]
     #[schema(nullable = false, example = 125.66370614359172)]
     pub phi_rad: Option<f64>,
     /// Total motor rotation \[rev\] (`Phi_rad = 2π·Phi_rev`), ≠ 0. Exactly one of this and
     /// `Phi_rad`.
     #[serde(rename = "Phi_rev", default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = PHI)]
     #[schema(nullable = false, example = 20.0)]
     pub phi_rev: Option<f64>,
     /// Motion time `T` \[s\].
     #[serde(rename = "T_s")]
+    #[rule(range = MOTION_TIME)]
     #[schema(example = 1.0)]
     pub t_s: f64,
     /// Order `m` of the derivatives forced to zero at both ends (1..6). Default 2.
-    #[serde(default = "default_m")]
+    #[serde(default = "default_m", deserialize_with = "null_m")]
+    #[rule(range = ORDER_M)]
     #[schema(example = 2)]
     pub m: u64,
     /// Number `p` of free interior ordinates (1..20), with `N = 2m + p − 1 ≤ 30`. Default 3.
-    #[serde(default = "default_p")]
+    #[serde(default = "default_p", deserialize_with = "null_p")]
+    #[rule(range = FREE_P)]
     #[schema(example = 3)]
     pub p: u64,
     /// The p interior ordinates γ_j \[rad\]: the law itself in `simulate`, the reference law in
     /// `optimize`; each `|γ_j| ≤ 1e3·|Phi|`. Default: the linear ramp `Phi·j/(p+1)`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(items = GAMMA)]
     #[schema(nullable = false)]
     pub gamma_rad: Option<Vec<f64>>,
 }
@@ -177,6 +190,22 @@ fn default_m() -> u64 {
 }
 fn default_p() -> u64 {
     3
+}
+/// `m`: `null` reads as the default 2, exactly as if absent.
+fn null_m<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+    Ok(Option::<u64>::deserialize(d)?.unwrap_or_else(default_m))
+}
+/// `p`: `null` reads as the default 3, exactly as if absent.
+fn null_p<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+    Ok(Option::<u64>::deserialize(d)?.unwrap_or_else(default_p))
+}
+/// `shapers`: `null` reads as all four, exactly as if absent.
+fn null_shapers<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<ShaperIn>, D::Error> {
+    Ok(Option::<Vec<ShaperIn>>::deserialize(d)?.unwrap_or_else(all_shapers))
+}
+/// `ei_tolerance`: `null` reads as the default 0.05, exactly as if absent.
+fn null_ei_tolerance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or_else(default_ei_tolerance))
 }
 
 /// How to choose among the zero-energy laws.
@@ -206,6 +235,7 @@ pub struct OptimizeIn {
     /// Robust extension (not in the paper): also zero the residual energy for `k·(1−δ)` and
     /// `k·(1+δ)` (6 constraints: exact when p ≥ 6). Ignored with a warning in `simulate`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[rule(range = ROBUST_REL)]
     #[schema(nullable = false, example = 0.1)]
     pub robust_stiffness_rel: Option<f64>,
 }
@@ -281,14 +311,19 @@ fn default_ei_tolerance() -> f64 {
 #[rules(legacy_nulls)]
 pub struct ShaperComparisonIn {
     /// Baseline move. Default `trapezoid`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub baseline: BaselineIn,
     /// Shapers to compare, each at most once (1..4 items). Default all four.
-    #[serde(default = "all_shapers")]
-    #[schema(min_items = 1, max_items = 4, example = json!(["none", "zv", "zvd", "ei"]))]
+    #[serde(default = "all_shapers", deserialize_with = "null_shapers")]
+    #[rule(min_items = 1, max_items = MAX_SHAPERS)]
+    #[schema(example = json!(["none", "zv", "zvd", "ei"]))]
     pub shapers: Vec<ShaperIn>,
     /// EI's tolerable residual vibration `V` (fraction of the unshaped one). Default 0.05.
-    #[serde(default = "default_ei_tolerance")]
+    #[serde(
+        default = "default_ei_tolerance",
+        deserialize_with = "null_ei_tolerance"
+    )]
+    #[rule(range = EI_TOLERANCE)]
     #[schema(example = 0.05)]
     pub ei_tolerance: f64,
 }
@@ -321,14 +356,17 @@ impl Default for OutputsIn {
 pub struct TimeHistoryIn {
     /// Uniform samples on [0, T], both ends included (0 = none).
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
+    #[rule(range = HISTORY_SAMPLES)]
     #[schema(example = 200)]
     pub n_samples: u64,
     /// Length of the free-vibration window after T \[s\].
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
+    #[rule(range = WINDOW_AFTER)]
     #[schema(example = 0.5)]
     pub t_after_s: f64,
     /// Samples in (T, T + t_after_s].
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
+    #[rule(range = HISTORY_SAMPLES)]
     #[schema(example = 100)]
     pub n_after: u64,
 }
@@ -339,7 +377,8 @@ pub struct TimeHistoryIn {
 #[serde(deny_unknown_fields)]
 pub struct SensitivityIn {
     /// Factors f: the returned law is evaluated for stiffness `k·f` (J_eq, c, z fixed); ≤ 201.
-    #[schema(max_items = 201, example = json!([0.8, 0.9, 1.0, 1.1, 1.2]))]
+    #[rule(items = STIFFNESS_FACTOR, max_items = MAX_FACTORS)]
+    #[schema(example = json!([0.8, 0.9, 1.0, 1.1, 1.2]))]
     pub stiffness_factors: Vec<f64>,
 }
 
@@ -706,40 +745,4 @@ pub struct FactorEnergyOut {
     /// Residual energy E(T) \[J\].
     #[serde(rename = "E_T_J")]
     pub e_t_j: f64,
-}
-
-// The documented bounds: the validator (input.rs) checks the same constants.
-crate::schema_bounds! {
-    BezierMotionRequest {
-        time_limit_ms: crate::calc::common::TIME_LIMIT_MS,
-    },
-    SystemIn {
-        inertias_kgm2 @items: INERTIA,
-        j_eq_kgm2 as "J_eq_kgm2": J_EQ,
-        k_nm_per_rad as "k_Nm_per_rad": STIFFNESS,
-        c_nms_per_rad as "c_Nms_per_rad": DAMPING,
-        z: RATIO,
-    },
-    MotionIn {
-        phi_rad as "Phi_rad": PHI,
-        phi_rev as "Phi_rev": PHI,
-        t_s as "T_s": MOTION_TIME,
-        m: ORDER_M,
-        p: FREE_P,
-        gamma_rad @items: GAMMA,
-    },
-    OptimizeIn {
-        robust_stiffness_rel: ROBUST_REL,
-    },
-    TimeHistoryIn {
-        n_samples: HISTORY_SAMPLES,
-        t_after_s: WINDOW_AFTER,
-        n_after: HISTORY_SAMPLES,
-    },
-    SensitivityIn {
-        stiffness_factors @items: STIFFNESS_FACTOR,
-    },
-    ShaperComparisonIn {
-        ei_tolerance: EI_TOLERANCE,
-    },
 }
