@@ -90,7 +90,6 @@ impl FieldRules {
 #[derive(Default)]
 struct ContainerRules {
     code: Option<LitStr>,
-    legacy_nulls: bool,
     /// Groups of exactly-one fields, and whether a failure points at the object (else the field).
     one_of: Vec<(Vec<LitStr>, bool)>,
 }
@@ -187,9 +186,7 @@ fn container_rules(attrs: &[Attribute]) -> syn::Result<ContainerRules> {
             if m.path.is_ident("code") {
                 r.code = Some(m.value()?.parse()?);
                 Ok(())
-            } else if m.path.is_ident("legacy_nulls") {
-                r.legacy_nulls = true;
-                Ok(())
+
             } else if m.path.is_ident("one_of") || m.path.is_ident("one_of_object") {
                 let content;
                 syn::parenthesized!(content in m.input);
@@ -373,7 +370,6 @@ fn named_fields<'a>(
     fields: &'a syn::FieldsNamed,
     rename_all: Option<&str>,
     container_default: bool,
-    legacy_nulls: bool,
     access: impl Fn(&syn::Ident) -> Ts,
     schema_base: &str,
 ) -> syn::Result<Vec<FieldSpec<'a>>> {
@@ -394,7 +390,7 @@ fn named_fields<'a>(
             continue;
         }
         let optional = sf.default || container_default;
-        if optional && !legacy_nulls && !is_option(&field.ty) && !sf.custom_de {
+        if optional && !is_option(&field.ty) && !sf.custom_de {
             return Err(syn::Error::new(
                 field.ty.span(),
                 "an optional field must read `null` as absent: make it an `Option` or add \
@@ -450,7 +446,6 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                 named,
                 sc.rename_all.as_deref(),
                 sc.default,
-                cr.legacy_nulls,
                 |i| quote!(&self.#i),
                 "",
             )?;
@@ -542,7 +537,6 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                             named,
                             var_rename_all.as_deref(),
                             false,
-                            cr.legacy_nulls,
                             |i| {
                                 let b = bound(i);
                                 quote!(#b)

@@ -1,14 +1,7 @@
-//! One source for every documented bound of a request field.
-//!
-//! A bound is a [`Range`] constant in the module's `wire.rs`. The same constant is used twice:
-//! by the module's validator ([`Validator::range`](crate::calc::Validator::range)), which rejects a
-//! value outside it with a JSON pointer, and by the module's [`schema_bounds!`](crate::schema_bounds)
-//! table, from which the OpenAPI document's `minimum` / `maximum` / `exclusiveMinimum` /
-//! `exclusiveMaximum` are written (no bound is written as a `#[schema]` literal). A contract test
-//! probes every documented bound over HTTP just inside and just outside, so a bound that the code
-//! enforces and the document does not state, or the reverse, fails a test.
+//! The range of a request number: a [`Range`] constant in the module's `wire.rs`, named by the
+//! field's `#[rule(range = ..)]` (see [`crate::calc::rules`]), which both the check at the door
+//! and the OpenAPI document read.
 
-use std::borrow::Cow;
 use std::fmt;
 
 /// A closed, half-open or open interval of admissible values; every admissible value is finite.
@@ -160,71 +153,6 @@ fn num(x: f64) -> String {
     } else {
         format!("{x}")
     }
-}
-
-/// A bound on one property of one wire type, for the OpenAPI document.
-#[derive(Debug, Clone)]
-pub struct SchemaBound {
-    /// The schema name of the wire type (`ToSchema::name`), e.g. `cognates.Links`.
-    pub schema: Cow<'static, str>,
-    /// The property as it appears on the wire, or a JSON pointer into the schema starting with
-    /// `/` (for fields of enum variants, which are rendered inline).
-    pub property: &'static str,
-    /// The bound applies to each item of an array property, not to the property itself.
-    pub items: bool,
-    /// The bound.
-    pub range: Range,
-}
-
-impl SchemaBound {
-    /// A bound at a JSON pointer inside the schema of `T` (fields of enum variants and items of
-    /// untagged alternatives, which the document renders inline).
-    #[must_use]
-    pub fn at<T: utoipa::ToSchema>(pointer: &'static str, range: Range) -> Self {
-        Self {
-            schema: T::name(),
-            property: pointer,
-            items: false,
-            range,
-        }
-    }
-}
-
-/// Declares the documented bounds of a module's wire types, one line per field; expands to
-/// `pub fn schema_bounds() -> Vec<SchemaBound>`. Each field is checked to exist at compile time.
-///
-/// ```ignore
-/// pub const LENGTH: Range = Range::FINITE.gt(0.0).max(1e100);
-/// mechcalc::schema_bounds! {
-///     Links { a: LENGTH, b: LENGTH },
-///     Samples { values @items: Range::FINITE },   // each array item
-///     Gear { z2 as "Z2": Z2_RANGE },              // wire name differs from the Rust field
-/// }
-/// ```
-#[macro_export]
-macro_rules! schema_bounds {
-    ($( $ty:ty { $( $field:ident $(@$items:ident)? $(as $wire:literal)? : $range:expr ),* $(,)? } ),* $(,)?) => {
-        /// The documented bounds of this module's wire types (written into the OpenAPI document).
-        #[must_use]
-        pub fn schema_bounds() -> ::std::vec::Vec<$crate::calc::bounds::SchemaBound> {
-            let mut v = ::std::vec::Vec::new();
-            $($(
-                {
-                    // Fails to compile when the field does not exist.
-                    let _ = |x: &$ty| { let _ = &x.$field; };
-                    let property: &'static str = [$($wire,)? stringify!($field)][0];
-                    let items = false $( || stringify!($items) == "items" )?;
-                    v.push($crate::calc::bounds::SchemaBound {
-                        schema: <$ty as ::utoipa::ToSchema>::name(),
-                        property,
-                        items,
-                        range: $range,
-                    });
-                }
-            )*)*
-            v
-        }
-    };
 }
 
 #[cfg(test)]

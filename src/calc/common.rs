@@ -413,12 +413,6 @@ pub const RESPONSE_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
      fits the service's --max-response-bytes; the failure points at the option driving its size.",
 );
 
-/// Empty: the per-field rules of the shared types are declared on the types (`#[rule]`).
-#[must_use]
-pub fn schema_bounds() -> Vec<crate::calc::SchemaBound> {
-    Vec::new()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -23,7 +23,7 @@ pub mod rules;
 pub mod spatial_coupling;
 pub mod vibration_absorber;
 
-pub use bounds::{Range, SchemaBound};
+pub use bounds::Range;
 pub use problem::{CalcFailure, FieldIssue, INVALID_INPUT, ProblemClass, Validator};
 pub use rules::{CrossRule, Rules};
 
@@ -48,14 +48,4 @@ pub fn document_rules() -> rules::DocRules {
         .of::<machining_size::wire::GbdtModel>()
         .of::<spatial_coupling::SpatialCouplingRequest>()
         .of::<vibration_absorber::VibrationAbsorberRequest>()
-}
-
-/// Every module's documented request bounds (the `schema_bounds!` tables), for the OpenAPI
-/// document.
-#[must_use]
-pub fn schema_bounds() -> Vec<SchemaBound> {
-    [
-        common::schema_bounds(),
-    ]
-    .concat()
 }

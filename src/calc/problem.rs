@@ -96,7 +96,7 @@ pub const INVALID_INPUT: &str = "INVALID_INPUT";
 /// Each problem carries a JSON pointer, a message naming the quantity, the value and the broken
 /// limit, and a code (`INVALID_INPUT` unless the module's spec names another, e.g.
 /// `NON_POSITIVE_LENGTH`). Range checks take a [`Range`] constant: the same constant the module's
-/// [`schema_bounds!`](crate::schema_bounds) table writes into the OpenAPI document.
+/// field's `#[rule]` writes into the OpenAPI document.
 ///
 /// ```
 /// use mechcalc::calc::{Range, Validator};

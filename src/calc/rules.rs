@@ -813,19 +813,23 @@ mod tests {
     }
 
     #[test]
-    fn one_of_counts_given_fields() {
+    fn one_of_counts_given_fields_and_points_at_the_field_or_the_object() {
         let mut v = Validator::new();
-        one_of(&[("a", true), ("b", false)], None, At::Root, &mut v);
+        one_of(&[("a", true), ("b", false)], None, false, At::Root, &mut v);
         assert!(v.is_clean());
+        let p = At::Root.key("p");
+        one_of(&[("a", true), ("b", true)], Some("X"), false, p, &mut v);
+        one_of(&[("a", false), ("b", false)], None, false, At::Root, &mut v);
         one_of(
             &[("a", true), ("b", true)],
-            Some("X"),
-            At::Root.key("p"),
+            None,
+            true,
+            At::Root.key("q"),
             &mut v,
         );
-        one_of(&[("a", false), ("b", false)], None, At::Root, &mut v);
-        let e = v.finish().expect_err("two groups are broken");
-        assert_eq!(e.errors[0].pointer, "/p");
+        let e = v.finish().expect_err("three groups are broken");
+        let pointers: Vec<&str> = e.errors.iter().map(|i| i.pointer.as_str()).collect();
+        assert_eq!(pointers, ["/p/b", "/a", "/q"]);
         assert_eq!(
             e.errors[0].detail,
             "X: give exactly one of `a` or `b`, got both"

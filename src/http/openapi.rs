@@ -4,9 +4,10 @@
 //! * Schema names are module-qualified (`cognates.Meta`); [`Registry`] records every schema a
 //!   route brings and reports two different Rust types that map to one name (utoipa would keep
 //!   one of them silently).
-//! * Bounds (`minimum`, `maximum`, `exclusiveMinimum`, `exclusiveMaximum`) are written from the
-//!   modules' [`schema_bounds`](crate::calc::schema_bounds) tables; a bound written anywhere else
-//!   is reported by [`document_problems`].
+//! * Per-field rules (`minimum`, `maximum`, `exclusiveMinimum`, `exclusiveMaximum`, `minItems`,
+//!   `maxItems`, `minLength`, `maxLength`, `oneOf` groups) are written from the `#[rule]`
+//!   declarations ([`crate::calc::document_rules`]); a bound written anywhere else is reported by
+//!   [`document_problems`]. Each operation lists its rules between fields (`x-cross-field-rules`).
 //! * Internally tagged request enums (`{"model": "constant", ...}`) are rewritten so the tag is a
 //!   property of each variant's own closed object and the `oneOf` carries a discriminator: utoipa
 //!   renders them as `allOf[{closed object}, {tag}]`, which no instance can satisfy.
@@ -20,8 +21,8 @@ use utoipa::openapi::path::Paths;
 use utoipa::openapi::{RefOr, schema::Schema};
 use utoipa_axum::router::OpenApiRouter;
 
+use crate::calc::Range;
 use crate::calc::rules::{DocRules, Kind};
-use crate::calc::{Range, SchemaBound};
 
 use super::AppState;
 
@@ -102,7 +103,6 @@ fn build() -> (Value, Vec<String>) {
         for s in schemas.values_mut() {
             unsigned_32_bit_range(s);
         }
-        problems.extend(apply_bounds(schemas, &crate::calc::schema_bounds()));
         problems.extend(apply_rules(schemas, &crate::calc::document_rules()));
         close_tagged_enums(schemas);
     }
@@ -175,36 +175,6 @@ fn type_is(schema: &Value, ty: &str) -> bool {
         Some(Value::Array(a)) => a.iter().any(|t| t == ty),
         _ => false,
     }
-}
-
-/// Writes each bound into its property's schema; returns the bounds that name no property.
-fn apply_bounds(schemas: &mut Map<String, Value>, bounds: &[SchemaBound]) -> Vec<String> {
-    let mut missing = Vec::new();
-    for b in bounds {
-        // A property name, or a JSON pointer into the schema (fields of enum variants, which
-        // utoipa renders inline: `/oneOf/0/properties/d`).
-        let target = schemas
-            .get_mut(b.schema.as_ref())
-            .and_then(|s| {
-                if b.property.starts_with('/') {
-                    s.pointer_mut(b.property)
-                } else {
-                    s.get_mut("properties").and_then(|p| p.get_mut(b.property))
-                }
-            })
-            .and_then(|p| if b.items { p.get_mut("items") } else { Some(p) })
-            .and_then(Value::as_object_mut);
-        match target {
-            Some(t) => write_range(t, &b.range),
-            None => missing.push(format!(
-                "bound for {}.{}{} names no property of the document",
-                b.schema,
-                b.property,
-                if b.items { "[]" } else { "" }
-            )),
-        }
-    }
-    missing
 }
 
 /// Writes each declared rule ([`crate::calc::rules`]) into its schema; returns the rules whose

@@ -308,7 +308,6 @@ fn default_ei_tolerance() -> f64 {
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = bezier_motion::ShaperComparisonIn)]
 #[serde(deny_unknown_fields)]
-#[rules(legacy_nulls)]
 pub struct ShaperComparisonIn {
     /// Baseline move. Default `trapezoid`.
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
