@@ -361,8 +361,48 @@ fn document_field(f: &FieldSpec<'_>) -> (Vec<Ts>, Ts) {
             string: <#ty as crate::calc::rules::HasLen>::STRING,
         });));
     }
+    // A fixed-size array's length is part of the Rust type (serde enforces it): the document
+    // states it too, for the field itself or each item of a list of them.
+    if let Some((len, items)) = fixed_array(ty) {
+        let p = if items {
+            format!("{p}/items")
+        } else {
+            p.clone()
+        };
+        pushes.push(quote!(out.push(&schema, #p, crate::calc::rules::Kind::Len {
+            min: ::core::option::Option::Some(#len), max: ::core::option::Option::Some(#len),
+            string: false,
+        });));
+    }
     let recurse = quote!(<#ty as crate::calc::rules::Rules>::document_rules(out););
     (pushes, recurse)
+}
+
+/// `[T; N]`, `Option<[T; N]>` (the field: `false`) or `Vec<[T; N]>`, `Option<Vec<[T; N]>>` (each
+/// item: `true`), with `N`.
+fn fixed_array(ty: &Type) -> Option<(Expr, bool)> {
+    fn inner(ty: &Type, name: &str) -> Option<Type> {
+        let Type::Path(p) = ty else { return None };
+        let seg = p.path.segments.last()?;
+        if seg.ident != name {
+            return None;
+        }
+        let syn::PathArguments::AngleBracketed(a) = &seg.arguments else {
+            return None;
+        };
+        match a.args.first()? {
+            syn::GenericArgument::Type(t) => Some(t.clone()),
+            _ => None,
+        }
+    }
+    let ty = inner(ty, "Option").unwrap_or_else(|| ty.clone());
+    if let Type::Array(a) = &ty {
+        return Some((a.len.clone(), false));
+    }
+    if let Some(Type::Array(a)) = inner(&ty, "Vec") {
+        return Some((a.len.clone(), true));
+    }
+    None
 }
 
 /// The named fields of a struct or struct variant.

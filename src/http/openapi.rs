@@ -291,8 +291,14 @@ fn document_cross_field_rules(doc: &mut Value) {
 
 /// A bound as JSON Schema 2020-12 keywords; integer ranges are written as integers.
 pub fn write_range(t: &mut Map<String, Value>, r: &Range) {
-    for k in ["minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"] {
-        t.remove(k);
+    // A side the rule leaves open keeps the bound of the Rust type (e.g. a u32's maximum).
+    if r.has_lo() {
+        t.remove("minimum");
+        t.remove("exclusiveMinimum");
+    }
+    if r.has_hi() {
+        t.remove("maximum");
+        t.remove("exclusiveMaximum");
     }
     let num = |x: f64| -> Value {
         if r.integer && x.fract() == 0.0 && x.abs() < 9.0e15 {
@@ -593,6 +599,16 @@ fn document_alternative_media_types(doc: &mut Value) {
 fn unsigned_32_bit_range(v: &mut Value) {
     match v {
         Value::Object(m) => {
+            // utoipa writes u64 as `format: int64, minimum: 0`, which validators bound at 2^63 − 1
+            // while the service accepts every u64: say so.
+            let unsigned64 = m.get("format").and_then(Value::as_str) == Some("int64")
+                && m.get("minimum").and_then(Value::as_f64) == Some(0.0)
+                && m.get("maximum").is_none()
+                && type_is(&Value::Object(m.clone()), "integer");
+            if unsigned64 {
+                m.insert("format".to_owned(), json!("uint64"));
+                m.insert("maximum".to_owned(), json!(u64::MAX));
+            }
             let unsigned32 = m.get("format").and_then(Value::as_str) == Some("int32")
                 && m.get("minimum").and_then(Value::as_f64) == Some(0.0)
                 && type_is(&Value::Object(m.clone()), "integer");

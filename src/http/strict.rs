@@ -26,21 +26,34 @@ macro_rules! forward {
     )*};
 }
 
+/// Forwards an integer `deserialize_*` method: JSON Schema's `integer` admits `3.0`, so a whole
+/// number written with a fraction part reads as that integer (range checks stay the visitor's).
+macro_rules! integer {
+    ($($method:ident),* $(,)?) => {$(
+        fn $method<V: Visitor<'de>>(self, visitor: V) -> Result<V::Value, D::Error> {
+            self.0.$method(Integer(visitor))
+        }
+    )*};
+}
+
 impl<'de, D: Deserializer<'de>> Deserializer<'de> for Strict<D> {
     type Error = D::Error;
 
-    forward!(
-        deserialize_any,
-        deserialize_bool,
+    integer!(
         deserialize_i8,
         deserialize_i16,
         deserialize_i32,
         deserialize_i64,
-        deserialize_i128,
         deserialize_u8,
         deserialize_u16,
         deserialize_u32,
         deserialize_u64,
+    );
+
+    forward!(
+        deserialize_any,
+        deserialize_bool,
+        deserialize_i128,
         deserialize_u128,
         deserialize_f32,
         deserialize_f64,
@@ -175,6 +188,62 @@ impl<'de, V: Visitor<'de>> Visitor<'de> for Object<V> {
     }
 }
 
+/// An integer's visitor: a whole `f64` (below 2^53 in magnitude, so exact) is passed on as an
+/// integer; everything else as it came.
+struct Integer<V>(V);
+
+/// Whole numbers up to this magnitude are exact in an `f64`.
+const EXACT_INTEGER: f64 = 9_007_199_254_740_992.0;
+
+impl<'de, V: Visitor<'de>> Visitor<'de> for Integer<V> {
+    type Value = V::Value;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.0.expecting(f)
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Self::Value, E> {
+        self.0.visit_i64(v)
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Self::Value, E> {
+        self.0.visit_u64(v)
+    }
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        reason = "whole and below 2^53 in magnitude: the conversion is exact"
+    )]
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<Self::Value, E> {
+        if v.fract() == 0.0 && v.abs() <= EXACT_INTEGER {
+            if v >= 0.0 {
+                self.0.visit_u64(v as u64)
+            } else {
+                self.0.visit_i64(v as i64)
+            }
+        } else {
+            self.0.visit_f64(v)
+        }
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
+        self.0.visit_str(v)
+    }
+    fn visit_bool<E: de::Error>(self, v: bool) -> Result<Self::Value, E> {
+        self.0.visit_bool(v)
+    }
+    fn visit_none<E: de::Error>(self) -> Result<Self::Value, E> {
+        self.0.visit_none()
+    }
+    fn visit_unit<E: de::Error>(self) -> Result<Self::Value, E> {
+        self.0.visit_unit()
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+        self.0.visit_seq(Seq(seq))
+    }
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+        self.0.visit_map(Map(map))
+    }
+}
+
 /// A seed whose value is read strictly.
 struct Seed<S>(S);
 
@@ -287,6 +356,30 @@ mod tests {
     fn read(s: &str) -> Result<Outer, serde_json::Error> {
         let mut de = serde_json::Deserializer::from_str(s);
         Outer::deserialize(Strict(&mut de))
+    }
+
+    #[derive(Debug, Deserialize, PartialEq)]
+    struct Counts {
+        n: u32,
+        m: Option<i64>,
+    }
+
+    #[test]
+    fn whole_numbers_with_a_fraction_part_read_as_integers() {
+        let read = |s: &str| {
+            let mut de = serde_json::Deserializer::from_str(s);
+            Counts::deserialize(Strict(&mut de))
+        };
+        assert_eq!(
+            read(r#"{"n": 621.0, "m": -3.0}"#).expect("whole numbers"),
+            Counts {
+                n: 621,
+                m: Some(-3)
+            }
+        );
+        assert!(read(r#"{"n": 621.5, "m": null}"#).is_err());
+        assert!(read(r#"{"n": -1.0, "m": null}"#).is_err());
+        assert!(read(r#"{"n": 5e9, "m": null}"#).is_err());
     }
 
     #[test]

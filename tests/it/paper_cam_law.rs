@@ -641,10 +641,11 @@ fn rejections_carry_pointers() {
                 "constraints": {"t_a": 0.0, "t_b": 1.0, "s_b": 5e12},
                 "abscissa": {"grid": {"start": 0.0, "end": 1.0, "count": 0}}
             }),
+            // Listed in the order of the request's fields (the door walks them in order).
             vec![
                 "/coefficients/1",
-                "/abscissa/grid/count",
                 "/constraints/s_b",
+                "/abscissa/grid/count",
             ],
         ),
     ];

@@ -17,8 +17,9 @@ pub const ABSCISSA: Range = Range::closed(0.0, 1e3);
 pub const MODULUS: Range = Range::FINITE.gt(0.0).max(1e13);
 /// Density [kg/m³].
 pub const DENSITY: Range = Range::FINITE.gt(0.0).max(1e6);
-/// Section area \[m²\], second moment \[m⁴\], section width/thickness \[m\].
-pub const SECTION: Range = Range::FINITE.gt(0.0).max(1e2);
+/// Section area \[m²\], second moment \[m⁴\], section width/thickness \[m\]: at least 1e-30 (below
+/// it the bending stiffness EI underflows and the modes are not finite).
+pub const SECTION: Range = Range::FINITE.min(1e-30).max(1e2);
 /// Modes kept (spec §2: 1…50; mode-shape cost and overflow beyond).
 pub const N_MODES: Range = Range::int(1, 50);
 /// Mode index of a `{mode: k}` reference (also ≤ `beam.n_modes`).
