@@ -363,12 +363,8 @@ fn document_field(f: &FieldSpec<'_>) -> (Vec<Ts>, Ts) {
     }
     // A fixed-size array's length is part of the Rust type (serde enforces it): the document
     // states it too, for the field itself or each item of a list of them.
-    if let Some((len, items)) = fixed_array(ty) {
-        let p = if items {
-            format!("{p}/items")
-        } else {
-            p.clone()
-        };
+    for (len, suffix) in fixed_arrays(ty) {
+        let p = format!("{p}{suffix}");
         pushes.push(quote!(out.push(&schema, #p, crate::calc::rules::Kind::Len {
             min: ::core::option::Option::Some(#len), max: ::core::option::Option::Some(#len),
             string: false,
@@ -378,9 +374,9 @@ fn document_field(f: &FieldSpec<'_>) -> (Vec<Ts>, Ts) {
     (pushes, recurse)
 }
 
-/// `[T; N]`, `Option<[T; N]>` (the field: `false`) or `Vec<[T; N]>`, `Option<Vec<[T; N]>>` (each
-/// item: `true`), with `N`.
-fn fixed_array(ty: &Type) -> Option<(Expr, bool)> {
+/// The fixed lengths inside a field's type, with where they apply: `[T; N]` and `Option<[T; N]>`
+/// at the field itself, `Vec<[T; N]>` at each item, and nested arrays (`[[T; 2]; 2]`) below.
+fn fixed_arrays(ty: &Type) -> Vec<(Expr, String)> {
     fn inner(ty: &Type, name: &str) -> Option<Type> {
         let Type::Path(p) = ty else { return None };
         let seg = p.path.segments.last()?;
@@ -395,14 +391,19 @@ fn fixed_array(ty: &Type) -> Option<(Expr, bool)> {
             _ => None,
         }
     }
+    fn arrays(ty: &Type, at: String, out: &mut Vec<(Expr, String)>) {
+        if let Type::Array(a) = ty {
+            out.push((a.len.clone(), at.clone()));
+            arrays(&a.elem, format!("{at}/items"), out);
+        }
+    }
     let ty = inner(ty, "Option").unwrap_or_else(|| ty.clone());
-    if let Type::Array(a) = &ty {
-        return Some((a.len.clone(), false));
+    let mut out = Vec::new();
+    match inner(&ty, "Vec") {
+        Some(item) => arrays(&item, "/items".to_owned(), &mut out),
+        None => arrays(&ty, String::new(), &mut out),
     }
-    if let Some(Type::Array(a)) = inner(&ty, "Vec") {
-        return Some((a.len.clone(), true));
-    }
-    None
+    out
 }
 
 /// The named fields of a struct or struct variant.

@@ -640,6 +640,39 @@ where
     Ok(Option::<T>::deserialize(d)?.unwrap_or_default())
 }
 
+/// `deserialize_with` of an integer field inside an internally tagged enum (serde buffers those,
+/// so the door's strict reader does not see them): a whole number written with a fraction part
+/// (`8.0`, an integer to JSON Schema) reads as that integer; a fraction or a value out of range
+/// is refused.
+///
+/// # Errors
+/// The value is not a whole number in the type's range.
+pub fn whole<'de, D, T>(d: D) -> Result<T, D::Error>
+where
+    D: Deserializer<'de>,
+    T: TryFrom<u64>,
+{
+    let x = serde_json::Number::deserialize(d)?;
+    let n = x.as_u64().or_else(|| {
+        x.as_f64()
+            .filter(|f| f.fract() == 0.0 && (0.0..=9_007_199_254_740_992.0).contains(f))
+            .map(|f| {
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    clippy::cast_sign_loss,
+                    reason = "whole, non-negative and below 2^53: exact"
+                )]
+                let n = f as u64;
+                n
+            })
+    });
+    n.and_then(|n| T::try_from(n).ok()).ok_or_else(|| {
+        serde::de::Error::custom(format!(
+            "invalid value: {x}, expected a whole number in range"
+        ))
+    })
+}
+
 /// `deserialize_with` of an optional boolean whose default is `true`: `null` reads as `true`.
 ///
 /// # Errors

@@ -13,8 +13,9 @@ use crate::numerics::SolverReport;
 pub const INERTIA: Range = Range::closed(0.0, 1e12);
 /// Equivalent inertia `J_eq` [kg m²].
 pub const J_EQ: Range = Range::FINITE.gt(0.0).max(1e12);
-/// Joint stiffness `k` [N m/rad].
-pub const STIFFNESS: Range = Range::FINITE.gt(0.0).max(1e15);
+/// Joint stiffness `k` [N m/rad]: at least 1e-6 (a softer joint with the largest inertia and
+/// damping drives the damping ratio past what f64 can carry through the end state).
+pub const STIFFNESS: Range = Range::FINITE.min(1e-6).max(1e15);
 /// Joint damping `c` [N m s/rad].
 pub const DAMPING: Range = Range::closed(0.0, 1e15);
 /// Reducer ratio `z` (≠ 0 is checked too).

@@ -473,6 +473,7 @@ pub struct DowellSpec {
     /// Number of conductor layers m in the slot [-] (1..100).
     #[schema(example = 6)]
     #[rule(range = LAYERS)]
+    #[serde(deserialize_with = "crate::calc::rules::whole")]
     pub layers: u32,
     /// Layer porosity factor (0, 1] [-].
     #[schema(example = 0.9)]
@@ -534,6 +535,7 @@ pub struct IpmsmMotor {
     /// Pole pairs p (1..32).
     #[schema(example = 4)]
     #[rule(range = POLE_PAIRS)]
+    #[serde(deserialize_with = "crate::calc::rules::whole")]
     pub pole_pairs: u32,
     /// Peak phase PM flux linkage ψ_m \[Wb\] (give this or `back_emf`).
     #[schema(example = 0.198864)]

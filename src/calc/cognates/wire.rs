@@ -93,12 +93,12 @@ pub struct GroundSpec {
     #[serde(rename = "A", default, skip_serializing_if = "Option::is_none")]
     #[rule(items = COORDINATE)]
     #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([0.0, 0.0]))]
-    pub a: Option<Point>,
+    pub a: Option<[f64; 2]>,
     /// Output pivot B \[length\], ≠ A.
     #[serde(rename = "B", default, skip_serializing_if = "Option::is_none")]
     #[rule(items = COORDINATE)]
     #[schema(nullable = false, value_type = Option<[f64; 2]>, example = json!([3.1, 0.0]))]
-    pub b: Option<Point>,
+    pub b: Option<[f64; 2]>,
     /// Ground length `l` = |B − A| \[length\], > 0 (instead of `B`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[rule(range = LENGTH, code = "NON_POSITIVE_LENGTH")]

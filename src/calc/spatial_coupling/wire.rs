@@ -80,7 +80,7 @@ pub struct SpatialCouplingRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[rule(items_items = BODY3_COORD_M, max_items = MAX_BODY3_POINTS)]
     #[schema(nullable = false, value_type = Vec<[f64; 3]>)]
-    pub body3_points_m: Option<Vec<Vec3>>,
+    pub body3_points_m: Option<Vec<[f64; 3]>>,
     /// Optional output groups (spec §5); each costs O(1) per point.
     #[serde(default, deserialize_with = "crate::calc::rules::null_default")]
     pub outputs: OutputsIn,
