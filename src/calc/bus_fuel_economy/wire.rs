@@ -1183,38 +1183,42 @@ pub const R0_OHM: Range = Range::FINITE.gt(0.0).max(100.0);
 pub const RC_OHM: Range = Range::closed(0.0, 100.0);
 /// RC-branch capacitance C1, C2 \[F\]: > 0 (spec §2).
 pub const RC_F: Range = Range::FINITE.gt(0.0).max(1e9);
+/// Smallest positive motor parameter accepted: far below any physical motor, above the subnormal
+/// values whose products and quotients leave f64 (a fuzzer found an inductance of 8e-230 with
+/// sizes of 5e-324 driving the map to non-finite numbers).
+pub const MOTOR_FLOOR: f64 = 1e-12;
 /// Torque [N·m] (peak, cap, envelope values): positive.
-pub const TORQUE_NM: Range = Range::FINITE.gt(0.0).max(1e6);
+pub const TORQUE_NM: Range = Range::FINITE.min(MOTOR_FLOOR).max(1e6);
 /// Power \[W\] (peak, cap): positive.
-pub const POWER_W: Range = Range::FINITE.gt(0.0).max(1e9);
+pub const POWER_W: Range = Range::FINITE.min(MOTOR_FLOOR).max(1e9);
 /// Motor top speed \[rpm\].
-pub const N_MAX_RPM: Range = Range::FINITE.gt(0.0).max(1e5);
+pub const N_MAX_RPM: Range = Range::FINITE.min(MOTOR_FLOOR).max(1e5);
 /// Pole pairs [–].
 pub const POLE_PAIRS: Range = Range::int(1, 32);
 /// Permanent-magnet flux linkage ψ_m \[Wb\].
-pub const PSI_M_WB: Range = Range::FINITE.gt(0.0).max(100.0);
+pub const PSI_M_WB: Range = Range::FINITE.min(MOTOR_FLOOR).max(100.0);
 /// Back-EMF peak phase voltage \[V\] and its speed \[rpm\].
-pub const BACK_EMF: Range = Range::FINITE.gt(0.0).max(1e5);
+pub const BACK_EMF: Range = Range::FINITE.min(MOTOR_FLOOR).max(1e5);
 /// d- and q-axis inductance \[H\].
-pub const INDUCTANCE_H: Range = Range::FINITE.gt(0.0).max(1.0);
+pub const INDUCTANCE_H: Range = Range::FINITE.min(MOTOR_FLOOR).max(1.0);
 /// Phase resistance at 20 °C \[Ω\].
-pub const R_PHASE_OHM: Range = Range::FINITE.gt(0.0).max(100.0);
+pub const R_PHASE_OHM: Range = Range::FINITE.min(MOTOR_FLOOR).max(100.0);
 /// Winding temperature [°C] (spec §2).
 pub const WINDING_TEMP_C: Range = Range::closed(-40.0, 250.0);
 /// Current limit [A rms] and DC-link voltage \[V\].
-pub const ELECTRIC_LIMIT: Range = Range::FINITE.gt(0.0).max(1e5);
+pub const ELECTRIC_LIMIT: Range = Range::FINITE.min(MOTOR_FLOOR).max(1e5);
 /// Voltage utilisation [–] (≤ 2/√3 with space-vector modulation).
-pub const VOLTAGE_UTILIZATION: Range = Range::FINITE.gt(0.0).max(1.155);
+pub const VOLTAGE_UTILIZATION: Range = Range::FINITE.min(MOTOR_FLOOR).max(1.155);
 /// Stack scale [–].
-pub const STACK_SCALE: Range = Range::FINITE.gt(0.0).max(10.0);
+pub const STACK_SCALE: Range = Range::FINITE.min(MOTOR_FLOOR).max(10.0);
 /// Dowell conductor height \[m\].
-pub const CONDUCTOR_HEIGHT_M: Range = Range::FINITE.gt(0.0).max(0.1);
+pub const CONDUCTOR_HEIGHT_M: Range = Range::FINITE.min(MOTOR_FLOOR).max(0.1);
 /// Dowell conductor layers [–].
 pub const LAYERS: Range = Range::int(1, 100);
 /// Dowell porosity [–].
-pub const POROSITY: Range = Range::FINITE.gt(0.0).max(1.0);
+pub const POROSITY: Range = Range::FINITE.min(MOTOR_FLOOR).max(1.0);
 /// Stack length \[m\].
-pub const STACK_LENGTH_M: Range = Range::FINITE.gt(0.0).max(10.0);
+pub const STACK_LENGTH_M: Range = Range::FINITE.min(MOTOR_FLOOR).max(10.0);
 /// End-winding length \[m\].
 pub const END_LENGTH_M: Range = Range::closed(0.0, 10.0);
 /// Iron and mechanical loss coefficients (k_h, k_e, c_fric, c_wind): ≥ 0 (spec §2).

@@ -205,27 +205,27 @@ pub struct JointsSpec {
     #[serde(rename = "A")]
     #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
-    pub a: Point,
+    pub a: [f64; 2],
     /// Output pivot B \[length\].
     #[serde(rename = "B")]
     #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
-    pub b: Point,
+    pub b: [f64; 2],
     /// Crank joint D \[length\].
     #[serde(rename = "D")]
     #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
-    pub d: Point,
+    pub d: [f64; 2],
     /// Rocker joint E \[length\].
     #[serde(rename = "E")]
     #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
-    pub e: Point,
+    pub e: [f64; 2],
     /// Coupler point P \[length\].
     #[serde(rename = "P")]
     #[rule(items = COORDINATE)]
     #[schema(value_type = [f64; 2])]
-    pub p: Point,
+    pub p: [f64; 2],
 }
 
 /// Reference of `input_angle_deg`.
@@ -675,7 +675,7 @@ pub struct JointsOut {
     /// Coupler point P (common to all three).
     #[serde(rename = "P")]
     #[schema(value_type = [f64; 2])]
-    pub p: Point,
+    pub p: [f64; 2],
 }
 
 /// The snapshot configuration as seen by one mechanism (spec §4.4, §4.6).
@@ -887,7 +887,7 @@ pub struct FiveBarSnapshot {
     /// Coupler point \[length\].
     #[serde(rename = "P")]
     #[schema(value_type = [f64; 2])]
-    pub p: Point,
+    pub p: [f64; 2],
     /// Largest deviation of |P − tip_i| from the dyad lengths \[length\].
     pub dyad_residual: f64,
 }
