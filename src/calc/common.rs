@@ -405,6 +405,15 @@ impl ResponseSize {
 /// Code of an answer that would exceed the service's `--max-response-bytes`.
 pub const RESPONSE_TOO_LARGE: &str = "RESPONSE_TOO_LARGE";
 
+/// Every number of an answer is finite (every endpoint lists it): the last guard before an answer
+/// is sent. Reaching it is a defect of the module, logged as an error.
+pub const NON_FINITE_ANSWER_RULE: CrossRule = CrossRule::too_large(
+    "NON_FINITE_ANSWER",
+    &[],
+    "Every number of the answer is finite in f64; inputs at the extremes of their ranges whose \
+     results leave f64 are refused with this code rather than answered with a non-number.",
+);
+
 /// The answer fits the service's `--max-response-bytes` (every endpoint lists it).
 pub const RESPONSE_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
     RESPONSE_TOO_LARGE,

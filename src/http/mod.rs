@@ -338,8 +338,8 @@ fn panic_response(payload: Box<dyn std::any::Any + Send + 'static>) -> Response<
     ApiError::internal().into_response()
 }
 
-/// Serialize a calculation's response as JSON, refusing to send a non-finite number (a bug:
-/// logged, answered with 500).
+/// Serialize a calculation's response as JSON, refusing to send a non-finite number (a defect:
+/// logged as an error, answered with 422 `NON_FINITE_ANSWER`).
 pub fn respond<T: Serialize>(value: &T) -> Result<Response, ApiError> {
     encode(value).map(json_response)
 }
@@ -352,9 +352,16 @@ const ENCODE_CAPACITY: usize = 16 * 1024;
 /// bounded compute pool, not on the threads that accept connections.
 pub fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
     if !finite::all_finite(value) {
+        // Still a defect of the module (logged as an error for the developers), but the client
+        // gets a typed refusal naming the number, never a NaN and never a 500.
         let pointer = finite::first_non_finite(value).unwrap_or_default();
         tracing::error!(%pointer, "calculation produced a non-finite number");
-        return Err(ApiError::internal());
+        return Err(ApiError::from(
+            crate::calc::common::NON_FINITE_ANSWER_RULE.fail_general(format!(
+                "the answer's {pointer} is not a finite number for these inputs (they lie at the \
+                 extremes of their ranges); the service refuses the request rather than send it"
+            )),
+        ));
     }
     // Pre-sized: most answers fit, and a large one (tens of KB) doubles a few times at most.
     let mut body = Vec::with_capacity(ENCODE_CAPACITY);

@@ -105,6 +105,7 @@ fn build() -> (Value, Vec<String>) {
         }
         problems.extend(apply_rules(schemas, &crate::calc::document_rules()));
         close_tagged_enums(schemas);
+        close_inline_variants(schemas);
     }
     let request_roots: Vec<String> = doc
         .get("paths")
@@ -283,6 +284,7 @@ fn document_cross_field_rules(doc: &mut Value) {
         };
         let list: Vec<Value> = rules
             .iter()
+            .chain([&crate::calc::common::NON_FINITE_ANSWER_RULE])
             .map(|r| json!({"code": r.code, "pointers": r.pointers, "rule": r.rule}))
             .collect();
         op.insert("x-cross-field-rules".to_owned(), Value::Array(list));
@@ -329,6 +331,27 @@ pub fn write_range(t: &mut Map<String, Value>, r: &Range) {
             .to_owned(),
             num(r.hi),
         );
+    }
+}
+
+/// Untagged request enums whose inline object alternatives are decoded with unknown members
+/// refused (through a flat raw form with `deny_unknown_fields`).
+const CLOSED_UNTAGGED: &[&str] = &["cognates.CouplerPoint"];
+
+/// The inline object alternatives of those enums refuse unknown members: say so.
+fn close_inline_variants(schemas: &mut Map<String, Value>) {
+    for name in CLOSED_UNTAGGED {
+        let Some(s) = schemas.get_mut(*name) else {
+            continue;
+        };
+        let Some(alts) = s.get_mut("oneOf").and_then(Value::as_array_mut) else {
+            continue;
+        };
+        for a in alts.iter_mut().filter_map(Value::as_object_mut) {
+            if a.contains_key("properties") && !a.contains_key("additionalProperties") {
+                a.insert("additionalProperties".to_owned(), json!(false));
+            }
+        }
     }
 }
 
