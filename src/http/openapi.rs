@@ -129,6 +129,14 @@ fn build() -> (Value, Vec<String>) {
         allow_null_for_optional_request_fields(schemas, &request_roots);
     }
     document_cross_field_rules(&mut doc);
+    // The one service-wide refusal a schema-valid request can meet on every operation.
+    let r = &crate::calc::common::NON_FINITE_ANSWER_RULE;
+    if let Some(root) = doc.as_object_mut() {
+        root.insert(
+            "x-service-rules".to_owned(),
+            json!([{"code": r.code, "pointers": r.pointers, "rule": r.rule}]),
+        );
+    }
     document_alternative_media_types(&mut doc);
     unescape_unit_brackets(&mut doc);
     (doc, problems)
@@ -284,7 +292,6 @@ fn document_cross_field_rules(doc: &mut Value) {
         };
         let list: Vec<Value> = rules
             .iter()
-            .chain([&crate::calc::common::NON_FINITE_ANSWER_RULE])
             .map(|r| json!({"code": r.code, "pointers": r.pointers, "rule": r.rule}))
             .collect();
         op.insert("x-cross-field-rules".to_owned(), Value::Array(list));
@@ -624,7 +631,8 @@ fn unsigned_32_bit_range(v: &mut Value) {
         Value::Object(m) => {
             // utoipa writes u64 as `format: int64, minimum: 0`, which validators bound at 2^63 − 1
             // while the service accepts every u64: say so.
-            let unsigned64 = m.get("format").and_then(Value::as_str) == Some("int64")
+            let format = m.get("format").and_then(Value::as_str);
+            let unsigned64 = matches!(format, None | Some("int64" | "uint64" | "uint"))
                 && m.get("minimum").and_then(Value::as_f64) == Some(0.0)
                 && m.get("maximum").is_none()
                 && type_is(&Value::Object(m.clone()), "integer");
