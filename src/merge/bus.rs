@@ -4,14 +4,11 @@
 //! with paper eq. 11-13 and the request's normalised `desirability_weights`; `report` counters
 //! added.
 
-use std::collections::BTreeMap;
-
 use serde_json::Value;
 
 use crate::calc::bus_fuel_economy::BusFuelEconomyRequest;
-use crate::calc::bus_fuel_economy::compute::{ComparisonData, compare};
+use crate::calc::bus_fuel_economy::compute::compare;
 use crate::calc::bus_fuel_economy::input::BusFuelEconomyInput;
-use crate::calc::bus_fuel_economy::wire::{Comparison, Desirability};
 
 use super::{MergeError, Part, concat, insert_after, remove, report, set, sum_u64};
 
@@ -128,43 +125,8 @@ fn comparison(results: &[Value], request: Option<&Value>) -> Result<Option<Value
         .collect::<Result<_, _>>()?;
     let weights = &input.options.weights;
     let c = compare(&fe, &energy, n_m, n_c, weights);
-    let wire = comparison_wire(&ids, cycles, weights, &c);
+    let wire = crate::calc::bus_fuel_economy::output::comparison_wire(&ids, cycles, weights, &c);
     serde_json::to_value(wire)
         .map(Some)
         .map_err(|e| MergeError::Request(format!("cannot encode the comparison: {e}")))
-}
-
-/// The wire form of a comparison of motors `ids` over `cycles` (as the endpoint builds it).
-fn comparison_wire(
-    ids: &[String],
-    cycles: Vec<String>,
-    weights: &[f64],
-    c: &ComparisonData,
-) -> Comparison {
-    let mut fe_change_pct = BTreeMap::new();
-    let mut desirability = BTreeMap::new();
-    for (mi, id) in ids.iter().enumerate() {
-        if mi > 0 {
-            let row: BTreeMap<String, Option<f64>> = cycles
-                .iter()
-                .cloned()
-                .zip(c.fe_change_pct[mi].iter().copied())
-                .collect();
-            fe_change_pct.insert(id.clone(), row);
-        }
-        desirability.insert(
-            id.clone(),
-            Desirability {
-                d: c.d[mi].clone(),
-                overall: c.overall[mi],
-            },
-        );
-    }
-    Comparison {
-        reference_motor: ids.first().cloned().unwrap_or_default(),
-        cycles,
-        weights: weights.to_vec(),
-        fe_change_pct,
-        desirability,
-    }
 }

@@ -352,8 +352,9 @@ pub fn response_size(input: &BusFuelEconomyInput) -> ResponseSize {
     size
 }
 
-/// The wire form of a comparison of motors `ids` over `cycles`.
-fn comparison_wire(
+/// The wire form of a comparison of motors `ids` over `cycles` (also the merge of sharded
+/// answers, `crate::merge`).
+pub fn comparison_wire(
     ids: &[String],
     cycles: Vec<String>,
     weights: &[f64],
