@@ -186,13 +186,14 @@ fn container_rules(attrs: &[Attribute]) -> syn::Result<ContainerRules> {
             if m.path.is_ident("code") {
                 r.code = Some(m.value()?.parse()?);
                 Ok(())
-
             } else if m.path.is_ident("one_of") || m.path.is_ident("one_of_object") {
                 let content;
                 syn::parenthesized!(content in m.input);
                 let names = Punctuated::<LitStr, Token![,]>::parse_terminated(&content)?;
-                r.one_of
-                    .push((names.into_iter().collect(), m.path.is_ident("one_of_object")));
+                r.one_of.push((
+                    names.into_iter().collect(),
+                    m.path.is_ident("one_of_object"),
+                ));
                 Ok(())
             } else {
                 Err(m.error("unknown container rule: expected code or one_of(\"a\", \"b\", ...)"))
@@ -296,10 +297,14 @@ fn check_field(f: &FieldSpec<'_>, container_code: Option<&LitStr>, at_key: bool)
     };
     let mut body = Vec::new();
     if let Some(e) = &f.rules.range {
-        body.push(quote_spanned!(e.span()=> crate::calc::rules::range(#access, &F, #e, __at, __v);));
+        body.push(
+            quote_spanned!(e.span()=> crate::calc::rules::range(#access, &F, #e, __at, __v);),
+        );
     }
     if let Some(e) = &f.rules.items {
-        body.push(quote_spanned!(e.span()=> crate::calc::rules::items(#access, &F, #e, __at, __v);));
+        body.push(
+            quote_spanned!(e.span()=> crate::calc::rules::items(#access, &F, #e, __at, __v);),
+        );
     }
     if let Some(e) = &f.rules.items_items {
         body.push(
@@ -307,7 +312,9 @@ fn check_field(f: &FieldSpec<'_>, container_code: Option<&LitStr>, at_key: bool)
         );
     }
     if let Some(e) = &f.rules.values {
-        body.push(quote_spanned!(e.span()=> crate::calc::rules::values(#access, &F, #e, __at, __v);));
+        body.push(
+            quote_spanned!(e.span()=> crate::calc::rules::values(#access, &F, #e, __at, __v);),
+        );
     }
     if f.rules.min_len.is_some() || f.rules.max_len.is_some() {
         let min = opt_usize(f.rules.min_len.as_ref());
@@ -507,7 +514,9 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
                 }
                 let code = code_tokens(None, cr.code.as_ref());
                 checks.push(quote!(crate::calc::rules::one_of(&[#(#entries),*], #code, #at_object, __at, __v);));
-                one_of_pushes.push(quote!(out.push(&schema, "", crate::calc::rules::Kind::OneOf(&[#(#wires),*]));));
+                one_of_pushes.push(
+                    quote!(out.push(&schema, "", crate::calc::rules::Kind::OneOf(&[#(#wires),*]));),
+                );
             }
             for f in &specs {
                 checks.push(check_field(f, cr.code.as_ref(), true));
@@ -619,7 +628,10 @@ fn expand(input: &DeriveInput) -> syn::Result<Ts> {
             }
         }
         Data::Union(_) => {
-            return Err(syn::Error::new(input.span(), "Rules: unions are not supported"));
+            return Err(syn::Error::new(
+                input.span(),
+                "Rules: unions are not supported",
+            ));
         }
     }
 
