@@ -463,8 +463,9 @@ async fn soak_mixed_load_from_several_keys() {
             false,
         )
     };
-    // (statuses, cheap latencies [ms] with their time [s]) per task.
-    type Out = (Vec<u16>, Vec<(f64, f64)>, usize);
+    // (statuses, cheap latencies [ms] with their time [s], failures: what went wrong and when,
+    // 5xx bodies included) per task.
+    type Out = (Vec<u16>, Vec<(f64, f64)>, Vec<String>);
     let t0 = Instant::now();
     let mut tasks: Vec<tokio::task::JoinHandle<Out>> = Vec::new();
     for _ in 0..2 {
@@ -475,12 +476,15 @@ async fn soak_mixed_load_from_several_keys() {
         );
         tasks.push(tokio::spawn(async move {
             let mut st = Vec::new();
-            let mut lost = 0;
+            let mut lost = Vec::new();
             while !stop.load(Ordering::Relaxed) {
                 sent.fetch_add(1, Ordering::Relaxed);
                 match client::send(addr, req.clone()).await {
-                    Ok(r) => st.push(r.status),
-                    Err(_) => lost += 1,
+                    Ok(r) => {
+                        note_5xx(&r, t0, "plm sweep", &mut lost);
+                        st.push(r.status);
+                    }
+                    Err(e) => lost.push(format!("{:.1} s plm sweep: {e}", t0.elapsed().as_secs_f64())),
                 }
             }
             (st, Vec::new(), lost)
@@ -496,10 +500,11 @@ async fn soak_mixed_load_from_several_keys() {
         tasks.push(tokio::spawn(async move {
             let mut st = Vec::new();
             let mut lat = Vec::new();
-            let mut lost = 0;
+            let mut lost = Vec::new();
             let mut n = 0u64;
-            let Ok(mut c) = KeepAlive::connect(addr).await else {
-                return (st, lat, 1);
+            let mut c = match KeepAlive::connect(addr).await {
+                Ok(c) => c,
+                Err(e) => return (st, lat, vec![format!("connect {token}: {e}")]),
             };
             while !stop.load(Ordering::Relaxed) {
                 n += 1;
@@ -507,22 +512,35 @@ async fn soak_mixed_load_from_several_keys() {
                 // ci: one sweep in 200 requests, on a connection of its own.
                 if mixed && (n + i as u64).is_multiple_of(200) {
                     match client::send(addr, heavy.clone()).await {
-                        Ok(r) => st.push(r.status),
-                        Err(_) => lost += 1,
+                        Ok(r) => {
+                            note_5xx(&r, t0, "ci sweep", &mut lost);
+                            st.push(r.status);
+                        }
+                        Err(e) => lost.push(format!(
+                            "{:.1} s ci sweep: {e}",
+                            t0.elapsed().as_secs_f64()
+                        )),
                     }
                     continue;
                 }
                 let t = Instant::now();
                 match c.exchange(&cheap).await {
                     Ok(r) => {
+                        note_5xx(&r, t0, token, &mut lost);
                         st.push(r.status);
                         lat.push((t0.elapsed().as_secs_f64(), t.elapsed().as_secs_f64() * 1e3));
                     }
-                    Err(_) => {
-                        lost += 1;
+                    Err(e) => {
+                        lost.push(format!(
+                            "{:.1} s {token} cheap after {n} on the connection: {e}",
+                            t0.elapsed().as_secs_f64()
+                        ));
                         match KeepAlive::connect(addr).await {
                             Ok(fresh) => c = fresh,
-                            Err(_) => return (st, lat, lost),
+                            Err(e) => {
+                                lost.push(format!("reconnect {token}: {e}"));
+                                return (st, lat, lost);
+                            }
                         }
                     }
                 }
@@ -541,12 +559,24 @@ async fn soak_mixed_load_from_several_keys() {
     stop.store(true, Ordering::Relaxed);
     let mut statuses = Vec::new();
     let mut lat = Vec::new();
-    let mut lost = 0;
+    let mut failures = Vec::new();
     for t in tasks {
         let (s, l, x) = t.await.expect("join");
         statuses.extend(s);
         lat.extend(l);
-        lost += x;
+        failures.extend(x);
+    }
+    let lost = failures.iter().filter(|f| !f.contains(" 5xx ")).count();
+    for f in failures.iter().take(40) {
+        eprintln!("soak failure: {f}");
+    }
+    for line in server
+        .log()
+        .lines()
+        .filter(|l| l.contains("WARN") || l.contains("ERROR"))
+        .take(40)
+    {
+        eprintln!("soak server log: {line}");
     }
     let answered = statuses.len();
     let sent = sent.load(Ordering::Relaxed) as usize;
@@ -605,4 +635,16 @@ async fn soak_mixed_load_from_several_keys() {
     }
     server.stop().await;
     let _ = std::fs::remove_file(&keys);
+}
+
+/// Keep a 5xx answer's body among the soak's failures (it is counted as answered, and asserted on).
+fn note_5xx(r: &client::Reply, t0: Instant, who: &str, out: &mut Vec<String>) {
+    if r.status >= 500 {
+        out.push(format!(
+            "{:.1} s {who}: 5xx {} {}",
+            t0.elapsed().as_secs_f64(),
+            r.status,
+            r.text()
+        ));
+    }
 }
