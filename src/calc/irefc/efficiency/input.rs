@@ -3,42 +3,27 @@
 use std::f64::consts::PI;
 
 use super::wire::{self, IrefcEfficiencyRequest, phase_deg_range};
+use crate::calc::CalcFailure;
 use crate::calc::irefc::error::{self, IrefcError};
 use crate::calc::irefc::geometry::Geometry;
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::MM;
-use crate::calc::{CalcFailure, CrossRule};
 
-/// Exactly one load: both given is ambiguous.
-pub const AMBIGUOUS_LOAD: CrossRule = CrossRule::invalid(
-    error::AMBIGUOUS_LOAD,
-    &["/power_W", "/input_torque_Nm"],
-    "At most one of `power_W` and `input_torque_Nm` is given.",
-);
-/// Exactly one load: none given is a missing field.
-pub const LOAD_MISSING: CrossRule = CrossRule::invalid(
-    error::MISSING_FIELD,
-    &["/power_W", "/input_torque_Nm"],
-    "One of `power_W` and `input_torque_Nm` is given.",
-);
-/// The cage phase lies within one element pitch.
-pub const PHASE_BELOW_PITCH: CrossRule = CrossRule::invalid(
-    error::BAD_RANGE,
-    &["/phase_deg", "/Z2"],
-    "phase_deg < 360/Z2 (one element pitch).",
-);
-
-/// The rules between fields of `POST /v1/irefc-efficiency`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    AMBIGUOUS_LOAD,
-    LOAD_MISSING,
-    PHASE_BELOW_PITCH,
-    design::UNDERCUT,
-    design::ELEMENT_OVERLAP,
-    design::NON_FINITE,
-    design::DEADLINE,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/irefc-efficiency`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid AMBIGUOUS_LOAD(error::AMBIGUOUS_LOAD) ["/power_W", "/input_torque_Nm"]
+        "At most one of `power_W` and `input_torque_Nm` is given.";
+    invalid LOAD_MISSING(error::MISSING_FIELD) ["/power_W", "/input_torque_Nm"]
+        "One of `power_W` and `input_torque_Nm` is given.";
+    invalid PHASE_BELOW_PITCH(error::BAD_RANGE) ["/phase_deg", "/Z2"]
+        "phase_deg < 360/Z2 (one element pitch).";
+    listed design::UNDERCUT;
+    listed design::ELEMENT_OVERLAP;
+    listed design::NON_FINITE;
+    listed design::DEADLINE;
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// The paper's rolling-friction lever arm μ = 0.001 m \[mm\].
 pub const ROLLING_FRICTION_PAPER_MM: f64 = 1.0;

@@ -11,76 +11,34 @@ use crate::calc::common::{self, Shard};
 use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, MISSING_FIELD, SWEEP_TOO_LARGE};
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::{MM, PROFILE_POINTS_DEFAULT, Warning};
-use crate::calc::{CalcFailure, CrossRule, Range, Validator};
+use crate::calc::{CalcFailure, Range, Validator};
 
-/// A sweep goes with mode "sweep".
-pub const SWEEP_NEEDS_MODE: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/sweep", "/mode"],
-    "`sweep` is given only with mode \"sweep\" (the default when `sweep` is present).",
-);
-/// A shard splits a sweep.
-pub const SHARD_NEEDS_SWEEP: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/shard", "/mode"],
-    "`shard` is given only in mode \"sweep\" (mode \"single\" has one design).",
-);
-/// The fields of the chosen mode are given.
-pub const MODE_FIELDS: CrossRule = CrossRule::invalid(
-    MISSING_FIELD,
-    &[
-        "/r2_mm",
-        "/rb_mm",
-        "/Z2",
-        "/chi",
-        "/sweep",
-        "/sweep/r2_mm",
-        "/sweep/rb_mm",
-    ],
-    "Mode \"single\" needs r2_mm, rb_mm, Z2 and chi; mode \"sweep\" needs `sweep`, and r2_mm \
-     and rb_mm unless `sweep.r2_mm`/`sweep.rb_mm` are given.",
-);
-/// Sweep ranges run upwards.
-pub const SWEEP_RANGE_ORDER: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/sweep/Z2/to", "/sweep/chi/to"],
-    "sweep.Z2.to ≥ sweep.Z2.from and sweep.chi.to ≥ sweep.chi.from.",
-);
-/// The contact length is at most 100 cage radii.
-pub const LB_BELOW_R2: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/lb_mm", "/r2_mm", "/sweep/r2_mm"],
-    "lb_mm ≤ 100·r2 for every r2 of the request.",
-);
-/// The φ2 grid has at most 2·10⁶ intervals.
-pub const GRID_TOO_FINE_RULE: CrossRule = CrossRule::too_large(
-    GRID_TOO_FINE,
-    &["/step_deg"],
-    "180/step_deg ≤ 2e6 (step_deg ≥ 9e-5).",
-);
-/// The sweep's size is bounded.
-pub const SWEEP_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
-    SWEEP_TOO_LARGE,
-    &["/sweep", "/step_deg"],
-    "The sweep has at most 1e5 combinations and at most 5e8 grid points in all.",
-);
-
-/// The rules between fields of `POST /v1/irefc-stress`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    SWEEP_NEEDS_MODE,
-    SHARD_NEEDS_SWEEP,
-    common::SHARD_INDEX_BELOW_COUNT,
-    MODE_FIELDS,
-    SWEEP_RANGE_ORDER,
-    LB_BELOW_R2,
-    GRID_TOO_FINE_RULE,
-    SWEEP_TOO_LARGE_RULE,
-    design::UNDERCUT,
-    design::ELEMENT_OVERLAP,
-    design::NON_FINITE,
-    design::DEADLINE,
-    common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/irefc-stress`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid SWEEP_NEEDS_MODE(BAD_RANGE) ["/sweep", "/mode"]
+        "`sweep` is given only with mode \"sweep\" (the default when `sweep` is present).";
+    invalid SHARD_NEEDS_SWEEP(BAD_RANGE) ["/shard", "/mode"]
+        "`shard` is given only in mode \"sweep\" (mode \"single\" has one design).";
+    listed common::SHARD_INDEX_BELOW_COUNT;
+    invalid MODE_FIELDS(MISSING_FIELD) ["/r2_mm", "/rb_mm", "/Z2", "/chi", "/sweep", "/sweep/r2_mm",
+        "/sweep/rb_mm"]
+        "Mode \"single\" needs r2_mm, rb_mm, Z2 and chi; mode \"sweep\" needs `sweep`, and r2_mm \
+         and rb_mm unless `sweep.r2_mm`/`sweep.rb_mm` are given.";
+    invalid SWEEP_RANGE_ORDER(BAD_RANGE) ["/sweep/Z2/to", "/sweep/chi/to"]
+        "sweep.Z2.to ≥ sweep.Z2.from and sweep.chi.to ≥ sweep.chi.from.";
+    invalid LB_BELOW_R2(BAD_RANGE) ["/lb_mm", "/r2_mm", "/sweep/r2_mm"]
+        "lb_mm ≤ 100·r2 for every r2 of the request.";
+    too_large GRID_TOO_FINE_RULE(GRID_TOO_FINE) ["/step_deg"]
+        "180/step_deg ≤ 2e6 (step_deg ≥ 9e-5).";
+    too_large SWEEP_TOO_LARGE_RULE(SWEEP_TOO_LARGE) ["/sweep", "/step_deg"]
+        "The sweep has at most 1e5 combinations and at most 5e8 grid points in all.";
+    listed design::UNDERCUT;
+    listed design::ELEMENT_OVERLAP;
+    listed design::NON_FINITE;
+    listed design::DEADLINE;
+    listed common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// Default φ2 grid step \[deg\]: 1° + refinement is ≤ 1e-10 from the exact maximum and ~40× cheaper than the
 /// paper's 0.02° grid (whose error is 1.8e-8); see `benches/RESULTS.md` (## irefc).
