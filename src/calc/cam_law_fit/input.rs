@@ -9,10 +9,9 @@ use crate::calc::cam_law::law::{
 use crate::calc::cam_law::wire::Units;
 use crate::calc::{CalcFailure, Validator};
 
-use super::compute::{Algorithm, Settings};
 use super::optim::ga::GaParams;
 use super::wire::{
-    Channels, FitCamLawRequest, FitQuantity, GaIn, MAX_CURVE_COUNT, Method, MetricName, OptimizerIn,
+    Channels, FitCamLawRequest, GaIn, MAX_CURVE_COUNT, Method, MetricName, OptimizerIn,
 };
 use crate::numerics::grid;
 
@@ -140,16 +139,8 @@ pub struct FitOutputs {
     pub classify: bool,
 }
 
-/// A measured channel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Channel {
-    /// Displacement `s`.
-    Displacement,
-    /// Velocity `v`.
-    Velocity,
-    /// Acceleration `a`.
-    Acceleration,
-}
+/// A measured channel: the request's quantity.
+pub use super::wire::FitQuantity as Channel;
 
 impl Channel {
     /// s, v, a.
@@ -186,33 +177,33 @@ impl Channel {
     }
 }
 
-impl From<FitQuantity> for Channel {
-    fn from(q: FitQuantity) -> Self {
-        match q {
-            FitQuantity::Displacement => Self::Displacement,
-            FitQuantity::Velocity => Self::Velocity,
-            FitQuantity::Acceleration => Self::Acceleration,
-        }
-    }
-}
+/// The distance between model and data: the request's metric.
+pub use super::wire::MetricName as MetricKind;
 
-/// The distance between model and data.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MetricKind {
-    /// Euclidean norm (paper Eq. 7).
-    Euclidean,
-    /// The paper's DTW.
-    Dtw,
-}
+/// The optimizer of a fit (spec §3.5): the request's `optimizer.method`.
+pub use super::wire::Method as Algorithm;
 
-fn algorithm(m: Method) -> Algorithm {
-    match m {
-        Method::Auto => Algorithm::Auto,
-        Method::Ga => Algorithm::Ga,
-        Method::De => Algorithm::De,
-        Method::Cmaes => Algorithm::Cmaes,
-        Method::Lsq => Algorithm::Lsq,
-    }
+/// Optimizer settings of one fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Method.
+    pub method: Algorithm,
+    /// RNG seed.
+    pub seed: u64,
+    /// GA settings.
+    pub ga: GaParams,
+    /// IPOP restarts for DTW in `auto`.
+    pub dtw_global_restarts: u32,
+    /// Least-squares + snap polish after the stochastic methods (EN only).
+    pub polish: bool,
+    /// Zero-snap threshold on normalized coefficients.
+    pub snap_tol: f64,
+    /// Initial coefficients (normalized, fixed genes zero).
+    pub initial: [f64; 7],
+    /// Segments held at zero.
+    pub fixed_zero: [bool; 7],
+    /// Request's evaluation cap (the `lsq` method's single run may use all of it).
+    pub max_evaluations: u64,
 }
 
 /// The sample abscissae (exactly one of `values`/`grid`, their lengths and the grid's count are
@@ -303,7 +294,7 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
             }
         }
     }
-    let fit_on = Channel::from(req.fit_on.unwrap_or(FitQuantity::Acceleration));
+    let fit_on = req.fit_on.unwrap_or(Channel::Acceleration);
     let fit_idx = fit_on.index();
     if supplied[fit_idx].is_none() && !supplied.iter().all(Option::is_none) {
         if !req.derive_missing {
@@ -758,14 +749,11 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         bc,
         objective: ObjectiveSpec {
             on: fit_on,
-            metric: match metric {
-                MetricName::Euclidean => MetricKind::Euclidean,
-                MetricName::Dtw => MetricKind::Dtw,
-            },
+            metric,
             dtw_window,
         },
         settings: Settings {
-            method: algorithm(method),
+            method,
             seed: o.seed.unwrap_or(0),
             ga,
             dtw_global_restarts,
