@@ -43,23 +43,8 @@ crate::calc::rules::cross_rules! {
     listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
 }
 
-/// What a request computes (the request's `mode`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    /// Evaluate the given law.
-    Simulate,
-    /// The zero (or least) residual-vibration law by the closed-form solve.
-    Optimize,
-}
-
-impl From<wire::Mode> for Mode {
-    fn from(m: wire::Mode) -> Self {
-        match m {
-            wire::Mode::Simulate => Self::Simulate,
-            wire::Mode::Optimize => Self::Optimize,
-        }
-    }
-}
+/// What a request computes: the request's `mode`.
+pub use super::wire::Mode;
 
 /// A validated request in SI units.
 #[derive(Debug, Clone, PartialEq)]
@@ -215,7 +200,7 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
 
         v.finish()?;
         Ok(Self {
-            mode: req.mode.into(),
+            mode: req.mode,
             plant: Plant::new(j_eq, k, c, z),
             phi,
             t: mo.t_s,

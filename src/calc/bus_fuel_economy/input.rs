@@ -118,42 +118,8 @@ const DEFAULT_T_PEAK: f64 = 800.0;
 const DEFAULT_P_PEAK: f64 = 130_000.0;
 const DEFAULT_N_MAX: f64 = 5200.0;
 
-/// How an `ipmsm` motor's loss is evaluated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MotorEval {
-    /// Solve the dq operating point at every interval.
-    Direct,
-    /// Interpolate a loss map precomputed on the options' grid.
-    LossMap,
-}
-
-impl From<w::Mode> for Mode {
-    fn from(m: w::Mode) -> Self {
-        match m {
-            w::Mode::Backward => Self::Backward,
-            w::Mode::Clip => Self::Clip,
-            w::Mode::Forward => Self::Forward,
-        }
-    }
-}
-
-impl From<w::PowerConvention> for PowerConvention {
-    fn from(c: w::PowerConvention) -> Self {
-        match c {
-            w::PowerConvention::Paper => Self::Paper,
-            w::PowerConvention::Loss => Self::Loss,
-        }
-    }
-}
-
-impl From<w::MotorEval> for MotorEval {
-    fn from(e: w::MotorEval) -> Self {
-        match e {
-            w::MotorEval::Direct => Self::Direct,
-            w::MotorEval::LossMap => Self::LossMap,
-        }
-    }
-}
+/// How an `ipmsm` motor's loss is evaluated: the request's `motor_eval`.
+pub use super::wire::MotorEval;
 
 /// Validated options.
 #[derive(Debug, Clone)]
@@ -897,8 +863,8 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
             cycles: cycles_ok.into_iter().map(|(_, c)| c).collect(),
             motors,
             options: Options {
-                mode: o.mode.into(),
-                convention: o.power_convention.into(),
+                mode: o.mode,
+                convention: o.power_convention,
                 substeps,
                 regen: o.regen,
                 regen_limit: o.regen_limit,

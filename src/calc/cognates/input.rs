@@ -15,7 +15,7 @@ use crate::calc::{CalcFailure, Validator};
 use super::geometry::{C64, FourBar, Sign, cis, cross};
 use super::sampling::Spacing;
 use super::wire::{
-    self, AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec, VerifyKind,
+    AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec, VerifyKind,
 };
 
 pub use super::wire::MAX_MAGNITUDE;
@@ -79,32 +79,8 @@ pub struct SnapshotSpec {
     pub branch: Sign,
 }
 
-/// How coupler curves are traced.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CurveMode {
-    /// Closed circuits, switching branch at toggles (the whole curve).
-    Circuits,
-    /// Paper style: each mechanism's own input over its range on the branch of the snapshot.
-    FixedBranch,
-}
-
-impl From<wire::CurveMode> for CurveMode {
-    fn from(m: wire::CurveMode) -> Self {
-        match m {
-            wire::CurveMode::Circuits => Self::Circuits,
-            wire::CurveMode::FixedBranch => Self::FixedBranch,
-        }
-    }
-}
-
-impl From<wire::Spacing> for Spacing {
-    fn from(s: wire::Spacing) -> Self {
-        match s {
-            wire::Spacing::Auto => Self::Auto,
-            wire::Spacing::Uniform => Self::Uniform,
-        }
-    }
-}
+/// How curves are traced: the request's curve mode.
+pub use super::wire::CurveMode;
 
 /// Validated options.
 #[derive(Debug, Clone, PartialEq)]
@@ -205,8 +181,8 @@ fn validate_options(req: &CognatesRequest) -> Options {
     Options {
         curves: o.curves,
         points_per_circuit: usize::try_from(o.points_per_circuit.clamp(lo, hi)).unwrap_or(360),
-        spacing: o.spacing.into(),
-        curve_mode: o.curve_mode.into(),
+        spacing: o.spacing,
+        curve_mode: o.curve_mode,
         verify_sync: o.verify.contains(&VerifyKind::Sync),
         verify_implicit: o.verify.contains(&VerifyKind::Implicit),
         verify_hausdorff: o.verify.contains(&VerifyKind::Hausdorff),

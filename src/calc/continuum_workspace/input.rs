@@ -106,52 +106,11 @@ const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
 /// compute pool's threads per job); results do not depend on it.
 pub const SWEEP_THREADS: usize = usize::MAX;
 
-/// What the request computes (the domain form of the wire `mode`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    /// Forward kinematics at one input.
-    Fk,
-    /// Workspace sweep over the 2-D input grid, one wave per seed.
-    Workspace,
-    /// Assembly-mode search at one input.
-    AssemblyModes,
-}
+/// What the request computes: the request's `mode`.
+pub use super::wire::Mode;
 
-impl From<wire::Mode> for Mode {
-    fn from(m: wire::Mode) -> Self {
-        match m {
-            wire::Mode::Fk => Self::Fk,
-            wire::Mode::Workspace => Self::Workspace,
-            wire::Mode::AssemblyModes => Self::AssemblyModes,
-        }
-    }
-}
-
-/// How the waves of a sweep are seeded at the seed node (the domain form of the wire
-/// `workspace.seed.kind`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SeedKind {
-    /// Continuation from the stress-free home (without one: the stable assembly mode with the
-    /// smallest |theta_EE|): one wave.
-    Home,
-    /// Newton from a given state: one wave.
-    Guess,
-    /// One assembly mode of the search: one wave.
-    AssemblyMode,
-    /// Every stable assembly mode of the search: one wave each.
-    AllStableModes,
-}
-
-impl From<wire::SeedKind> for SeedKind {
-    fn from(k: wire::SeedKind) -> Self {
-        match k {
-            wire::SeedKind::Home => Self::Home,
-            wire::SeedKind::Guess => Self::Guess,
-            wire::SeedKind::AssemblyMode => Self::AssemblyMode,
-            wire::SeedKind::AllStableModes => Self::AllStableModes,
-        }
-    }
-}
+/// How the waves of a sweep are seeded at the seed node: the request's `workspace.seed.kind`.
+pub use super::wire::SeedKind;
 
 /// How the FK starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -757,7 +716,7 @@ fn seed(v: &mut Validator, seed: Option<&SeedRequest>, nr: usize) -> SeedInput {
             index: 0,
         };
     };
-    let kind = SeedKind::from(s.kind);
+    let kind = s.kind;
     let state = match (kind, &s.state) {
         (SeedKind::Guess, None) => {
             v.rule(
@@ -911,7 +870,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             search_size(modes.n_grid, nr, has_home)?;
         }
         Ok(Self {
-            mode: Mode::from(req.mode),
+            mode: req.mode,
             model,
             preset,
             params: Params {

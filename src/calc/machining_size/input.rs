@@ -22,7 +22,7 @@ use super::gra::Normalise;
 use super::model::Model;
 use super::smogn::SmognParams;
 use super::wire::{
-    self, AnalyzeRequest, GraNormalise, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
+    AnalyzeRequest, GraNormalise, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
     MAX_INTERVENTIONAL_PAIRS, MAX_SCORE_CELLS, MAX_SHAP_CELLS, MAX_TREES, PredictRequest,
     RELEVANCE_PHI, TrainOutputKind, TrainRequest, TreeMethod,
 };
@@ -176,26 +176,8 @@ pub struct TrainOutputs {
     pub test_predictions: bool,
 }
 
-/// Which SHAP values a `/predict` request asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ShapKind {
-    /// No SHAP values.
-    None,
-    /// Path-dependent TreeSHAP (cover-weighted conditional expectations).
-    PathDependent,
-    /// Interventional TreeSHAP against the background rows.
-    Interventional,
-}
-
-impl From<wire::ShapKind> for ShapKind {
-    fn from(k: wire::ShapKind) -> Self {
-        match k {
-            wire::ShapKind::None => Self::None,
-            wire::ShapKind::PathDependent => Self::PathDependent,
-            wire::ShapKind::Interventional => Self::Interventional,
-        }
-    }
-}
+/// Which SHAP values `/predict` computes: the request's `shap`.
+pub use super::wire::ShapKind;
 
 /// A validated `/predict` request.
 #[derive(Debug, Clone)]
@@ -566,7 +548,7 @@ impl TryFrom<PredictRequest> for PredictInput {
             }
         }
         let n = req.rows.len();
-        let shap = ShapKind::from(req.shap);
+        let shap = req.shap;
         if shap != ShapKind::None && n * d > MAX_SHAP_CELLS {
             v.rule(
                 &PREDICT_WORK,

@@ -2,7 +2,7 @@
 
 use std::f64::consts::PI;
 
-use super::wire::{self, IrefcEfficiencyRequest, phase_deg_range};
+use super::wire::{IrefcEfficiencyRequest, phase_deg_range};
 use crate::calc::CalcFailure;
 use crate::calc::irefc::error::{self, IrefcError};
 use crate::calc::irefc::geometry::Geometry;
@@ -32,27 +32,8 @@ pub const ROLLING_FRICTION_HIGH_MM: f64 = 0.5;
 /// The paper's sliding friction coefficient.
 pub const SLIDING_FRICTION_PAPER: f64 = 0.1;
 
-/// Loss model of the element slip speeds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EfficiencyModel {
-    /// The paper's equations exactly as printed (signed slip speed); reproduces its Table 1.
-    PaperTable,
-    /// The paper's equations with |Vs| in the sliding loss (what the paper's text says).
-    PaperAbs,
-    /// Not in the paper: rigid-body relative speeds in the carrier frame (pure rolling at the
-    /// crown, slip at the cam).
-    RigidBody,
-}
-
-impl From<wire::EfficiencyModel> for EfficiencyModel {
-    fn from(m: wire::EfficiencyModel) -> Self {
-        match m {
-            wire::EfficiencyModel::PaperTable => Self::PaperTable,
-            wire::EfficiencyModel::PaperAbs => Self::PaperAbs,
-            wire::EfficiencyModel::RigidBody => Self::RigidBody,
-        }
-    }
-}
+/// The efficiency model: the request's `model`.
+pub use super::wire::EfficiencyModel;
 
 /// Validated efficiency input \[SI\].
 #[derive(Debug, Clone, PartialEq)]
@@ -144,7 +125,7 @@ impl EfficiencyInput {
             p_in,
             mu: mu_mm / MM,
             fs,
-            model: req.model.unwrap_or_default().into(),
+            model: req.model.unwrap_or_default(),
             phase_fraction,
             n_phase,
             elements: req.include.and_then(|i| i.elements).unwrap_or(true),

@@ -4,8 +4,8 @@
 //! codes.
 
 use super::wire::{
-    self, GRID_INTERVALS_MAX, IntRange, IrefcStressRequest, LB_MAX_OVER_R2, LB_MM, STEP_DEG,
-    StepRange, StressInclude, StressMode,
+    GRID_INTERVALS_MAX, IntRange, IrefcStressRequest, LB_MAX_OVER_R2, LB_MM, STEP_DEG, StepRange,
+    StressInclude, StressMode,
 };
 use crate::calc::common::{self, Shard};
 use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, MISSING_FIELD, SWEEP_TOO_LARGE};
@@ -52,41 +52,11 @@ pub const SWEEP_WORK_MAX: f64 = 5e8;
 /// Tolerance on the last χ of a sweep range: χ_i = from + i·step is kept while ≤ to + this (spec).
 pub const CHI_RANGE_TOL: f64 = 1e-12;
 
-/// Which link carries the output torque.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum OutputLink {
-    /// Cam output, crown fixed (T_cam = T_out).
-    Cam,
-    /// Crown output, cam rotation locked (T_cam = T_out·(Z2−1)/(Z2+1)).
-    Crown,
-}
+/// The output link: the request's `output_link`.
+pub use super::wire::OutputLink;
 
-/// How the torque is shared over the elements when an element sits at φ2.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LoadSharing {
-    /// The paper: F(φ2) = Fmax·sin α with Fmax from the phase-0 element set (eqs 16–17).
-    PaperPhase0,
-    /// F(φ2) = T_cam·sin α/(r1·Σsin²α) with Σ over the cage phase that puts an element at φ2.
-    PhaseExact,
-}
-
-impl From<wire::OutputLink> for OutputLink {
-    fn from(l: wire::OutputLink) -> Self {
-        match l {
-            wire::OutputLink::Cam => Self::Cam,
-            wire::OutputLink::Crown => Self::Crown,
-        }
-    }
-}
-
-impl From<wire::LoadSharing> for LoadSharing {
-    fn from(l: wire::LoadSharing) -> Self {
-        match l {
-            wire::LoadSharing::PaperPhase0 => Self::PaperPhase0,
-            wire::LoadSharing::PhaseExact => Self::PhaseExact,
-        }
-    }
-}
+/// How the load is shared: the request's `load_sharing`.
+pub use super::wire::LoadSharing;
 
 /// Scalar settings shared by every combination \[SI\].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -317,13 +287,13 @@ fn check_params(
     let n_intervals = grid_intervals(v, step_deg).unwrap_or(0);
     StressParams {
         torque: req.torque_nm,
-        output_link: req.output_link.unwrap_or_default().into(),
+        output_link: req.output_link.unwrap_or_default(),
         lb: None,
         e_star: 1.0 / (wm.compliance() + rm.compliance()),
         step_deg,
         n_intervals,
         refine: req.refine.unwrap_or(true),
-        load_sharing: req.load_sharing.unwrap_or_default().into(),
+        load_sharing: req.load_sharing.unwrap_or_default(),
         subsurface: include.subsurface.unwrap_or(false),
     }
 }
