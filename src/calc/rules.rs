@@ -807,6 +807,10 @@ macro_rules! cross_rules {
         [$($p:literal),* $(,)?] $rule:literal; $($rest:tt)*) => {
         $(#[$m])*
         #[doc = $rule]
+        #[allow(
+            rustdoc::broken_intra_doc_links,
+            reason = "the sentence is the published plain text: `[j]` is an index, not a link"
+        )]
         pub const $name: $crate::calc::CrossRule = $crate::calc::CrossRule::$class(
             $crate::calc::rules::cross_rules!(@code $name $($code)?),
             &[$($p),*],
