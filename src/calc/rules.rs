@@ -774,6 +774,59 @@ impl CrossRule {
     }
 }
 
+/// Declares a module's [`CrossRule`] constants, each in two lines, and (with a leading
+/// `pub const NAME: &[CrossRule];`) the list the document publishes, in the order written:
+///
+/// ```text
+/// cross_rules! {
+///     /// The rules between fields of `POST /v1/x`, as the document lists them.
+///     pub const CROSS_FIELD_RULES: &[CrossRule];
+///     invalid ABSCISSA_ORDER ["/abscissa/values/*", "/abscissa/grid/end"]
+///         "Abscissae strictly increase; a grid's `end` is greater than its `start`.";
+///     infeasible ZERO_MEAN(super::error::GRA_ZERO_MEAN) ["/gra"] "No series has a mean of 0.";
+///     listed common::RESPONSE_TOO_LARGE_RULE;
+/// }
+/// ```
+///
+/// A rule is its class (the [`CrossRule`] constructor: `invalid`, `infeasible`, `not_converged`,
+/// `too_large`), its name, its code in parentheses when it is not the name, its pointers and its
+/// sentence, which is also its doc (after any doc written above it). `listed PATH;` adds a rule
+/// declared elsewhere to the list.
+macro_rules! cross_rules {
+    (@code $name:ident) => { stringify!($name) };
+    (@code $name:ident $code:expr) => { $code };
+    (@munch [$($acc:tt)*] [$(#[$meta:meta])* $list:ident]) => {
+        $(#[$meta])*
+        pub const $list: &[$crate::calc::CrossRule] = &[$($acc)*];
+    };
+    (@munch [$($acc:tt)*] []) => {};
+    (@munch [$($acc:tt)*] $head:tt listed $rule:path; $($rest:tt)*) => {
+        $crate::calc::rules::cross_rules!(@munch [$($acc)* $rule,] $head $($rest)*);
+    };
+    (@munch [$($acc:tt)*] $head:tt $(#[$m:meta])* $class:ident $name:ident $(($code:expr))?
+        [$($p:literal),* $(,)?] $rule:literal; $($rest:tt)*) => {
+        $(#[$m])*
+        #[doc = $rule]
+        #[allow(
+            rustdoc::broken_intra_doc_links,
+            reason = "the sentence is the published plain text: `[j]` is an index, not a link"
+        )]
+        pub const $name: $crate::calc::CrossRule = $crate::calc::CrossRule::$class(
+            $crate::calc::rules::cross_rules!(@code $name $($code)?),
+            &[$($p),*],
+            $rule,
+        );
+        $crate::calc::rules::cross_rules!(@munch [$($acc)* $name,] $head $($rest)*);
+    };
+    ($(#[$meta:meta])* pub const $list:ident: &[CrossRule]; $($body:tt)*) => {
+        $crate::calc::rules::cross_rules!(@munch [] [$(#[$meta])* $list] $($body)*);
+    };
+    ($($body:tt)*) => {
+        $crate::calc::rules::cross_rules!(@munch [] [] $($body)*);
+    };
+}
+pub(crate) use cross_rules;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,83 +17,34 @@ use super::wire::{
     ObjectiveIn, ShaperIn,
 };
 use crate::calc::rules::door_skipped;
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 
-/// The inertias of `inertias_kgm2` sum to > 0.
-pub const INERTIA_SUM: CrossRule = CrossRule::invalid(
-    "INERTIA_SUM_ZERO",
-    &["/system/inertias_kgm2"],
-    "The inertias in inertias_kgm2 sum to > 0 (each is ≥ 0).",
-);
-/// The reducer ratio is not 0.
-pub const RATIO_NONZERO: CrossRule =
-    CrossRule::invalid("ZERO_RATIO", &["/system/z"], "The reducer ratio z is ≠ 0.");
-/// The total rotation is not 0.
-pub const ROTATION_NONZERO: CrossRule = CrossRule::invalid(
-    "ZERO_ROTATION",
-    &["/motion/Phi_rad", "/motion/Phi_rev"],
-    "The total motor rotation (Phi_rad or Phi_rev) is ≠ 0.",
-);
-/// The degree of φ'' stays within Bernstein conditioning.
-pub const DEGREE: CrossRule = CrossRule::invalid(
-    "DEGREE_TOO_HIGH",
-    &["/motion/m", "/motion/p"],
-    "N = 2m + p − 1 ≤ 30 (Bernstein conditioning, spec §6).",
-);
-/// γ holds p ordinates.
-pub const GAMMA_LENGTH: CrossRule = CrossRule::invalid(
-    "GAMMA_LENGTH",
-    &["/motion/gamma_rad", "/motion/p"],
-    "gamma_rad holds exactly p ordinates.",
-);
-/// γ is on the scale of the move.
-pub const GAMMA_SCALE: CrossRule = CrossRule::invalid(
-    "GAMMA_OUT_OF_SCALE",
-    &["/motion/gamma_rad/*", "/motion/Phi_rad", "/motion/Phi_rev"],
-    "Each |gamma_rad[j]| ≤ 1e3·|Phi| (Phi in rad).",
-);
-/// Each shaper at most once.
-pub const SHAPER_REPEATED: CrossRule = CrossRule::invalid(
-    "SHAPER_REPEATED",
-    &["/outputs/shaper_comparison/shapers/*"],
-    "Each shaper of shaper_comparison.shapers is listed at most once.",
-);
-
-/// The rules between fields of `POST /v1/bezier-motion-law`, and every code its computation can
-/// answer a schema-valid request with, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    INERTIA_SUM,
-    RATIO_NONZERO,
-    ROTATION_NONZERO,
-    DEGREE,
-    GAMMA_LENGTH,
-    GAMMA_SCALE,
-    SHAPER_REPEATED,
-    RHO_TOO_LARGE_RULE,
-    HISTORY_TOO_LARGE_RULE,
-    OBJECTIVE_SINGULAR_RULE,
-    NON_FINITE_RESULT_RULE,
-    DEADLINE_RULE,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
-
-/// What a request computes (the request's `mode`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    /// Evaluate the given law.
-    Simulate,
-    /// The zero (or least) residual-vibration law by the closed-form solve.
-    Optimize,
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/bezier-motion-law`, and every code its computation can
+    /// answer a schema-valid request with, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid INERTIA_SUM("INERTIA_SUM_ZERO") ["/system/inertias_kgm2"]
+        "The inertias in inertias_kgm2 sum to > 0 (each is ≥ 0).";
+    invalid RATIO_NONZERO("ZERO_RATIO") ["/system/z"] "The reducer ratio z is ≠ 0.";
+    invalid ROTATION_NONZERO("ZERO_ROTATION") ["/motion/Phi_rad", "/motion/Phi_rev"]
+        "The total motor rotation (Phi_rad or Phi_rev) is ≠ 0.";
+    invalid DEGREE("DEGREE_TOO_HIGH") ["/motion/m", "/motion/p"]
+        "N = 2m + p − 1 ≤ 30 (Bernstein conditioning, spec §6).";
+    invalid GAMMA_LENGTH ["/motion/gamma_rad", "/motion/p"] "gamma_rad holds exactly p ordinates.";
+    invalid GAMMA_SCALE("GAMMA_OUT_OF_SCALE") ["/motion/gamma_rad/*", "/motion/Phi_rad",
+        "/motion/Phi_rev"] "Each |gamma_rad[j]| ≤ 1e3·|Phi| (Phi in rad).";
+    invalid SHAPER_REPEATED ["/outputs/shaper_comparison/shapers/*"]
+        "Each shaper of shaper_comparison.shapers is listed at most once.";
+    listed RHO_TOO_LARGE_RULE;
+    listed HISTORY_TOO_LARGE_RULE;
+    listed OBJECTIVE_SINGULAR_RULE;
+    listed NON_FINITE_RESULT_RULE;
+    listed DEADLINE_RULE;
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
 }
 
-impl From<wire::Mode> for Mode {
-    fn from(m: wire::Mode) -> Self {
-        match m {
-            wire::Mode::Simulate => Self::Simulate,
-            wire::Mode::Optimize => Self::Optimize,
-        }
-    }
-}
+/// What a request computes: the request's `mode`.
+pub use super::wire::Mode;
 
 /// A validated request in SI units.
 #[derive(Debug, Clone, PartialEq)]
@@ -249,7 +200,7 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
 
         v.finish()?;
         Ok(Self {
-            mode: req.mode.into(),
+            mode: req.mode,
             plant: Plant::new(j_eq, k, c, z),
             phi,
             t: mo.t_s,

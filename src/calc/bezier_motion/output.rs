@@ -4,12 +4,12 @@ use std::f64::consts::TAU;
 
 use super::compute::{BezierOutput, BezierWarning, FactorResult, GAMMA_WARN, Residual};
 use super::history::History;
-use super::input::{BezierInput, Mode};
+use super::input::BezierInput;
 use super::optimize::Objective;
 use super::plant::{EndStateMethod, Plant};
 use super::shaper::{Baseline, Comparison, Shaper};
 use super::wire::{
-    self, BaselineIn, BezierMotionResponse, BezierRowOut, EndState, FactorEnergyOut, HistoryOut,
+    BaselineIn, BezierMotionResponse, BezierRowOut, EndState, FactorEnergyOut, HistoryOut,
     ImpulseOut, KinematicsOut, LawOut, MethodOut, ObjectiveIn, OptimizerOut, ReferenceOut,
     ResidualOut, SensitivityRow, ShaperComparisonOut, ShaperIn, ShaperRowOut, SystemOut,
 };
@@ -47,15 +47,6 @@ pub fn response_size(input: &BezierInput) -> ResponseSize {
     size
 }
 
-impl From<Mode> for wire::Mode {
-    fn from(m: Mode) -> Self {
-        match m {
-            Mode::Simulate => Self::Simulate,
-            Mode::Optimize => Self::Optimize,
-        }
-    }
-}
-
 /// Builds the response.
 #[must_use]
 pub fn respond(input: &BezierInput, out: &BezierOutput, budget: &Budget) -> BezierMotionResponse {
@@ -67,7 +58,7 @@ pub fn respond(input: &BezierInput, out: &BezierOutput, budget: &Budget) -> Bezi
         .as_ref()
         .map_or(0, |h| (h.substeps * h.t.len()) as u64);
     BezierMotionResponse {
-        mode: input.mode.into(),
+        mode: input.mode,
         system: system_out(plant, input.t),
         method: method_out(out),
         law: LawOut {

@@ -24,156 +24,58 @@ pub use super::wire::{MAX_CYCLE_SAMPLES, MAX_CYCLES, MAX_MOTORS};
 use crate::calc::common::{RESPONSE_TOO_LARGE_RULE, SHARD_INDEX_BELOW_COUNT};
 use crate::calc::{CalcFailure, CrossRule, Validator};
 
-/// Model fields of the other battery model are absent.
-pub const BATTERY_MODEL_FIELDS: CrossRule = CrossRule::invalid(
-    "BATTERY_MODEL_FIELDS",
-    &["/battery/model", "/battery/*"],
-    "A battery gives only the fields of its model: efficiency for constant; nominal_voltage, \
-     capacity_kwh, soc_initial, ocv_soc, ocv_v, r0_ohm, r1_ohm, c1_f, r2_ohm, c2_f for ecm_2rc.",
-);
-/// The ecm_2rc model's required fields are given.
-pub const BATTERY_ECM_REQUIRED: CrossRule = CrossRule::invalid(
-    "BATTERY_ECM_REQUIRED",
-    &["/battery/model", "/battery/*"],
-    "With model ecm_2rc, soc_initial, ocv_soc, ocv_v, r0_ohm, r1_ohm, c1_f, r2_ohm and c2_f are given.",
-);
-/// Axes strictly increase.
-pub const AXIS_ORDER: CrossRule = CrossRule::invalid(
-    "AXIS_ORDER",
-    &[
-        "/battery/ocv_soc",
-        "/cycles/*/time_s",
-        "/motors/*/speed_rpm",
-        "/motors/*/torque_nm",
-        "/motors/*/envelope/speed_rpm",
-        "/motors/*/ac_factor/freq_hz",
-    ],
-    "Every axis (OCV SOC points, cycle times, map and envelope speeds and torques, k_AC \
-     frequencies) is strictly increasing.",
-);
-/// Paired lists and tables have matching lengths.
-pub const LENGTH_MISMATCH: CrossRule = CrossRule::invalid(
-    "LENGTH_MISMATCH",
-    &[
-        "/battery/ocv_v",
-        "/cycles/*/speed_kmh",
-        "/cycles/*/speed_mps",
-        "/cycles/*/grade",
-        "/motors/*/envelope/t_max_nm",
-        "/motors/*/ac_factor/k_ac",
-        "/motors/*/efficiency",
-        "/motors/*/efficiency_gen",
-        "/motors/*/loss_w",
-        "/options/desirability_weights",
-    ],
-    "Paired lists have the length of their axis (ocv_v ~ ocv_soc, speeds and grade ~ time_s, \
-     t_max_nm ~ speed_rpm, k_ac ~ freq_hz), map tables are speed_rpm × torque_nm, and \
-     desirability_weights hold one weight per cycle.",
-);
-/// A custom cycle's time steps lie in [1e-3, 60] s.
-pub const TIME_STEP: CrossRule = CrossRule::invalid(
-    "TIME_STEP",
-    &["/cycles/*/time_s"],
-    "Each time step of a custom cycle lies in [0.001, 60] s.",
-);
-/// A built-in cycle name is known.
-pub const UNKNOWN_CYCLE: CrossRule = CrossRule::invalid(
-    "UNKNOWN_CYCLE",
-    &["/cycles/*"],
-    "A built-in cycle is one of manhattan, hwfet, hdudds.",
-);
-/// A cycle drives some distance.
-pub const ZERO_DISTANCE: CrossRule = CrossRule::invalid(
-    "ZERO_DISTANCE",
-    &["/cycles/*"],
-    "Every cycle drives a positive distance (fuel economy is undefined otherwise).",
-);
-/// Cycle names and motor ids are unique.
-pub const DUPLICATE_NAME: CrossRule = CrossRule::invalid(
-    "DUPLICATE_NAME",
-    &["/cycles/*", "/motors/*/id"],
-    "Cycle names are unique among the cycles, motor ids among the motors.",
-);
-/// A tabulated envelope excludes `t_peak_nm`/`p_peak_w`.
-pub const ENVELOPE_CONFLICT: CrossRule = CrossRule::invalid(
-    "ENVELOPE_CONFLICT",
-    &[
-        "/motors/*/envelope",
-        "/motors/*/t_peak_nm",
-        "/motors/*/p_peak_w",
-    ],
-    "A motor gives either envelope or t_peak_nm/p_peak_w, not both.",
-);
-/// The ψ_m implied by a back-EMF measurement lies in its range.
-pub const BACK_EMF_PSI: CrossRule = CrossRule::invalid(
-    "BACK_EMF_PSI",
-    &["/motors/*/back_emf", "/motors/*/pole_pairs"],
-    "ψ_m = v_peak_phase / (pole_pairs·2π·at_rpm/60) lies in (0, 100] Wb.",
-);
-/// L_q ≥ L_d.
-pub const LQ_BELOW_LD: CrossRule = CrossRule::invalid(
-    "LQ_BELOW_LD",
-    &["/motors/*/lq_h", "/motors/*/ld_h"],
-    "An ipmsm has lq_h ≥ ld_h (reluctance torque; MTPA assumes L_q ≥ L_d).",
-);
-/// `stack_scale` needs the Dowell AC model.
-pub const STACK_SCALE_DOWELL: CrossRule = CrossRule::invalid(
-    "STACK_SCALE_NEEDS_DOWELL",
-    &["/motors/*/stack_scale", "/motors/*/ac_factor"],
-    "stack_scale is given only with ac_factor model dowell (its stack/end lengths split the resistance).",
-);
-/// A loss map's signed torque axis contains 0.
-pub const LOSS_AXIS_ZERO: CrossRule = CrossRule::invalid(
-    "LOSS_AXIS_ZERO",
-    &["/motors/*/torque_nm"],
-    "A loss_map motor's signed torque axis contains 0.",
-);
-/// The desirability weights are not all zero.
-pub const DESIRABILITY_ZERO: CrossRule = CrossRule::invalid(
-    "DESIRABILITY_ZERO",
-    &["/options/desirability_weights"],
-    "The desirability weights are not all 0.",
-);
-/// Every cycle's top speed is within every motor's speed limit.
-pub const CYCLE_ABOVE_MOTOR_SPEED: CrossRule = CrossRule::invalid(
-    "CYCLE_ABOVE_MOTOR_SPEED",
-    &["/motors/*/n_max_rpm", "/cycles", "/vehicle"],
-    "The motor speed at every cycle's top speed (through wheel radius and gear ratio) is within \
-     each motor's n_max_rpm (for maps, also their last speed_rpm).",
-);
-/// The simulated intervals stay within the service limit.
-pub const TOO_MANY_SAMPLES: CrossRule = CrossRule::too_large(
-    "TOO_MANY_SAMPLES",
-    &["/options/substeps", "/cycles"],
-    "The intervals of all cycles after sub-stepping number at most 1 000 000.",
-);
-
-/// The rules between fields of `POST /v1/bus-fuel-economy` and the failures of its computation,
-/// as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    BATTERY_MODEL_FIELDS,
-    BATTERY_ECM_REQUIRED,
-    AXIS_ORDER,
-    LENGTH_MISMATCH,
-    TIME_STEP,
-    UNKNOWN_CYCLE,
-    ZERO_DISTANCE,
-    DUPLICATE_NAME,
-    ENVELOPE_CONFLICT,
-    BACK_EMF_PSI,
-    LQ_BELOW_LD,
-    STACK_SCALE_DOWELL,
-    LOSS_AXIS_ZERO,
-    DESIRABILITY_ZERO,
-    CYCLE_ABOVE_MOTOR_SPEED,
-    TOO_MANY_SAMPLES,
-    SHARD_INDEX_BELOW_COUNT,
-    DEADLINE_RULE,
-    SPEED_UNREACHABLE_RULE,
-    HISTOGRAM_TOO_LARGE_RULE,
-    MAP_TOO_LARGE_RULE,
-    RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/bus-fuel-economy` and the failures of its computation,
+    /// as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid BATTERY_MODEL_FIELDS ["/battery/model", "/battery/*"]
+        "A battery gives only the fields of its model: efficiency for constant; nominal_voltage, \
+         capacity_kwh, soc_initial, ocv_soc, ocv_v, r0_ohm, r1_ohm, c1_f, r2_ohm, c2_f for ecm_2rc.";
+    invalid BATTERY_ECM_REQUIRED ["/battery/model", "/battery/*"]
+        "With model ecm_2rc, soc_initial, ocv_soc, ocv_v, r0_ohm, r1_ohm, c1_f, r2_ohm and c2_f are given.";
+    invalid AXIS_ORDER ["/battery/ocv_soc", "/cycles/*/time_s", "/motors/*/speed_rpm",
+        "/motors/*/torque_nm", "/motors/*/envelope/speed_rpm", "/motors/*/ac_factor/freq_hz"]
+        "Every axis (OCV SOC points, cycle times, map and envelope speeds and torques, k_AC \
+         frequencies) is strictly increasing.";
+    invalid LENGTH_MISMATCH ["/battery/ocv_v", "/cycles/*/speed_kmh", "/cycles/*/speed_mps",
+        "/cycles/*/grade", "/motors/*/envelope/t_max_nm", "/motors/*/ac_factor/k_ac",
+        "/motors/*/efficiency", "/motors/*/efficiency_gen", "/motors/*/loss_w",
+        "/options/desirability_weights"]
+        "Paired lists have the length of their axis (ocv_v ~ ocv_soc, speeds and grade ~ time_s, \
+         t_max_nm ~ speed_rpm, k_ac ~ freq_hz), map tables are speed_rpm × torque_nm, and \
+         desirability_weights hold one weight per cycle.";
+    invalid TIME_STEP ["/cycles/*/time_s"]
+        "Each time step of a custom cycle lies in [0.001, 60] s.";
+    invalid UNKNOWN_CYCLE ["/cycles/*"] "A built-in cycle is one of manhattan, hwfet, hdudds.";
+    invalid ZERO_DISTANCE ["/cycles/*"]
+        "Every cycle drives a positive distance (fuel economy is undefined otherwise).";
+    invalid DUPLICATE_NAME ["/cycles/*", "/motors/*/id"]
+        "Cycle names are unique among the cycles, motor ids among the motors.";
+    invalid ENVELOPE_CONFLICT ["/motors/*/envelope", "/motors/*/t_peak_nm", "/motors/*/p_peak_w"]
+        "A motor gives either envelope or t_peak_nm/p_peak_w, not both.";
+    invalid BACK_EMF_PSI ["/motors/*/back_emf", "/motors/*/pole_pairs"]
+        "ψ_m = v_peak_phase / (pole_pairs·2π·at_rpm/60) lies in (0, 100] Wb.";
+    invalid LQ_BELOW_LD ["/motors/*/lq_h", "/motors/*/ld_h"]
+        "An ipmsm has lq_h ≥ ld_h (reluctance torque; MTPA assumes L_q ≥ L_d).";
+    invalid STACK_SCALE_DOWELL("STACK_SCALE_NEEDS_DOWELL") ["/motors/*/stack_scale",
+        "/motors/*/ac_factor"]
+        "stack_scale is given only with ac_factor model dowell (its stack/end lengths split the resistance).";
+    invalid LOSS_AXIS_ZERO ["/motors/*/torque_nm"]
+        "A loss_map motor's signed torque axis contains 0.";
+    invalid DESIRABILITY_ZERO ["/options/desirability_weights"]
+        "The desirability weights are not all 0.";
+    invalid CYCLE_ABOVE_MOTOR_SPEED ["/motors/*/n_max_rpm", "/cycles", "/vehicle"]
+        "The motor speed at every cycle's top speed (through wheel radius and gear ratio) is within \
+         each motor's n_max_rpm (for maps, also their last speed_rpm).";
+    too_large TOO_MANY_SAMPLES ["/options/substeps", "/cycles"]
+        "The intervals of all cycles after sub-stepping number at most 1 000 000.";
+    listed SHARD_INDEX_BELOW_COUNT;
+    listed DEADLINE_RULE;
+    listed SPEED_UNREACHABLE_RULE;
+    listed HISTOGRAM_TOO_LARGE_RULE;
+    listed MAP_TOO_LARGE_RULE;
+    listed RESPONSE_TOO_LARGE_RULE;
+}
 
 /// The rules between fields of `POST /v1/bus-fuel-economy/motor-map` and the failures of its
 /// computation, as the document lists them (the motor's rules apply to `/motor/...` here).
@@ -216,42 +118,8 @@ const DEFAULT_T_PEAK: f64 = 800.0;
 const DEFAULT_P_PEAK: f64 = 130_000.0;
 const DEFAULT_N_MAX: f64 = 5200.0;
 
-/// How an `ipmsm` motor's loss is evaluated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MotorEval {
-    /// Solve the dq operating point at every interval.
-    Direct,
-    /// Interpolate a loss map precomputed on the options' grid.
-    LossMap,
-}
-
-impl From<w::Mode> for Mode {
-    fn from(m: w::Mode) -> Self {
-        match m {
-            w::Mode::Backward => Self::Backward,
-            w::Mode::Clip => Self::Clip,
-            w::Mode::Forward => Self::Forward,
-        }
-    }
-}
-
-impl From<w::PowerConvention> for PowerConvention {
-    fn from(c: w::PowerConvention) -> Self {
-        match c {
-            w::PowerConvention::Paper => Self::Paper,
-            w::PowerConvention::Loss => Self::Loss,
-        }
-    }
-}
-
-impl From<w::MotorEval> for MotorEval {
-    fn from(e: w::MotorEval) -> Self {
-        match e {
-            w::MotorEval::Direct => Self::Direct,
-            w::MotorEval::LossMap => Self::LossMap,
-        }
-    }
-}
+/// How an `ipmsm` motor's loss is evaluated: the request's `motor_eval`.
+pub use super::wire::MotorEval;
 
 /// Validated options.
 #[derive(Debug, Clone)]
@@ -995,8 +863,8 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
             cycles: cycles_ok.into_iter().map(|(_, c)| c).collect(),
             motors,
             options: Options {
-                mode: o.mode.into(),
-                convention: o.power_convention.into(),
+                mode: o.mode,
+                convention: o.power_convention,
                 substeps,
                 regen: o.regen,
                 regen_limit: o.regen_limit,

@@ -9,12 +9,12 @@ use super::compute::{
     self, BusFuelEconomyOutput, ComparisonData, Histogram, MapData, RunResult, fuel_economy,
 };
 use super::cycles;
-use super::input::{BusFuelEconomyInput, MotorEval};
+use super::input::BusFuelEconomyInput;
 use super::ipmsm::{self, rad_s_to_rpm};
 use super::motor::{self, MotorInput};
-use super::sim::{Mode, PowerConvention, SimOutcome};
+use super::sim::{Mode, SimOutcome};
 use super::wire::{
-    self, BusFuelEconomyResponse, Comparison, CycleResult, Desirability, Echo, LossBreakdown,
+    BusFuelEconomyResponse, Comparison, CycleResult, Desirability, Echo, LossBreakdown,
     LossComponentMaps, ModalBin, MotorMapData, MotorMapResponse, OpHistogram, Traces,
 };
 use crate::calc::common::ResponseSize;
@@ -22,34 +22,6 @@ use crate::numerics::{Budget, SolverReport, StopReason};
 
 /// J → kWh.
 const J_PER_KWH: f64 = 3.6e6;
-
-impl From<Mode> for wire::Mode {
-    fn from(m: Mode) -> Self {
-        match m {
-            Mode::Backward => Self::Backward,
-            Mode::Clip => Self::Clip,
-            Mode::Forward => Self::Forward,
-        }
-    }
-}
-
-impl From<PowerConvention> for wire::PowerConvention {
-    fn from(c: PowerConvention) -> Self {
-        match c {
-            PowerConvention::Paper => Self::Paper,
-            PowerConvention::Loss => Self::Loss,
-        }
-    }
-}
-
-impl From<MotorEval> for wire::MotorEval {
-    fn from(e: MotorEval) -> Self {
-        match e {
-            MotorEval::Direct => Self::Direct,
-            MotorEval::LossMap => Self::LossMap,
-        }
-    }
-}
 
 /// Builds the response of the motor-map endpoint from the validated motor and its map.
 #[must_use]
@@ -452,10 +424,10 @@ pub fn respond(
         motor_maps,
         shard: input.shard.map(|s| s.out(pairs)),
         echo: Echo {
-            mode: o.mode.into(),
-            power_convention: o.convention.into(),
+            mode: o.mode,
+            power_convention: o.convention,
             substeps: u32::try_from(o.substeps).unwrap_or(u32::MAX),
-            motor_eval: o.motor_eval.into(),
+            motor_eval: o.motor_eval,
             regen: o.regen,
             regen_limit: o.regen_limit,
             cycle_data_version: cycles::CYCLE_DATA_VERSION.to_owned(),

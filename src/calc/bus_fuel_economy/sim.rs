@@ -10,25 +10,11 @@ use super::error::BusFuelEconomyError;
 use super::motor::MotorEvaluator;
 use crate::numerics::Budget;
 
-/// Handling of traction demand above the motor envelope (spec §5.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    /// Follow the trace exactly; losses evaluated at the envelope; exceedances counted.
-    Backward,
-    /// Clip the motor torque to the envelope (missing traction dropped).
-    Clip,
-    /// Trace miss: the bus accelerates at the envelope and falls behind.
-    Forward,
-}
+/// The envelope policy: the request's `mode`.
+pub use super::wire::Mode;
 
-/// Motor terminal power convention (spec §5.6).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PowerConvention {
-    /// Paper eq. 2-3: P_el = P_m/η motoring, P_m·η generating, 0 at zero power.
-    Paper,
-    /// Additive losses: P_el = P_m + P_loss in both directions.
-    Loss,
-}
+/// The power convention: the request's `power_convention`.
+pub use super::wire::PowerConvention;
 
 /// Torque margin above T_max before an interval counts as over the envelope (spec §5.4).
 pub const OVER_ENVELOPE_TOL: f64 = 1e-9;

@@ -9,83 +9,33 @@ use super::law::{
     normalize_coefficients,
 };
 use super::wire::{AbscissaIn, ConstraintsIn, EvaluateRequest, Units};
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 
-/// The coefficients sum to 1 within [`SUM_TOL`] unless `normalize` is set.
-pub const COEFFICIENT_SUM: CrossRule = CrossRule::invalid(
-    "COEFFICIENT_SUM",
-    &["/coefficients", "/normalize"],
-    "The coefficients sum to 1 within 1e-3, unless `normalize` is true (then any positive sum).",
-);
-/// Both acceleration pulses hold some duration.
-pub const EMPTY_PULSE: CrossRule = CrossRule::invalid(
-    "EMPTY_PULSE",
-    &["/coefficients"],
-    "Both acceleration pulses are non-empty: c0 + c1 + c2 and c4 + c5 + c6 each at least 1e-9 of the sum.",
-);
-/// Abscissae strictly increase; a grid's end lies beyond its start.
-pub const ABSCISSA_ORDER: CrossRule = CrossRule::invalid(
-    "ABSCISSA_ORDER",
-    &["/abscissa/values/*", "/abscissa/grid/end"],
-    "Abscissae strictly increase; a grid's `end` is greater than its `start`.",
-);
-/// The segment has a positive, resolvable length.
-pub const SEGMENT_INTERVAL: CrossRule = CrossRule::invalid(
-    "SEGMENT_INTERVAL",
-    &["/constraints/t_a", "/constraints/t_b"],
-    "t_b > t_a (each defaulting to the first/last abscissa, else 0 and 1), and t_b − t_a exceeds \
-     1e-12·max(|t_a|, |t_b|) so the knots stay distinct.",
-);
-/// Every abscissa lies inside the segment.
-pub const ABSCISSA_OUTSIDE: CrossRule = CrossRule::invalid(
-    "ABSCISSA_OUTSIDE",
-    &[
-        "/abscissa/values/*",
-        "/abscissa/grid/start",
-        "/abscissa/grid/end",
-        "/constraints/t_a",
-        "/constraints/t_b",
-    ],
-    "Every abscissa lies in [t_a, t_b] within 1e-9·(t_b − t_a) (values within that tolerance are clamped).",
-);
-/// Named laws outside the 7-segment class take zero end rates only.
-pub const CLOSED_FORM_RATES: CrossRule = CrossRule::invalid(
-    "CLOSED_FORM_RATES",
-    &[
-        "/law",
-        "/constraints/v_a",
-        "/constraints/v_b",
-        "/constraints/a_a",
-        "/constraints/a_b",
-    ],
-    "A named law outside the 7-segment class (constant_velocity, cubic, polynomial_*, \
-     double_harmonic) requires zero end velocities and accelerations.",
-);
-/// The law's values stay within f64.
-pub const LAW_OVERFLOW: CrossRule = CrossRule::too_large(
-    "LAW_OVERFLOW",
-    &["/constraints"],
-    "The law's peaks stay finite in f64 (a very short interval with a large rise or large end rates overflows).",
-);
-/// The evaluated curves stay within f64.
-pub const NON_FINITE_RESULT: CrossRule = CrossRule::too_large(
-    "NON_FINITE_RESULT",
-    &["/constraints", "/abscissa"],
-    "Every reported number is finite in f64.",
-);
-
-/// The rules between fields of `POST /v1/cam-law/evaluate`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    COEFFICIENT_SUM,
-    EMPTY_PULSE,
-    ABSCISSA_ORDER,
-    SEGMENT_INTERVAL,
-    ABSCISSA_OUTSIDE,
-    CLOSED_FORM_RATES,
-    LAW_OVERFLOW,
-    NON_FINITE_RESULT,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/cam-law/evaluate`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid COEFFICIENT_SUM ["/coefficients", "/normalize"]
+        "The coefficients sum to 1 within 1e-3, unless `normalize` is true (then any positive sum).";
+    invalid EMPTY_PULSE ["/coefficients"]
+        "Both acceleration pulses are non-empty: c0 + c1 + c2 and c4 + c5 + c6 each at least 1e-9 of the sum.";
+    invalid ABSCISSA_ORDER ["/abscissa/values/*", "/abscissa/grid/end"]
+        "Abscissae strictly increase; a grid's `end` is greater than its `start`.";
+    invalid SEGMENT_INTERVAL ["/constraints/t_a", "/constraints/t_b"]
+        "t_b > t_a (each defaulting to the first/last abscissa, else 0 and 1), and t_b − t_a exceeds \
+         1e-12·max(|t_a|, |t_b|) so the knots stay distinct.";
+    invalid ABSCISSA_OUTSIDE ["/abscissa/values/*", "/abscissa/grid/start", "/abscissa/grid/end",
+        "/constraints/t_a", "/constraints/t_b"]
+        "Every abscissa lies in [t_a, t_b] within 1e-9·(t_b − t_a) (values within that tolerance are clamped).";
+    invalid CLOSED_FORM_RATES ["/law", "/constraints/v_a", "/constraints/v_b", "/constraints/a_a",
+        "/constraints/a_b"]
+        "A named law outside the 7-segment class (constant_velocity, cubic, polynomial_*, \
+         double_harmonic) requires zero end velocities and accelerations.";
+    too_large LAW_OVERFLOW ["/constraints"]
+        "The law's peaks stay finite in f64 (a very short interval with a large rise or large end rates overflows).";
+    too_large NON_FINITE_RESULT ["/constraints", "/abscissa"]
+        "Every reported number is finite in f64.";
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// Coefficients must sum to 1 within this unless `normalize` is set (spec §2).
 pub const SUM_TOL: f64 = 1e-3;

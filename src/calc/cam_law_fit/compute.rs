@@ -13,10 +13,11 @@ use crate::calc::cam_law::law::{
 use crate::numerics::{Budget, StopReason};
 
 use super::error::FitError;
+pub use super::input::{Algorithm, Settings};
 use super::input::{Channel, FitInput, MetricKind};
 use super::objective::{Ctx, CurveModel, Dtw, Metric, euclidean};
 use super::optim::cmaes::{self, CmaParams, default_lambda};
-use super::optim::ga::{self, GaParams};
+use super::optim::ga;
 use super::optim::lsq::{self, MAX_EVALS_PER_START};
 use super::optim::{FreeGenes, de, normalized};
 use crate::numerics::grid;
@@ -60,44 +61,6 @@ impl CurveModel for LawModel<'_> {
             Err(_) => false,
         }
     }
-}
-
-/// The optimizer of a fit (spec §3.5; the request's `optimizer.method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Algorithm {
-    /// Multi-start least squares with zero-snapping (+ CMA-ES polish and IPOP for DTW).
-    Auto,
-    /// The paper's elitist GA.
-    Ga,
-    /// Differential evolution DE/best/1/bin.
-    De,
-    /// CMA-ES from the initial solution.
-    Cmaes,
-    /// One least-squares run from the initial solution (Euclidean only).
-    Lsq,
-}
-
-/// Optimizer settings of one fit.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Settings {
-    /// Method.
-    pub method: Algorithm,
-    /// RNG seed.
-    pub seed: u64,
-    /// GA settings.
-    pub ga: GaParams,
-    /// IPOP restarts for DTW in `auto`.
-    pub dtw_global_restarts: u32,
-    /// Least-squares + snap polish after the stochastic methods (EN only).
-    pub polish: bool,
-    /// Zero-snap threshold on normalized coefficients.
-    pub snap_tol: f64,
-    /// Initial coefficients (normalized, fixed genes zero).
-    pub initial: [f64; 7],
-    /// Segments held at zero.
-    pub fixed_zero: [bool; 7],
-    /// Request's evaluation cap (the `lsq` method's single run may use all of it).
-    pub max_evaluations: u64,
 }
 
 /// Result of the optimizer pipeline.

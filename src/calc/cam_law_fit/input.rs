@@ -7,157 +7,62 @@ use crate::calc::cam_law::law::{
     BoundaryConditions, K1, LawError, LawNotice, Quantity, SevenSegmentLaw,
 };
 use crate::calc::cam_law::wire::Units;
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 
-use super::compute::{Algorithm, Settings};
 use super::optim::ga::GaParams;
 use super::wire::{
-    Channels, FitCamLawRequest, FitQuantity, GaIn, MAX_CURVE_COUNT, Method, MetricName, OptimizerIn,
+    Channels, FitCamLawRequest, GaIn, MAX_CURVE_COUNT, Method, MetricName, OptimizerIn,
 };
 use crate::numerics::grid;
 
-/// Abscissae strictly increase; a grid's end lies beyond its start and its points stay distinct.
-pub const ABSCISSA_ORDER: CrossRule = CrossRule::invalid(
-    "ABSCISSA_ORDER",
-    &["/abscissa/values/*", "/abscissa/grid/end", "/abscissa/grid"],
-    "Abscissae strictly increase; a grid's `end` is greater than its `start`, and its `count` \
-     points stay strictly increasing in f64.",
-);
-/// At least one channel is supplied.
-pub const NO_CHANNEL: CrossRule = CrossRule::invalid(
-    "NO_CHANNEL",
-    &["/channels"],
-    "At least one of `channels.displacement`, `channels.velocity`, `channels.acceleration` is given.",
-);
-/// Every channel has one value per abscissa.
-pub const CHANNEL_LENGTH: CrossRule = CrossRule::invalid(
-    "CHANNEL_LENGTH",
-    &[
-        "/channels/displacement",
-        "/channels/velocity",
-        "/channels/acceleration",
-        "/abscissa",
-    ],
-    "Every supplied channel holds exactly one value per abscissa (N values).",
-);
-/// The fitted channel is supplied or can be derived from a lower one.
-pub const FIT_CHANNEL: CrossRule = CrossRule::invalid(
-    "FIT_CHANNEL_MISSING",
-    &["/fit_on", "/derive_missing", "/channels"],
-    "The `fit_on` channel (default acceleration) is supplied, or `derive_missing` is true and a \
-     lower channel (s → v → a) is supplied to differentiate.",
-);
-/// Without a displacement channel the end displacements are given.
-pub const END_DISPLACEMENT: CrossRule = CrossRule::invalid(
-    "END_DISPLACEMENT_REQUIRED",
-    &[
-        "/constraints/s_a",
-        "/constraints/s_b",
-        "/channels/displacement",
-    ],
-    "`constraints.s_a` and `constraints.s_b` are given when no displacement channel is supplied.",
-);
-/// The segment has a positive, resolvable length within the law's magnitude cap.
-pub const SEGMENT_INTERVAL: CrossRule = CrossRule::invalid(
-    "SEGMENT_INTERVAL",
-    &["/constraints/t_a", "/constraints/t_b"],
-    "t_b > t_a (each defaulting to the first/last abscissa), and t_b − t_a exceeds \
-     1e-12·max(|t_a|, |t_b|) so the knots stay distinct.",
-);
-/// Every sample lies inside the segment.
-pub const ABSCISSA_OUTSIDE: CrossRule = CrossRule::invalid(
-    "ABSCISSA_OUTSIDE",
-    &[
-        "/abscissa/values/*",
-        "/abscissa/grid",
-        "/constraints/t_a",
-        "/constraints/t_b",
-    ],
-    "Every sample abscissa lies in [t_a, t_b] within 1e-9·(t_b − t_a) (values within that \
-     tolerance are clamped).",
-);
-/// The DTW band is at most the number of samples.
-pub const DTW_WINDOW_SAMPLES: CrossRule = CrossRule::invalid(
-    "DTW_WINDOW_SAMPLES",
-    &["/objective/dtw_window", "/abscissa"],
-    "objective.dtw_window ≤ N, the number of samples.",
-);
-/// Least squares cannot minimize the DTW metric.
-pub const METHOD_METRIC: CrossRule = CrossRule::invalid(
-    "METHOD_METRIC",
-    &["/optimizer/method", "/objective/metric"],
-    "optimizer.method `lsq` is used only with objective.metric `euclidean`.",
-);
-/// At most one starting point.
-pub const INITIAL_EXCLUSIVE: CrossRule = CrossRule::invalid(
-    "INITIAL_EXCLUSIVE",
-    &["/initial_coefficients", "/initial_law"],
-    "At most one of `initial_coefficients` and `initial_law` is given.",
-);
-/// The starting law belongs to the 7-segment class.
-pub const INITIAL_LAW_CLASS: CrossRule = CrossRule::invalid(
-    "INITIAL_LAW_CLASS",
-    &["/initial_law"],
-    "initial_law is a 7-segment law: constant_acceleration, simple_harmonic, cycloidal, \
-     modified_trapezoid or modified_sine.",
-);
-/// Both acceleration pulses of the starting solution hold some duration.
-pub const EMPTY_PULSE: CrossRule = CrossRule::invalid(
-    "EMPTY_PULSE",
-    &["/fixed_zero", "/initial_coefficients", "/initial_law"],
-    "Both acceleration pulses of the initial solution (c0..c2 and c4..c6, after `fixed_zero`) \
-     keep a free segment with a positive duration.",
-);
-/// The cost estimate stays below [`MAX_COST`].
-pub const FIT_TOO_EXPENSIVE: CrossRule = CrossRule::too_large(
-    "FIT_TOO_EXPENSIVE",
-    &[
-        "/optimizer/max_evaluations",
-        "/abscissa",
-        "/objective/dtw_window",
-    ],
-    "max_evaluations × N × (metric dtw ? 2w+1 : 1) ≤ 2e10 cell operations.",
-);
-/// The initial law exists in f64.
-pub const INFEASIBLE_CONSTRAINTS: CrossRule = CrossRule::infeasible(
-    "INFEASIBLE_CONSTRAINTS",
-    &["/constraints"],
-    "Some 7-segment law over [t_a, t_b] meets the end conditions in f64 (the initial law's \
-     peaks stay finite).",
-);
-/// The fitted law exists in f64 (found while computing).
-pub const LAW_OVERFLOW: CrossRule = CrossRule::too_large(
-    "LAW_OVERFLOW",
-    &["/constraints"],
-    "The fitted law's peaks stay finite in f64.",
-);
-/// Every reported number is finite (found while computing).
-pub const RESULT_OVERFLOW: CrossRule = CrossRule::too_large(
-    "RESULT_OVERFLOW",
-    &["/channels", "/constraints"],
-    "Every reported number of the fitted law is finite in f64 (rescale the units of the data).",
-);
-
-/// The rules between fields of `POST /v1/fit-cam-law`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    ABSCISSA_ORDER,
-    NO_CHANNEL,
-    CHANNEL_LENGTH,
-    FIT_CHANNEL,
-    END_DISPLACEMENT,
-    SEGMENT_INTERVAL,
-    ABSCISSA_OUTSIDE,
-    DTW_WINDOW_SAMPLES,
-    METHOD_METRIC,
-    INITIAL_EXCLUSIVE,
-    INITIAL_LAW_CLASS,
-    EMPTY_PULSE,
-    FIT_TOO_EXPENSIVE,
-    INFEASIBLE_CONSTRAINTS,
-    LAW_OVERFLOW,
-    RESULT_OVERFLOW,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/fit-cam-law`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid ABSCISSA_ORDER ["/abscissa/values/*", "/abscissa/grid/end", "/abscissa/grid"]
+        "Abscissae strictly increase; a grid's `end` is greater than its `start`, and its `count` \
+         points stay strictly increasing in f64.";
+    invalid NO_CHANNEL ["/channels"]
+        "At least one of `channels.displacement`, `channels.velocity`, `channels.acceleration` is given.";
+    invalid CHANNEL_LENGTH ["/channels/displacement", "/channels/velocity",
+        "/channels/acceleration", "/abscissa"]
+        "Every supplied channel holds exactly one value per abscissa (N values).";
+    invalid FIT_CHANNEL("FIT_CHANNEL_MISSING") ["/fit_on", "/derive_missing", "/channels"]
+        "The `fit_on` channel (default acceleration) is supplied, or `derive_missing` is true and a \
+         lower channel (s → v → a) is supplied to differentiate.";
+    invalid END_DISPLACEMENT("END_DISPLACEMENT_REQUIRED") ["/constraints/s_a", "/constraints/s_b",
+        "/channels/displacement"]
+        "`constraints.s_a` and `constraints.s_b` are given when no displacement channel is supplied.";
+    invalid SEGMENT_INTERVAL ["/constraints/t_a", "/constraints/t_b"]
+        "t_b > t_a (each defaulting to the first/last abscissa), and t_b − t_a exceeds \
+         1e-12·max(|t_a|, |t_b|) so the knots stay distinct.";
+    invalid ABSCISSA_OUTSIDE ["/abscissa/values/*", "/abscissa/grid", "/constraints/t_a",
+        "/constraints/t_b"]
+        "Every sample abscissa lies in [t_a, t_b] within 1e-9·(t_b − t_a) (values within that \
+         tolerance are clamped).";
+    invalid DTW_WINDOW_SAMPLES ["/objective/dtw_window", "/abscissa"]
+        "objective.dtw_window ≤ N, the number of samples.";
+    invalid METHOD_METRIC ["/optimizer/method", "/objective/metric"]
+        "optimizer.method `lsq` is used only with objective.metric `euclidean`.";
+    invalid INITIAL_EXCLUSIVE ["/initial_coefficients", "/initial_law"]
+        "At most one of `initial_coefficients` and `initial_law` is given.";
+    invalid INITIAL_LAW_CLASS ["/initial_law"]
+        "initial_law is a 7-segment law: constant_acceleration, simple_harmonic, cycloidal, \
+         modified_trapezoid or modified_sine.";
+    invalid EMPTY_PULSE ["/fixed_zero", "/initial_coefficients", "/initial_law"]
+        "Both acceleration pulses of the initial solution (c0..c2 and c4..c6, after `fixed_zero`) \
+         keep a free segment with a positive duration.";
+    too_large FIT_TOO_EXPENSIVE ["/optimizer/max_evaluations", "/abscissa", "/objective/dtw_window"]
+        "max_evaluations × N × (metric dtw ? 2w+1 : 1) ≤ 2e10 cell operations.";
+    infeasible INFEASIBLE_CONSTRAINTS ["/constraints"]
+        "Some 7-segment law over [t_a, t_b] meets the end conditions in f64 (the initial law's \
+         peaks stay finite).";
+    /// The fitted law exists in f64 (found while computing).
+    too_large LAW_OVERFLOW ["/constraints"] "The fitted law's peaks stay finite in f64.";
+    /// Every reported number is finite (found while computing).
+    too_large RESULT_OVERFLOW ["/channels", "/constraints"]
+        "Every reported number of the fitted law is finite in f64 (rescale the units of the data).";
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// Samples may lie this fraction of Δt outside `[t_a, t_b]` (they are clamped), spec §2.
 pub const ABSCISSA_TOL: f64 = 1e-9;
@@ -234,16 +139,8 @@ pub struct FitOutputs {
     pub classify: bool,
 }
 
-/// A measured channel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Channel {
-    /// Displacement `s`.
-    Displacement,
-    /// Velocity `v`.
-    Velocity,
-    /// Acceleration `a`.
-    Acceleration,
-}
+/// A measured channel: the request's quantity.
+pub use super::wire::FitQuantity as Channel;
 
 impl Channel {
     /// s, v, a.
@@ -280,33 +177,33 @@ impl Channel {
     }
 }
 
-impl From<FitQuantity> for Channel {
-    fn from(q: FitQuantity) -> Self {
-        match q {
-            FitQuantity::Displacement => Self::Displacement,
-            FitQuantity::Velocity => Self::Velocity,
-            FitQuantity::Acceleration => Self::Acceleration,
-        }
-    }
-}
+/// The distance between model and data: the request's metric.
+pub use super::wire::MetricName as MetricKind;
 
-/// The distance between model and data.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MetricKind {
-    /// Euclidean norm (paper Eq. 7).
-    Euclidean,
-    /// The paper's DTW.
-    Dtw,
-}
+/// The optimizer of a fit (spec §3.5): the request's `optimizer.method`.
+pub use super::wire::Method as Algorithm;
 
-fn algorithm(m: Method) -> Algorithm {
-    match m {
-        Method::Auto => Algorithm::Auto,
-        Method::Ga => Algorithm::Ga,
-        Method::De => Algorithm::De,
-        Method::Cmaes => Algorithm::Cmaes,
-        Method::Lsq => Algorithm::Lsq,
-    }
+/// Optimizer settings of one fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Method.
+    pub method: Algorithm,
+    /// RNG seed.
+    pub seed: u64,
+    /// GA settings.
+    pub ga: GaParams,
+    /// IPOP restarts for DTW in `auto`.
+    pub dtw_global_restarts: u32,
+    /// Least-squares + snap polish after the stochastic methods (EN only).
+    pub polish: bool,
+    /// Zero-snap threshold on normalized coefficients.
+    pub snap_tol: f64,
+    /// Initial coefficients (normalized, fixed genes zero).
+    pub initial: [f64; 7],
+    /// Segments held at zero.
+    pub fixed_zero: [bool; 7],
+    /// Request's evaluation cap (the `lsq` method's single run may use all of it).
+    pub max_evaluations: u64,
 }
 
 /// The sample abscissae (exactly one of `values`/`grid`, their lengths and the grid's count are
@@ -397,7 +294,7 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
             }
         }
     }
-    let fit_on = Channel::from(req.fit_on.unwrap_or(FitQuantity::Acceleration));
+    let fit_on = req.fit_on.unwrap_or(Channel::Acceleration);
     let fit_idx = fit_on.index();
     if supplied[fit_idx].is_none() && !supplied.iter().all(Option::is_none) {
         if !req.derive_missing {
@@ -852,14 +749,11 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         bc,
         objective: ObjectiveSpec {
             on: fit_on,
-            metric: match metric {
-                MetricName::Euclidean => MetricKind::Euclidean,
-                MetricName::Dtw => MetricKind::Dtw,
-            },
+            metric,
             dtw_window,
         },
         settings: Settings {
-            method: algorithm(method),
+            method,
             seed: o.seed.unwrap_or(0),
             ga,
             dtw_global_restarts,

@@ -2,33 +2,15 @@
 //! the objective and optimizer report, the optional outputs the request asked for (omitted
 //! otherwise), warning codes and the echoed unit labels.
 
-use super::compute::{Algorithm, ChannelErrors as Errors, FitOutput};
-use super::input::{Channel, FitInput, MetricKind};
+use super::compute::{ChannelErrors as Errors, FitOutput};
+use super::input::{FitInput, MetricKind};
 use super::wire::{
-    ChannelErrors, Classification, ErrorTable, FitCamLawResponse, FitQuantity, Method, MetricName,
-    ObjectiveOut, OptimizerReport,
+    ChannelErrors, Classification, ErrorTable, FitCamLawResponse, MetricName, ObjectiveOut,
+    OptimizerReport,
 };
 use crate::calc::cam_law::output::warnings;
 use crate::calc::cam_law::wire::Curves;
 use crate::numerics::Budget;
-
-const fn method(a: Algorithm) -> Method {
-    match a {
-        Algorithm::Auto => Method::Auto,
-        Algorithm::Ga => Method::Ga,
-        Algorithm::De => Method::De,
-        Algorithm::Cmaes => Method::Cmaes,
-        Algorithm::Lsq => Method::Lsq,
-    }
-}
-
-const fn quantity(c: Channel) -> FitQuantity {
-    match c {
-        Channel::Displacement => FitQuantity::Displacement,
-        Channel::Velocity => FitQuantity::Velocity,
-        Channel::Acceleration => FitQuantity::Acceleration,
-    }
-}
 
 fn error_table([s, v, a]: [Option<Errors>; 3]) -> ErrorTable {
     let wire = |e: Option<Errors>| {
@@ -61,7 +43,7 @@ pub fn respond(input: &FitInput, out: FitOutput, budget: &Budget) -> FitCamLawRe
             } else {
                 MetricName::Euclidean
             },
-            quantity: quantity(objective.on),
+            quantity: objective.on,
             dtw_window: dtw.then_some(objective.dtw_window as u64),
             initial: out.objective.initial,
             final_value: out.objective.final_value,
@@ -76,7 +58,7 @@ pub fn respond(input: &FitInput, out: FitOutput, budget: &Budget) -> FitCamLawRe
         curves: out.curves.map(Curves::from),
         history: out.history,
         optimizer_report: OptimizerReport {
-            method: method(input.settings.method),
+            method: input.settings.method,
             seed: input.settings.seed,
             evaluations: out.stats.evaluations,
             iterations: out.stats.iterations,

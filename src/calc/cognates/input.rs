@@ -10,129 +10,54 @@
 //! no square can overflow or underflow whatever the caller's unit.
 
 use crate::calc::common;
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 
 use super::geometry::{C64, FourBar, Sign, cis, cross};
 use super::sampling::Spacing;
 use super::wire::{
-    self, AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec, VerifyKind,
+    AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec, VerifyKind,
 };
 
 pub use super::wire::MAX_MAGNITUDE;
 use super::wire::POINTS_PER_CIRCUIT;
 
-/// With `joints`, the dimension fields are omitted.
-pub const JOINTS_EXCLUSIVE: CrossRule = CrossRule::invalid(
-    "JOINTS_EXCLUSIVE",
-    &[
-        "/joints",
-        "/ground",
-        "/crank",
-        "/coupler",
-        "/rocker",
-        "/coupler_point",
-        "/input_angle_deg",
-        "/branch",
-    ],
-    "With `joints`, `ground`, `crank`, `coupler`, `rocker`, `coupler_point`, `input_angle_deg` \
-     and `branch` are omitted (they are read from the drawn configuration).",
-);
-/// Without `joints`, the dimensions are given.
-pub const DIMENSIONS_REQUIRED: CrossRule = CrossRule::invalid(
-    "DIMENSIONS_REQUIRED",
-    &[
-        "/ground",
-        "/crank",
-        "/coupler",
-        "/rocker",
-        "/coupler_point",
-        "/joints",
-    ],
-    "Without `joints`, `ground`, `crank`, `coupler`, `rocker` and `coupler_point` are all given.",
-);
-/// The ground is given by exactly one of its far pivot and its length. (Not a `one_of` of the
-/// schema: its failures point at `/ground/length` (both) or `/ground/B` (neither), as before.)
-pub const GROUND_B_OR_LENGTH: CrossRule = CrossRule::invalid(
-    "GROUND_B_OR_LENGTH",
-    &["/ground/B", "/ground/length"],
-    "Exactly one of `ground.B` and `ground.length` is given.",
-);
-/// The ground direction goes with its length.
-pub const GROUND_ANGLE_WITH_LENGTH: CrossRule = CrossRule::invalid(
-    "GROUND_ANGLE_WITH_LENGTH",
-    &["/ground/angle_deg", "/ground/B"],
-    "`ground.angle_deg` is given only with `ground.length` (not with `ground.B`).",
-);
-/// The ground pivots are distinct next to the linkage's size.
-pub const COINCIDENT_PIVOTS: CrossRule = CrossRule::invalid(
-    super::error::COINCIDENT_PIVOTS,
-    &["/ground/B", "/ground/length", "/joints/B"],
-    "|B − A| > 1e-12·L, L the largest length of the linkage.",
-);
-/// Every link is non-zero next to the linkage's size.
-pub const LENGTH_FLOOR: CrossRule = CrossRule::invalid(
-    super::error::NON_POSITIVE_LENGTH,
-    &[
-        "/crank",
-        "/coupler",
-        "/rocker",
-        "/joints/D",
-        "/joints/E",
-        "/joints",
-    ],
-    "Crank, coupler and rocker are each ≥ 1e-12·L, L the largest length of the linkage (in \
-     `joints` mode: the joints do not all coincide).",
-);
-/// The coupler triangle closes.
-pub const COUPLER_TRIANGLE_INVALID: CrossRule = CrossRule::invalid(
-    super::error::COUPLER_TRIANGLE_INVALID,
-    &["/coupler_point", "/coupler"],
-    "(b, d, e) satisfy the triangle inequality within 1e-12·max(b, d, e).",
-);
-/// The coupler point is not on a coupler joint.
-pub const COUPLER_POINT_AT_JOINT: CrossRule = CrossRule::invalid(
-    super::error::COUPLER_POINT_AT_JOINT,
-    &["/coupler_point", "/joints/P"],
-    "P is off the coupler joints: |k| > 1e-9 and |1 − k| > 1e-9, k = (P − D)/(E − D).",
-);
-/// The linkage assembles somewhere (found while computing).
-pub const NOT_ASSEMBLABLE: CrossRule = CrossRule::infeasible(
-    "NOT_ASSEMBLABLE",
-    &["/ground", "/crank", "/coupler", "/rocker"],
-    "The four-bar assembles for some input angle.",
-);
-/// The curves fit the point limit (found while computing).
-pub const TOO_MANY_POINTS: CrossRule = CrossRule::too_large(
-    "TOO_MANY_POINTS",
-    &[
-        "/options/points_per_circuit",
-        "/options/curves",
-        "/options/verify",
-    ],
-    "The sampled points of every requested output stay within the service's point limit.",
-);
-/// The work fits the time budget (found while computing).
-pub const DEADLINE_EXCEEDED: CrossRule = CrossRule::too_large(
-    "DEADLINE_EXCEEDED",
-    &["/time_limit_ms", "/options"],
-    "The requested outputs are computed within the request's time limit.",
-);
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/cognates`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid JOINTS_EXCLUSIVE ["/joints", "/ground", "/crank", "/coupler", "/rocker",
+        "/coupler_point", "/input_angle_deg", "/branch"]
+        "With `joints`, `ground`, `crank`, `coupler`, `rocker`, `coupler_point`, `input_angle_deg` \
+         and `branch` are omitted (they are read from the drawn configuration).";
+    invalid DIMENSIONS_REQUIRED ["/ground", "/crank", "/coupler", "/rocker", "/coupler_point",
+        "/joints"]
+        "Without `joints`, `ground`, `crank`, `coupler`, `rocker` and `coupler_point` are all given.";
+    invalid GROUND_B_OR_LENGTH ["/ground/B", "/ground/length"]
+        "Exactly one of `ground.B` and `ground.length` is given.";
+    invalid GROUND_ANGLE_WITH_LENGTH ["/ground/angle_deg", "/ground/B"]
+        "`ground.angle_deg` is given only with `ground.length` (not with `ground.B`).";
+    invalid COINCIDENT_PIVOTS(super::error::COINCIDENT_PIVOTS) ["/ground/B", "/ground/length",
+        "/joints/B"] "|B − A| > 1e-12·L, L the largest length of the linkage.";
+    invalid LENGTH_FLOOR(super::error::NON_POSITIVE_LENGTH) ["/crank", "/coupler", "/rocker",
+        "/joints/D", "/joints/E", "/joints"]
+        "Crank, coupler and rocker are each ≥ 1e-12·L, L the largest length of the linkage (in \
+         `joints` mode: the joints do not all coincide).";
+    invalid COUPLER_TRIANGLE_INVALID(super::error::COUPLER_TRIANGLE_INVALID) ["/coupler_point",
+        "/coupler"] "(b, d, e) satisfy the triangle inequality within 1e-12·max(b, d, e).";
+    invalid COUPLER_POINT_AT_JOINT(super::error::COUPLER_POINT_AT_JOINT) ["/coupler_point",
+        "/joints/P"]
+        "P is off the coupler joints: |k| > 1e-9 and |1 − k| > 1e-9, k = (P − D)/(E − D).";
+    /// The linkage assembles somewhere (found while computing).
+    infeasible NOT_ASSEMBLABLE ["/ground", "/crank", "/coupler", "/rocker"]
+        "The four-bar assembles for some input angle.";
+    /// The curves fit the point limit (found while computing).
+    too_large TOO_MANY_POINTS ["/options/points_per_circuit", "/options/curves", "/options/verify"]
+        "The sampled points of every requested output stay within the service's point limit.";
+    /// The work fits the time budget (found while computing).
+    too_large DEADLINE_EXCEEDED ["/time_limit_ms", "/options"]
+        "The requested outputs are computed within the request's time limit.";
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
+}
 
-/// The rules between fields of `POST /v1/cognates`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    JOINTS_EXCLUSIVE,
-    DIMENSIONS_REQUIRED,
-    GROUND_B_OR_LENGTH,
-    GROUND_ANGLE_WITH_LENGTH,
-    COINCIDENT_PIVOTS,
-    LENGTH_FLOOR,
-    COUPLER_TRIANGLE_INVALID,
-    COUPLER_POINT_AT_JOINT,
-    NOT_ASSEMBLABLE,
-    TOO_MANY_POINTS,
-    DEADLINE_EXCEEDED,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
 /// A ground length at or below this fraction of L is "coincident pivots" (spec §3: 1e-12).
 pub const COINCIDENT_REL: f64 = 1e-12;
 /// A link length below this fraction of L is numerically zero next to L (same bound as the pivots):
@@ -154,32 +79,8 @@ pub struct SnapshotSpec {
     pub branch: Sign,
 }
 
-/// How coupler curves are traced.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CurveMode {
-    /// Closed circuits, switching branch at toggles (the whole curve).
-    Circuits,
-    /// Paper style: each mechanism's own input over its range on the branch of the snapshot.
-    FixedBranch,
-}
-
-impl From<wire::CurveMode> for CurveMode {
-    fn from(m: wire::CurveMode) -> Self {
-        match m {
-            wire::CurveMode::Circuits => Self::Circuits,
-            wire::CurveMode::FixedBranch => Self::FixedBranch,
-        }
-    }
-}
-
-impl From<wire::Spacing> for Spacing {
-    fn from(s: wire::Spacing) -> Self {
-        match s {
-            wire::Spacing::Auto => Self::Auto,
-            wire::Spacing::Uniform => Self::Uniform,
-        }
-    }
-}
+/// How curves are traced: the request's curve mode.
+pub use super::wire::CurveMode;
 
 /// Validated options.
 #[derive(Debug, Clone, PartialEq)]
@@ -280,8 +181,8 @@ fn validate_options(req: &CognatesRequest) -> Options {
     Options {
         curves: o.curves,
         points_per_circuit: usize::try_from(o.points_per_circuit.clamp(lo, hi)).unwrap_or(360),
-        spacing: o.spacing.into(),
-        curve_mode: o.curve_mode.into(),
+        spacing: o.spacing,
+        curve_mode: o.curve_mode,
         verify_sync: o.verify.contains(&VerifyKind::Sync),
         verify_implicit: o.verify.contains(&VerifyKind::Implicit),
         verify_hausdorff: o.verify.contains(&VerifyKind::Hausdorff),

@@ -12,15 +12,8 @@ use std::f64::consts::PI;
 
 use super::geometry::{C64, Circuit, FourBar, Sign, Solve};
 
-/// Spacing of the samples on a limited-range circuit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Spacing {
-    /// Cosine spacing on limited-range circuits, uniform on full-rotation ones (O(N⁻²) chord
-    /// error).
-    Auto,
-    /// Uniform in the input angle (O(N⁻¹) near toggles).
-    Uniform,
-}
+/// How samples are spaced along a circuit: the request's `spacing`.
+pub use super::wire::Spacing;
 
 /// Input angle relative to the ground line \[rad\] and branch at circuit parameter `u ∈ [0, 2π]`.
 #[must_use]

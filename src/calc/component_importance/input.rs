@@ -19,116 +19,45 @@ use super::wire::{
     LevelsMode, Options, Outputs, PathMethod,
 };
 pub use super::wire::{MAX_COMPONENTS, MAX_ID_CHARS, MAX_TIMES, MIN_COMPONENTS};
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 
-/// Component ids are unique.
-pub const DUPLICATE_ID: CrossRule = CrossRule::invalid(
-    "DUPLICATE_ID",
-    &["/components/*/id"],
-    "Component ids are unique.",
-);
-/// Every id an edge or an override names is a component id.
-pub const UNKNOWN_ID: CrossRule = CrossRule::invalid(
-    "UNKNOWN_COMPONENT_ID",
-    &[
-        "/edges/*/0",
-        "/edges/*/1",
-        "/overrides/*/F/*",
-        "/overrides/*/RI/*",
-    ],
-    "Every id named by an edge or an override key is the id of a component.",
-);
-/// No edge joins a component to itself.
-pub const SELF_LOOP: CrossRule = CrossRule::invalid(
-    "SELF_LOOP",
-    &["/edges/*"],
-    "No edge joins a component to itself (a component cannot propagate to itself).",
-);
-/// No edge is given twice.
-pub const DUPLICATE_EDGE: CrossRule = CrossRule::invalid(
-    "DUPLICATE_EDGE",
-    &["/edges/*"],
-    "No edge [from, to] is given twice (its weight would be ambiguous).",
-);
-/// Each override's time is one of the requested times, at most one override per time.
-pub const OVERRIDE_TIME: CrossRule = CrossRule::invalid(
-    "OVERRIDE_TIME",
-    &["/overrides/*/time_h", "/times_h"],
-    "Each override's time_h is one of times_h (within 1e-12 relative), and no two overrides \
-     name the same time.",
-);
-/// A component has Weibull data unless overrides give both F and RI at every time.
-pub const WEIBULL_REQUIRED: CrossRule = CrossRule::invalid(
-    "WEIBULL_REQUIRED",
-    &["/components/*/weibull", "/overrides"],
-    "A component has weibull data unless the overrides give both its F and its RI at every time.",
-);
-/// A component has failure modes or a mode sum unless overrides give RI at every time.
-pub const MODE_DATA_REQUIRED: CrossRule = CrossRule::invalid(
-    "MODE_DATA_REQUIRED",
-    &[
-        "/components/*/failure_modes",
-        "/components/*/mode_sum",
-        "/overrides",
-    ],
-    "A component has failure_modes or mode_sum unless the overrides give its RI at every time.",
-);
-/// `failure_modes` and `mode_sum` exclude each other.
-pub const MODE_DATA_CONFLICT: CrossRule = CrossRule::invalid(
-    "MODE_DATA_CONFLICT",
-    &["/components/*/failure_modes", "/components/*/mode_sum"],
-    "A component gives failure_modes or mode_sum, not both.",
-);
-/// Σ α·impact of a component stays within f64.
-pub const MODE_SUM_OVERFLOW: CrossRule = CrossRule::invalid(
-    "MODE_SUM_OVERFLOW",
-    &["/components/*/failure_modes"],
-    "The sum of alpha·impact over a component's failure modes is finite in f64.",
-);
-/// Q + O = 1.
-pub const Q_PLUS_O: CrossRule = CrossRule::invalid(
-    "Q_PLUS_O",
-    &["/options/q_in", "/options/o_out"],
-    "q_in + o_out = 1 within 1e-9 (defaults 0.25 and 0.75).",
-);
-/// The two constant weights sum to 1.
-pub const WEIGHT_SUM: CrossRule = CrossRule::invalid(
-    "WEIGHT_SUM",
-    &[
-        "/options/constant_weights",
-        "/options/constant_weights/subjective",
-    ],
-    "The two constant (or subjective) weights sum to 1 within 1e-9.",
-);
-/// The entropy time is one of the requested times.
-pub const ENTROPY_TIME: CrossRule = CrossRule::invalid(
-    "ENTROPY_TIME",
-    &["/options/constant_weights/entropy_at_h", "/times_h"],
-    "constant_weights.entropy_at_h is one of times_h (within 1e-12 relative).",
-);
-
-/// The rules between fields of `POST /v1/component-importance` and the failures of its
-/// computation, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    DUPLICATE_ID,
-    UNKNOWN_ID,
-    SELF_LOOP,
-    DUPLICATE_EDGE,
-    OVERRIDE_TIME,
-    WEIBULL_REQUIRED,
-    MODE_DATA_REQUIRED,
-    MODE_DATA_CONFLICT,
-    MODE_SUM_OVERFLOW,
-    Q_PLUS_O,
-    WEIGHT_SUM,
-    ENTROPY_TIME,
-    SIMPLE_PATH_BUDGET_RULE,
-    PROPAGATION_PATH_BUDGET_RULE,
-    BUDGET_RULE,
-    HAZARD_RATE_RULE,
-    NUMERICAL_RULE,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/component-importance` and the failures of its
+    /// computation, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid DUPLICATE_ID ["/components/*/id"] "Component ids are unique.";
+    invalid UNKNOWN_ID("UNKNOWN_COMPONENT_ID") ["/edges/*/0", "/edges/*/1", "/overrides/*/F/*",
+        "/overrides/*/RI/*"]
+        "Every id named by an edge or an override key is the id of a component.";
+    invalid SELF_LOOP ["/edges/*"]
+        "No edge joins a component to itself (a component cannot propagate to itself).";
+    invalid DUPLICATE_EDGE ["/edges/*"]
+        "No edge [from, to] is given twice (its weight would be ambiguous).";
+    invalid OVERRIDE_TIME ["/overrides/*/time_h", "/times_h"]
+        "Each override's time_h is one of times_h (within 1e-12 relative), and no two overrides \
+         name the same time.";
+    invalid WEIBULL_REQUIRED ["/components/*/weibull", "/overrides"]
+        "A component has weibull data unless the overrides give both its F and its RI at every time.";
+    invalid MODE_DATA_REQUIRED ["/components/*/failure_modes", "/components/*/mode_sum",
+        "/overrides"]
+        "A component has failure_modes or mode_sum unless the overrides give its RI at every time.";
+    invalid MODE_DATA_CONFLICT ["/components/*/failure_modes", "/components/*/mode_sum"]
+        "A component gives failure_modes or mode_sum, not both.";
+    invalid MODE_SUM_OVERFLOW ["/components/*/failure_modes"]
+        "The sum of alpha·impact over a component's failure modes is finite in f64.";
+    invalid Q_PLUS_O ["/options/q_in", "/options/o_out"]
+        "q_in + o_out = 1 within 1e-9 (defaults 0.25 and 0.75).";
+    invalid WEIGHT_SUM ["/options/constant_weights", "/options/constant_weights/subjective"]
+        "The two constant (or subjective) weights sum to 1 within 1e-9.";
+    invalid ENTROPY_TIME ["/options/constant_weights/entropy_at_h", "/times_h"]
+        "constant_weights.entropy_at_h is one of times_h (within 1e-12 relative).";
+    listed SIMPLE_PATH_BUDGET_RULE;
+    listed PROPAGATION_PATH_BUDGET_RULE;
+    listed BUDGET_RULE;
+    listed HAZARD_RATE_RULE;
+    listed NUMERICAL_RULE;
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// Q + O = 1 and Σω_c = 1 are checked to this absolute tolerance (spec §2).
 pub const SUM_TOL: f64 = 1e-9;

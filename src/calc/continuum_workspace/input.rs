@@ -17,189 +17,69 @@ use super::wire::{
     StartRequest, WorkspaceRequest,
 };
 use crate::calc::common::{self, Shard};
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 
-/// A design is either `preset` alone or explicit `actuators` and `rods`.
-pub const DESIGN_SOURCE: CrossRule = CrossRule::invalid(
-    "DESIGN_SOURCE",
-    &[
-        "/design/preset",
-        "/design/actuators",
-        "/design/rods",
-        "/design/home_inputs_m",
-    ],
-    "Give either design.preset (with at most sigma_allow_pa) or both design.actuators and \
-     design.rods (home_inputs_m only with an explicit design).",
-);
-/// A guide direction can be normalised.
-pub const DIRECTION_NORM: CrossRule = CrossRule::invalid(
-    "DIRECTION_NORM",
-    &["/design/actuators/*/direction"],
-    "The norm of each guide direction exceeds 1e-12.",
-);
-/// A stroke is an interval.
-pub const STROKE_ORDER: CrossRule = CrossRule::invalid(
-    "STROKE_ORDER",
-    &["/design/actuators/*/stroke_m"],
-    "Each stroke_m is [min, max] with min < max.",
-);
-/// A rod's actuator exists.
-pub const UNKNOWN_ACTUATOR: CrossRule = CrossRule::invalid(
-    "UNKNOWN_ACTUATOR",
-    &["/design/rods/*/actuator", "/design/actuators"],
-    "Each rod's actuator is an index of design.actuators.",
-);
-/// Every actuator moves some rod.
-pub const ACTUATOR_WITHOUT_ROD: CrossRule = CrossRule::invalid(
-    "ACTUATOR_WITHOUT_ROD",
-    &["/design/actuators/*", "/design/rods/*/actuator"],
-    "Every actuator carries at least one rod (else its input is undetermined).",
-);
-/// A rod's bending stiffness is known.
-pub const ROD_STIFFNESS: CrossRule = CrossRule::invalid(
-    "ROD_STIFFNESS",
-    &["/design/rods/*/diameter_m", "/design/rods/*/ei_nm2"],
-    "Each rod gives diameter_m or ei_nm2 (or both).",
-);
-/// A rod is slender enough for the rod model.
-pub const SLENDERNESS: CrossRule = CrossRule::invalid(
-    "SLENDERNESS",
-    &["/design/rods/*/diameter_m", "/design/rods/*/length_m"],
-    "Each rod's slenderness length_m / diameter_m is at least 5 (below 20 it is warned).",
-);
-/// The platform rotation is determined.
-pub const COINCIDENT_ATTACHMENTS: CrossRule = CrossRule::invalid(
-    "COINCIDENT_ATTACHMENTS",
-    &["/design/rods"],
-    "The rods' attachment points attach_m do not all coincide (spread above 1e-9 L_ref).",
-);
-/// One home input per actuator.
-pub const HOME_INPUTS_COUNT: CrossRule = CrossRule::invalid(
-    "HOME_INPUTS_COUNT",
-    &["/design/home_inputs_m", "/design/actuators"],
-    "design.home_inputs_m has one entry per actuator.",
-);
-/// Given home inputs really are the stress-free home.
-pub const HOME_NOT_STRESS_FREE: CrossRule = CrossRule::invalid(
-    "HOME_NOT_STRESS_FREE",
-    &["/design/home_inputs_m"],
-    "At design.home_inputs_m every rod is straight and unloaded with theta_EE = 0 (closure \
-     residual at most 1e-6 L_ref).",
-);
-/// Axial compliance needs the section.
-pub const EXTENSIBILITY_NEEDS_DIAMETER: CrossRule = CrossRule::invalid(
-    "EXTENSIBILITY_NEEDS_DIAMETER",
-    &["/solver/axial_extensibility", "/design/rods/*/diameter_m"],
-    "solver.axial_extensibility needs diameter_m on every rod (EA = E pi d^2/4).",
-);
-/// The load is within the design's own scale.
-pub const LOAD_LIMIT: CrossRule = CrossRule::invalid(
-    "LOAD_LIMIT",
-    &["/load/force_n", "/load/moment_nm"],
-    "|load.force_n| <= 1e4 EI_ref/L_ref^2 and |load.moment_nm| <= 1e4 EI_ref/L_ref (EI_ref, \
-     L_ref: the rods' mean bending stiffness and length).",
-);
-/// Modes `fk` and `assembly_modes` need the inputs.
-pub const INPUTS_REQUIRED: CrossRule = CrossRule::invalid(
-    "INPUTS_REQUIRED",
-    &["/inputs_m", "/mode"],
-    "inputs_m is given for mode fk and assembly_modes.",
-);
-/// One input per actuator.
-pub const INPUTS_COUNT: CrossRule = CrossRule::invalid(
-    "INPUTS_COUNT",
-    &["/inputs_m", "/design/actuators"],
-    "inputs_m (mode fk and assembly_modes) has one entry per actuator.",
-);
-/// Each input inside its stroke.
-pub const INPUT_OUTSIDE_STROKE: CrossRule = CrossRule::invalid(
-    "INPUT_OUTSIDE_STROKE",
-    &["/inputs_m/*", "/design/actuators/*/stroke_m"],
-    "Each input of inputs_m (mode fk and assembly_modes) lies inside its actuator's stroke_m.",
-);
-/// A warm start needs its state.
-pub const STATE_REQUIRED: CrossRule = CrossRule::invalid(
-    "STATE_REQUIRED",
-    &[
-        "/start/state",
-        "/start/kind",
-        "/workspace/seed/state",
-        "/workspace/seed/kind",
-    ],
-    "start.state (seed.state) is given when start.kind (seed.kind) is guess.",
-);
-/// A solver state fits the design.
-pub const STATE_LENGTH: CrossRule = CrossRule::invalid(
-    "STATE_LENGTH",
-    &["/start/state/v", "/workspace/seed/state/v", "/design/rods"],
-    "A solver state v has 3N+3 entries for N rods.",
-);
-/// A sweep runs over two inputs.
-pub const WORKSPACE_ACTUATORS: CrossRule = CrossRule::invalid(
-    "WORKSPACE_ACTUATORS",
-    &["/design/actuators", "/mode"],
-    "Mode workspace needs exactly 2 actuators (a 2-D input grid).",
-);
-/// A sweep's input ranges are intervals.
-pub const RANGE_ORDER: CrossRule = CrossRule::invalid(
-    "RANGE_ORDER",
-    &["/workspace/ranges_m/*"],
-    "Each workspace.ranges_m entry is [min, max] with min < max.",
-);
-/// A sweep's grid is within the node limit.
-pub const GRID_TOO_LARGE: CrossRule = CrossRule::too_large(
-    "GRID_TOO_LARGE",
-    &["/workspace/grid"],
-    "workspace.grid has n1 * n2 <= 40401 nodes (split the ranges into tiles, which can run in \
-     parallel).",
-);
-/// The assembly-mode search is within its combination limit.
-pub const SEARCH_TOO_LARGE: CrossRule = CrossRule::too_large(
-    "SEARCH_TOO_LARGE",
-    &["/assembly_modes/n_grid", "/design/rods"],
-    "When the assembly-mode search runs, (2 N_grid)^(2N) <= 1e8 grid combinations for N rods.",
-);
-/// Only a workspace sweep can be sharded.
-pub const SHARD_NOT_APPLICABLE: CrossRule = CrossRule::invalid(
-    "SHARD_NOT_APPLICABLE",
-    &["/shard", "/mode"],
-    "shard is given only with mode workspace (modes fk and assembly_modes are one job).",
-);
-/// The search found the requested assembly mode (found while computing).
-pub const ASSEMBLY_MODE_NOT_FOUND: CrossRule = CrossRule::not_converged(
-    super::error::ASSEMBLY_MODE_NOT_FOUND,
-    &["/start/index", "/workspace/seed/index"],
-    "The (non-certified) assembly-mode search finds more solutions than the requested index.",
-);
-
-/// The rules between fields of `POST /v1/continuum-workspace`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    DESIGN_SOURCE,
-    DIRECTION_NORM,
-    STROKE_ORDER,
-    UNKNOWN_ACTUATOR,
-    ACTUATOR_WITHOUT_ROD,
-    ROD_STIFFNESS,
-    SLENDERNESS,
-    COINCIDENT_ATTACHMENTS,
-    HOME_INPUTS_COUNT,
-    HOME_NOT_STRESS_FREE,
-    EXTENSIBILITY_NEEDS_DIAMETER,
-    LOAD_LIMIT,
-    INPUTS_REQUIRED,
-    INPUTS_COUNT,
-    INPUT_OUTSIDE_STROKE,
-    STATE_REQUIRED,
-    STATE_LENGTH,
-    WORKSPACE_ACTUATORS,
-    RANGE_ORDER,
-    GRID_TOO_LARGE,
-    SEARCH_TOO_LARGE,
-    common::SHARD_INDEX_BELOW_COUNT,
-    SHARD_NOT_APPLICABLE,
-    ASSEMBLY_MODE_NOT_FOUND,
-    common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/continuum-workspace`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid DESIGN_SOURCE ["/design/preset", "/design/actuators", "/design/rods",
+        "/design/home_inputs_m"]
+        "Give either design.preset (with at most sigma_allow_pa) or both design.actuators and \
+         design.rods (home_inputs_m only with an explicit design).";
+    invalid DIRECTION_NORM ["/design/actuators/*/direction"]
+        "The norm of each guide direction exceeds 1e-12.";
+    invalid STROKE_ORDER ["/design/actuators/*/stroke_m"]
+        "Each stroke_m is [min, max] with min < max.";
+    invalid UNKNOWN_ACTUATOR ["/design/rods/*/actuator", "/design/actuators"]
+        "Each rod's actuator is an index of design.actuators.";
+    invalid ACTUATOR_WITHOUT_ROD ["/design/actuators/*", "/design/rods/*/actuator"]
+        "Every actuator carries at least one rod (else its input is undetermined).";
+    invalid ROD_STIFFNESS ["/design/rods/*/diameter_m", "/design/rods/*/ei_nm2"]
+        "Each rod gives diameter_m or ei_nm2 (or both).";
+    invalid SLENDERNESS ["/design/rods/*/diameter_m", "/design/rods/*/length_m"]
+        "Each rod's slenderness length_m / diameter_m is at least 5 (below 20 it is warned).";
+    invalid COINCIDENT_ATTACHMENTS ["/design/rods"]
+        "The rods' attachment points attach_m do not all coincide (spread above 1e-9 L_ref).";
+    invalid HOME_INPUTS_COUNT ["/design/home_inputs_m", "/design/actuators"]
+        "design.home_inputs_m has one entry per actuator.";
+    invalid HOME_NOT_STRESS_FREE ["/design/home_inputs_m"]
+        "At design.home_inputs_m every rod is straight and unloaded with theta_EE = 0 (closure \
+         residual at most 1e-6 L_ref).";
+    invalid EXTENSIBILITY_NEEDS_DIAMETER ["/solver/axial_extensibility",
+        "/design/rods/*/diameter_m"]
+        "solver.axial_extensibility needs diameter_m on every rod (EA = E pi d^2/4).";
+    invalid LOAD_LIMIT ["/load/force_n", "/load/moment_nm"]
+        "|load.force_n| <= 1e4 EI_ref/L_ref^2 and |load.moment_nm| <= 1e4 EI_ref/L_ref (EI_ref, \
+         L_ref: the rods' mean bending stiffness and length).";
+    invalid INPUTS_REQUIRED ["/inputs_m", "/mode"]
+        "inputs_m is given for mode fk and assembly_modes.";
+    invalid INPUTS_COUNT ["/inputs_m", "/design/actuators"]
+        "inputs_m (mode fk and assembly_modes) has one entry per actuator.";
+    invalid INPUT_OUTSIDE_STROKE ["/inputs_m/*", "/design/actuators/*/stroke_m"]
+        "Each input of inputs_m (mode fk and assembly_modes) lies inside its actuator's stroke_m.";
+    invalid STATE_REQUIRED ["/start/state", "/start/kind", "/workspace/seed/state",
+        "/workspace/seed/kind"]
+        "start.state (seed.state) is given when start.kind (seed.kind) is guess.";
+    invalid STATE_LENGTH ["/start/state/v", "/workspace/seed/state/v", "/design/rods"]
+        "A solver state v has 3N+3 entries for N rods.";
+    invalid WORKSPACE_ACTUATORS ["/design/actuators", "/mode"]
+        "Mode workspace needs exactly 2 actuators (a 2-D input grid).";
+    invalid RANGE_ORDER ["/workspace/ranges_m/*"]
+        "Each workspace.ranges_m entry is [min, max] with min < max.";
+    too_large GRID_TOO_LARGE ["/workspace/grid"]
+        "workspace.grid has n1 * n2 <= 40401 nodes (split the ranges into tiles, which can run in \
+         parallel).";
+    too_large SEARCH_TOO_LARGE ["/assembly_modes/n_grid", "/design/rods"]
+        "When the assembly-mode search runs, (2 N_grid)^(2N) <= 1e8 grid combinations for N rods.";
+    listed common::SHARD_INDEX_BELOW_COUNT;
+    invalid SHARD_NOT_APPLICABLE ["/shard", "/mode"]
+        "shard is given only with mode workspace (modes fk and assembly_modes are one job).";
+    /// The search found the requested assembly mode (found while computing).
+    not_converged ASSEMBLY_MODE_NOT_FOUND(super::error::ASSEMBLY_MODE_NOT_FOUND) ["/start/index",
+        "/workspace/seed/index"]
+        "The (non-certified) assembly-mode search finds more solutions than the requested index.";
+    listed common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// Default Young's modulus (steel) [Pa] (spec 3.1).
 const DEFAULT_E: f64 = 2.1e11;
@@ -226,52 +106,11 @@ const DEFAULT_SWEEP_SEGMENTS: u32 = 20;
 /// compute pool's threads per job); results do not depend on it.
 pub const SWEEP_THREADS: usize = usize::MAX;
 
-/// What the request computes (the domain form of the wire `mode`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    /// Forward kinematics at one input.
-    Fk,
-    /// Workspace sweep over the 2-D input grid, one wave per seed.
-    Workspace,
-    /// Assembly-mode search at one input.
-    AssemblyModes,
-}
+/// What the request computes: the request's `mode`.
+pub use super::wire::Mode;
 
-impl From<wire::Mode> for Mode {
-    fn from(m: wire::Mode) -> Self {
-        match m {
-            wire::Mode::Fk => Self::Fk,
-            wire::Mode::Workspace => Self::Workspace,
-            wire::Mode::AssemblyModes => Self::AssemblyModes,
-        }
-    }
-}
-
-/// How the waves of a sweep are seeded at the seed node (the domain form of the wire
-/// `workspace.seed.kind`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SeedKind {
-    /// Continuation from the stress-free home (without one: the stable assembly mode with the
-    /// smallest |theta_EE|): one wave.
-    Home,
-    /// Newton from a given state: one wave.
-    Guess,
-    /// One assembly mode of the search: one wave.
-    AssemblyMode,
-    /// Every stable assembly mode of the search: one wave each.
-    AllStableModes,
-}
-
-impl From<wire::SeedKind> for SeedKind {
-    fn from(k: wire::SeedKind) -> Self {
-        match k {
-            wire::SeedKind::Home => Self::Home,
-            wire::SeedKind::Guess => Self::Guess,
-            wire::SeedKind::AssemblyMode => Self::AssemblyMode,
-            wire::SeedKind::AllStableModes => Self::AllStableModes,
-        }
-    }
-}
+/// How the waves of a sweep are seeded at the seed node: the request's `workspace.seed.kind`.
+pub use super::wire::SeedKind;
 
 /// How the FK starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -877,7 +716,7 @@ fn seed(v: &mut Validator, seed: Option<&SeedRequest>, nr: usize) -> SeedInput {
             index: 0,
         };
     };
-    let kind = SeedKind::from(s.kind);
+    let kind = s.kind;
     let state = match (kind, &s.state) {
         (SeedKind::Guess, None) => {
             v.rule(
@@ -1031,7 +870,7 @@ impl TryFrom<&ContinuumWorkspaceRequest> for Input {
             search_size(modes.n_grid, nr, has_home)?;
         }
         Ok(Self {
-            mode: Mode::from(req.mode),
+            mode: req.mode,
             model,
             preset,
             params: Params {

@@ -196,16 +196,6 @@ fn fk_status(s: compute::FkStatus) -> wire::FkStatus {
     }
 }
 
-/// The echoed seed kind of a wave.
-fn wire_seed_kind(k: domain::SeedKind) -> wire::SeedKind {
-    match k {
-        domain::SeedKind::Home => wire::SeedKind::Home,
-        domain::SeedKind::Guess => wire::SeedKind::Guess,
-        domain::SeedKind::AssemblyMode => wire::SeedKind::AssemblyMode,
-        domain::SeedKind::AllStableModes => wire::SeedKind::AllStableModes,
-    }
-}
-
 fn wave_out(
     input: &Input,
     w: &WaveOutput,
@@ -308,7 +298,7 @@ fn workspace_response(
                         .collect(),
                 },
                 sw.return_nodes,
-                wire_seed_kind(sw.seed.kind),
+                sw.seed.kind,
             )
         }
         // No sweep settings: the computation returns no wave.

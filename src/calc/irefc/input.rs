@@ -16,30 +16,20 @@ pub fn validator() -> Validator {
     Validator::coded(BAD_RANGE, class_of)
 }
 
-/// The design is buildable: no undercut (found on the geometry).
-pub const UNDERCUT: CrossRule = CrossRule::infeasible(
-    super::error::UNDERCUT,
-    &["/rb_mm", "/r2_mm", "/Z2", "/chi"],
-    "rb < rb_undercut(r2, Z2, χ): the cam and crown profiles have no cusp or undercut.",
-);
-/// The rolling elements do not overlap (found on the geometry).
-pub const ELEMENT_OVERLAP: CrossRule = CrossRule::infeasible(
-    super::error::ELEMENT_OVERLAP,
-    &["/rb_mm", "/r2_mm", "/Z2", "/chi"],
-    "rb < rb_overlap = χ·r2·sin(π/Z2): neighbouring rolling elements do not overlap.",
-);
-/// Every reported number is finite (found while computing).
-pub const NON_FINITE: CrossRule = CrossRule::infeasible(
-    super::error::NON_FINITE,
-    &["/r2_mm", "/rb_mm", "/torque_Nm"],
-    "Every reported number is finite in f64 (extreme scales overflow).",
-);
-/// The work fits the time budget (found while computing).
-pub const DEADLINE: CrossRule = CrossRule::not_converged(
-    super::error::DEADLINE,
-    &["/time_limit_ms"],
-    "The calculation ends within the request's time limit.",
-);
+crate::calc::rules::cross_rules! {
+    /// The design is buildable: no undercut (found on the geometry).
+    infeasible UNDERCUT(super::error::UNDERCUT) ["/rb_mm", "/r2_mm", "/Z2", "/chi"]
+        "rb < rb_undercut(r2, Z2, χ): the cam and crown profiles have no cusp or undercut.";
+    /// The rolling elements do not overlap (found on the geometry).
+    infeasible ELEMENT_OVERLAP(super::error::ELEMENT_OVERLAP) ["/rb_mm", "/r2_mm", "/Z2", "/chi"]
+        "rb < rb_overlap = χ·r2·sin(π/Z2): neighbouring rolling elements do not overlap.";
+    /// Every reported number is finite (found while computing).
+    infeasible NON_FINITE(super::error::NON_FINITE) ["/r2_mm", "/rb_mm", "/torque_Nm"]
+        "Every reported number is finite in f64 (extreme scales overflow).";
+    /// The work fits the time budget (found while computing).
+    not_converged DEADLINE(super::error::DEADLINE) ["/time_limit_ms"]
+        "The calculation ends within the request's time limit.";
+}
 
 /// Record a missing required field (`MISSING_FIELD`, a rule of `rule`).
 pub fn missing(v: &mut Validator, rule: &CrossRule, pointer: &str, what: &str) {

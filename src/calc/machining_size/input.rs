@@ -22,175 +22,71 @@ use super::gra::Normalise;
 use super::model::Model;
 use super::smogn::SmognParams;
 use super::wire::{
-    self, AnalyzeRequest, GraNormalise, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
+    AnalyzeRequest, GraNormalise, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
     MAX_INTERVENTIONAL_PAIRS, MAX_SCORE_CELLS, MAX_SHAP_CELLS, MAX_TREES, PredictRequest,
     RELEVANCE_PHI, TrainOutputKind, TrainRequest, TreeMethod,
 };
 
-/// Feature names are not blank.
-pub const FEATURE_NAME_EMPTY: CrossRule = CrossRule::invalid(
-    "FEATURE_NAME_EMPTY",
-    &["/feature_names/*"],
-    "Every feature name holds a character other than white space.",
-);
-/// Feature names are unique.
-pub const FEATURE_NAME_DUPLICATE: CrossRule = CrossRule::invalid(
-    "FEATURE_NAME_DUPLICATE",
-    &["/feature_names/*"],
-    "Feature names are unique.",
-);
-/// A row has one value per feature name.
-pub const ROW_WIDTH: CrossRule = CrossRule::invalid(
-    "ROW_WIDTH",
-    &["/rows/*", "/feature_names"],
-    "Every row of rows has one value per name of feature_names.",
-);
-/// One target per row.
-pub const TARGET_LENGTH: CrossRule = CrossRule::invalid(
-    "TARGET_LENGTH",
-    &["/target", "/rows"],
-    "target has one value per row of rows.",
-);
-/// The targets vary.
-pub const CONSTANT_TARGET: CrossRule = CrossRule::invalid(
-    "CONSTANT_TARGET",
-    &["/target"],
-    "Not all targets are equal (else there is nothing to learn).",
-);
-/// An empty child cannot divide by zero.
-pub const REG_LAMBDA_ZERO: CrossRule = CrossRule::invalid(
-    "REG_LAMBDA_ZERO",
-    &["/params/reg_lambda", "/params/min_child_weight"],
-    "params.reg_lambda > 0 when params.min_child_weight is 0 (spec §8 hazard 4).",
-);
-/// The training split can hold two children.
-pub const TRAINING_ROWS: CrossRule = CrossRule::invalid(
-    "TRAINING_ROWS",
-    &[
-        "/params/min_child_weight",
-        "/validation/test_fraction",
-        "/rows",
-    ],
-    "The training split (rows less the holdout) has at least 2·max(1, min_child_weight) rows.",
-);
-/// Every fold's training rows can hold two children.
-pub const FOLD_ROWS: CrossRule = CrossRule::invalid(
-    "FOLD_ROWS",
-    &["/validation/k_fold", "/params/min_child_weight", "/rows"],
-    "Each k-fold training split (n − ⌈n/k⌉ rows) has at least 2·max(1, min_child_weight) rows.",
-);
-/// Something is left to split on.
-pub const ALL_FEATURES_CONSTANT: CrossRule = CrossRule::invalid(
-    "ALL_FEATURES_CONSTANT",
-    &["/rows", "/preprocessing/drop_constant"],
-    "With preprocessing.drop_constant, at least one feature column is not constant.",
-);
-/// Each tree draws at least one feature.
-pub const COLSAMPLE_NO_FEATURE: CrossRule = CrossRule::invalid(
-    "COLSAMPLE_NO_FEATURE",
-    &["/params/colsample_bytree", "/rows"],
-    "⌊colsample_bytree · d⌋ ≥ 1 for the d features left after dropping constant columns.",
-);
-/// Only a k-fold cross-validation can be sharded.
-pub const SHARD_NOT_APPLICABLE: CrossRule = CrossRule::invalid(
-    "SHARD_NOT_APPLICABLE",
-    &["/shard", "/validation/k_fold"],
-    "shard is given only with validation.k_fold (it splits the folds).",
-);
-/// SMOGN control points of `/train`: φ in [0, 1].
-pub const TRAIN_RELEVANCE_PHI: CrossRule = CrossRule::invalid(
-    "RELEVANCE_PHI",
-    &["/preprocessing/smogn/relevance/*/1"],
-    "The relevance φ of every SMOGN control point [y, φ] is in [0, 1].",
-);
-/// SMOGN control points of `/train`: y increasing.
-pub const TRAIN_RELEVANCE_ORDER: CrossRule = CrossRule::invalid(
-    "RELEVANCE_ORDER",
-    &["/preprocessing/smogn/relevance/*/0"],
-    "The y of the SMOGN control points [y, φ] strictly increase.",
-);
-/// SMOGN control points of `/analyze`: φ in [0, 1].
-pub const ANALYZE_RELEVANCE_PHI: CrossRule = CrossRule::invalid(
-    "RELEVANCE_PHI",
-    &["/smogn/relevance/*/1"],
-    "The relevance φ of every SMOGN control point [y, φ] is in [0, 1].",
-);
-/// SMOGN control points of `/analyze`: y increasing.
-pub const ANALYZE_RELEVANCE_ORDER: CrossRule = CrossRule::invalid(
-    "RELEVANCE_ORDER",
-    &["/smogn/relevance/*/0"],
-    "The y of the SMOGN control points [y, φ] strictly increase.",
-);
-/// SMOGN of `/train` finds rare and normal samples (found while computing).
-pub const TRAIN_SMOGN_DEGENERATE: CrossRule = CrossRule::infeasible(
-    SMOGN_DEGENERATE_RELEVANCE,
-    &["/preprocessing/smogn/relevance"],
-    "SMOGN's relevance marks some but not all training samples as rare.",
-);
-/// SMOGN of `/analyze` finds rare and normal samples (found while computing).
-pub const ANALYZE_SMOGN_DEGENERATE: CrossRule = CrossRule::infeasible(
-    SMOGN_DEGENERATE_RELEVANCE,
-    &["/smogn/relevance"],
-    "SMOGN's relevance marks some but not all samples as rare.",
-);
-/// The model document is well-formed.
-pub const MODEL_DOCUMENT: CrossRule = CrossRule::invalid(
-    MODEL_INVALID,
-    &["/model"],
-    "The model is our document (format machining-size-gbdt/1) or {\"xgboost_json\": ...}, with \
-     children in range, no cycles or shared children, depth ≤ 64, ≤ 5000 trees, ≤ 1 000 000 \
-     nodes, finite numbers and split features below n_features.",
-);
-/// The model is within v1.
-pub const MODEL_SUPPORTED: CrossRule = CrossRule::invalid(
-    UNSUPPORTED_MODEL,
-    &["/model"],
-    "The model's objective is reg:squarederror, its booster gbtree, with a single output.",
-);
-/// A `/predict` row has one value per model feature.
-pub const PREDICT_ROW_WIDTH: CrossRule = CrossRule::invalid(
-    "ROW_WIDTH",
-    &["/rows/*", "/background/*", "/model"],
-    "Every row of rows (and of background) has one value per model feature.",
-);
-/// Names given to `/predict` are the model's.
-pub const FEATURE_NAMES_MISMATCH: CrossRule = CrossRule::invalid(
-    "FEATURE_NAMES_MISMATCH",
-    &["/feature_names", "/model"],
-    "feature_names, when given, has one name per model feature and equals the model's names.",
-);
-/// Interventional SHAP needs a background.
-pub const BACKGROUND_REQUIRED: CrossRule = CrossRule::invalid(
-    "BACKGROUND_REQUIRED",
-    &["/background", "/shap"],
-    "background is given when shap is interventional.",
-);
-/// The SHAP, interaction and background work of `/predict` is within the limits.
-pub const PREDICT_WORK: CrossRule = CrossRule::too_large(
-    TOO_LARGE,
-    &["/rows", "/background", "/interactions"],
-    "With SHAP, rows·d ≤ 4 000 000; interventional rows·background ≤ 1 000 000; with \
-     interactions, rows ≤ 1000 and rows·d² ≤ 2 000 000 (d: model features).",
-);
-/// The PCA scores of `/analyze` are within the limit.
-pub const ANALYZE_WORK: CrossRule = CrossRule::too_large(
-    TOO_LARGE,
-    &["/pca/scores", "/pca/components", "/rows"],
-    "With pca.scores, rows·components ≤ 4 000 000.",
-);
-/// A GRA series can be normalised by its mean (found while computing).
-pub const GRA_MEAN: CrossRule = CrossRule::infeasible(
-    GRA_ZERO_MEAN,
-    &["/gra/normalise", "/rows", "/target"],
-    "With gra.normalise mean, no series (feature or target) has a mean of 0.",
-);
-/// An answer that cannot be partial is finished within the budget (found while computing).
-pub const DEADLINE: CrossRule = CrossRule::too_large(
-    DEADLINE_EXCEEDED,
-    &["/time_limit_ms"],
-    "The work of an answer that cannot be partial (SHAP values, an analysis) ends within the \
-     request's time limit.",
-);
+crate::calc::rules::cross_rules! {
+    invalid FEATURE_NAME_EMPTY ["/feature_names/*"]
+        "Every feature name holds a character other than white space.";
+    invalid FEATURE_NAME_DUPLICATE ["/feature_names/*"] "Feature names are unique.";
+    invalid ROW_WIDTH ["/rows/*", "/feature_names"]
+        "Every row of rows has one value per name of feature_names.";
+    invalid TARGET_LENGTH ["/target", "/rows"] "target has one value per row of rows.";
+    invalid CONSTANT_TARGET ["/target"]
+        "Not all targets are equal (else there is nothing to learn).";
+    invalid REG_LAMBDA_ZERO ["/params/reg_lambda", "/params/min_child_weight"]
+        "params.reg_lambda > 0 when params.min_child_weight is 0 (spec §8 hazard 4).";
+    invalid TRAINING_ROWS ["/params/min_child_weight", "/validation/test_fraction", "/rows"]
+        "The training split (rows less the holdout) has at least 2·max(1, min_child_weight) rows.";
+    invalid FOLD_ROWS ["/validation/k_fold", "/params/min_child_weight", "/rows"]
+        "Each k-fold training split (n − ⌈n/k⌉ rows) has at least 2·max(1, min_child_weight) rows.";
+    invalid ALL_FEATURES_CONSTANT ["/rows", "/preprocessing/drop_constant"]
+        "With preprocessing.drop_constant, at least one feature column is not constant.";
+    invalid COLSAMPLE_NO_FEATURE ["/params/colsample_bytree", "/rows"]
+        "⌊colsample_bytree · d⌋ ≥ 1 for the d features left after dropping constant columns.";
+    invalid SHARD_NOT_APPLICABLE ["/shard", "/validation/k_fold"]
+        "shard is given only with validation.k_fold (it splits the folds).";
+    invalid TRAIN_RELEVANCE_PHI("RELEVANCE_PHI") ["/preprocessing/smogn/relevance/*/1"]
+        "The relevance φ of every SMOGN control point [y, φ] is in [0, 1].";
+    invalid TRAIN_RELEVANCE_ORDER("RELEVANCE_ORDER") ["/preprocessing/smogn/relevance/*/0"]
+        "The y of the SMOGN control points [y, φ] strictly increase.";
+    invalid ANALYZE_RELEVANCE_PHI("RELEVANCE_PHI") ["/smogn/relevance/*/1"]
+        "The relevance φ of every SMOGN control point [y, φ] is in [0, 1].";
+    invalid ANALYZE_RELEVANCE_ORDER("RELEVANCE_ORDER") ["/smogn/relevance/*/0"]
+        "The y of the SMOGN control points [y, φ] strictly increase.";
+    /// SMOGN of `/train` finds rare and normal samples (found while computing).
+    infeasible TRAIN_SMOGN_DEGENERATE(SMOGN_DEGENERATE_RELEVANCE) ["/preprocessing/smogn/relevance"]
+        "SMOGN's relevance marks some but not all training samples as rare.";
+    /// SMOGN of `/analyze` finds rare and normal samples (found while computing).
+    infeasible ANALYZE_SMOGN_DEGENERATE(SMOGN_DEGENERATE_RELEVANCE) ["/smogn/relevance"]
+        "SMOGN's relevance marks some but not all samples as rare.";
+    invalid MODEL_DOCUMENT(MODEL_INVALID) ["/model"]
+        "The model is our document (format machining-size-gbdt/1) or {\"xgboost_json\": ...}, with \
+         children in range, no cycles or shared children, depth ≤ 64, ≤ 5000 trees, ≤ 1 000 000 \
+         nodes, finite numbers and split features below n_features.";
+    invalid MODEL_SUPPORTED(UNSUPPORTED_MODEL) ["/model"]
+        "The model's objective is reg:squarederror, its booster gbtree, with a single output.";
+    invalid PREDICT_ROW_WIDTH("ROW_WIDTH") ["/rows/*", "/background/*", "/model"]
+        "Every row of rows (and of background) has one value per model feature.";
+    invalid FEATURE_NAMES_MISMATCH ["/feature_names", "/model"]
+        "feature_names, when given, has one name per model feature and equals the model's names.";
+    invalid BACKGROUND_REQUIRED ["/background", "/shap"]
+        "background is given when shap is interventional.";
+    too_large PREDICT_WORK(TOO_LARGE) ["/rows", "/background", "/interactions"]
+        "With SHAP, rows·d ≤ 4 000 000; interventional rows·background ≤ 1 000 000; with \
+         interactions, rows ≤ 1000 and rows·d² ≤ 2 000 000 (d: model features).";
+    too_large ANALYZE_WORK(TOO_LARGE) ["/pca/scores", "/pca/components", "/rows"]
+        "With pca.scores, rows·components ≤ 4 000 000.";
+    /// A GRA series can be normalised by its mean (found while computing).
+    infeasible GRA_MEAN(GRA_ZERO_MEAN) ["/gra/normalise", "/rows", "/target"]
+        "With gra.normalise mean, no series (feature or target) has a mean of 0.";
+    /// An answer that cannot be partial is finished within the budget (found while computing).
+    too_large DEADLINE(DEADLINE_EXCEEDED) ["/time_limit_ms"]
+        "The work of an answer that cannot be partial (SHAP values, an analysis) ends within the \
+         request's time limit.";
+}
 
 /// The rules between fields of `POST /v1/machining-size/train`, as the document lists them.
 pub const TRAIN_RULES: &[CrossRule] = &[
@@ -280,26 +176,8 @@ pub struct TrainOutputs {
     pub test_predictions: bool,
 }
 
-/// Which SHAP values a `/predict` request asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ShapKind {
-    /// No SHAP values.
-    None,
-    /// Path-dependent TreeSHAP (cover-weighted conditional expectations).
-    PathDependent,
-    /// Interventional TreeSHAP against the background rows.
-    Interventional,
-}
-
-impl From<wire::ShapKind> for ShapKind {
-    fn from(k: wire::ShapKind) -> Self {
-        match k {
-            wire::ShapKind::None => Self::None,
-            wire::ShapKind::PathDependent => Self::PathDependent,
-            wire::ShapKind::Interventional => Self::Interventional,
-        }
-    }
-}
+/// Which SHAP values `/predict` computes: the request's `shap`.
+pub use super::wire::ShapKind;
 
 /// A validated `/predict` request.
 #[derive(Debug, Clone)]
@@ -670,7 +548,7 @@ impl TryFrom<PredictRequest> for PredictInput {
             }
         }
         let n = req.rows.len();
-        let shap = ShapKind::from(req.shap);
+        let shap = req.shap;
         if shap != ShapKind::None && n * d > MAX_SHAP_CELLS {
             v.rule(
                 &PREDICT_WORK,

@@ -8,27 +8,17 @@ use super::boost::{BoostParams, Method};
 use super::compute::{AnalyzeOutput, Importance, PredictOutput, ShapSummary, TrainOutput};
 use super::data::{Metrics, mean_sd};
 use super::document::{FORMAT, OBJECTIVE};
-use super::input::{AnalyzeInput, PredictInput, ShapKind, TrainInput};
+use super::input::{AnalyzeInput, PredictInput, TrainInput};
 use super::model::{Model, ModelSource, Routing, Tree};
 use super::pca::Pca;
 use super::smogn::Smogn;
 use super::wire::{
-    self, AnalyzeResponse, ConstantColumn, CvMetrics, FeatureImportance, FeatureShap, GbdtModel,
+    AnalyzeResponse, ConstantColumn, CvMetrics, FeatureImportance, FeatureShap, GbdtModel,
     GraGrade, GraNormalise, GraOut, LevelShap, MetricsOut, ModelSummary, OffGrid, PcaOut,
     PredictResponse, PreprocessingOut, ShapOut, ShapSummary as ShapSummaryWire, SmognBinOut,
     SmognData, SmognOut, SplitMetrics, TestPredictions, TrainParams, TrainResponse, TreeDoc,
     TreeMethod,
 };
-
-impl From<ShapKind> for wire::ShapKind {
-    fn from(k: ShapKind) -> Self {
-        match k {
-            ShapKind::None => Self::None,
-            ShapKind::PathDependent => Self::PathDependent,
-            ShapKind::Interventional => Self::Interventional,
-        }
-    }
-}
 
 /// Local accuracy is flagged when the residual exceeds this share of the output scale (f64
 /// sums over ≤ 5000 trees stay ~1e-12 of it).
@@ -415,7 +405,7 @@ pub fn respond_predict(
             warnings.push(w);
         }
         ShapOut {
-            kind: input.shap.into(),
+            kind: input.shap,
             expected_value: s.expected_value,
             values: s.values.clone(),
             local_accuracy_max_abs: s.local_accuracy,

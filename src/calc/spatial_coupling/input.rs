@@ -7,37 +7,24 @@
 use std::time::Duration;
 
 use crate::calc::common::Sign;
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 use crate::numerics::angles::sin_cos_deg;
 
 use super::wire::{MIN_ABS_COS_2ALPHA, SpatialCouplingRequest, Vec3};
 
-/// The shafts are not perpendicular.
-pub const PERPENDICULAR_SHAFTS: CrossRule = CrossRule::invalid(
-    "PERPENDICULAR_SHAFTS",
-    &["/alpha_deg"],
-    "|cos 2α| ≥ 1e-9: α = ±45° makes the shafts perpendicular (dead points, i12 = 0/0).",
-);
-/// A sweep's contact point stays finite (found while computing).
-pub const SUPPORT_PLANE_INVALID: CrossRule = CrossRule::infeasible(
-    "SUPPORT_PLANE_INVALID",
-    &["/beta_deg", "/alpha_deg", "/sweep"],
-    "With a `sweep`, cos(α−β)·cos 2α·cos(α+β) > 0 (the contact point is finite at every θ1).",
-);
-/// The work fits the time budget (found while computing).
-pub const DEADLINE_EXCEEDED: CrossRule = CrossRule::too_large(
-    "DEADLINE_EXCEEDED",
-    &["/time_limit_ms", "/sweep/n_points", "/theta1_deg"],
-    "The requested points are computed within the request's time limit.",
-);
-
-/// The rules between fields of `POST /v1/spatial-coupling`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    PERPENDICULAR_SHAFTS,
-    SUPPORT_PLANE_INVALID,
-    DEADLINE_EXCEEDED,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/spatial-coupling`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid PERPENDICULAR_SHAFTS ["/alpha_deg"]
+        "|cos 2α| ≥ 1e-9: α = ±45° makes the shafts perpendicular (dead points, i12 = 0/0).";
+    /// A sweep's contact point stays finite (found while computing).
+    infeasible SUPPORT_PLANE_INVALID ["/beta_deg", "/alpha_deg", "/sweep"]
+        "With a `sweep`, cos(α−β)·cos 2α·cos(α+β) > 0 (the contact point is finite at every θ1).";
+    /// The work fits the time budget (found while computing).
+    too_large DEADLINE_EXCEEDED ["/time_limit_ms", "/sweep/n_points", "/theta1_deg"]
+        "The requested points are computed within the request's time limit.";
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// Default α \[deg\] (spec §2; the paper-like case).
 pub const DEFAULT_ALPHA_DEG: f64 = 15.0;

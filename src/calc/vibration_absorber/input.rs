@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use crate::calc::common::{RESPONSE_TOO_LARGE_RULE, TimeLimited};
-use crate::calc::{CalcFailure, CrossRule, Validator};
+use crate::calc::{CalcFailure, Validator};
 
 use super::error::{DEADLINE_RULE, EIGEN_NOT_CONVERGED_RULE, NON_FINITE_RULE};
 use super::wire::{
@@ -12,138 +12,52 @@ use super::wire::{
     VibrationAbsorberRequest,
 };
 
-/// A `{mode: k}` reference names a mode the model keeps.
-pub const MODE_OUT_OF_RANGE: CrossRule = CrossRule::invalid(
-    "MODE_OUT_OF_RANGE",
-    &[
-        "/beam/n_modes",
-        "/absorber/passive_tuning_mode",
-        "/control/tuning_mode",
-        "/excitation/resonance_of_mode",
-        "/excitation/harmonics/*/resonance_of_mode",
-    ],
-    "Every mode reference (passive_tuning_mode, tuning_mode, resonance_of_mode) is at most \
-     beam.n_modes (default 3).",
-);
-/// `K_c ≠ 0` with `active`.
-pub const ZERO_FORCE_CONSTANT: CrossRule = CrossRule::invalid(
-    "ZERO_FORCE_CONSTANT",
-    &["/actuator/force_constant_n_a", "/control/mode"],
-    "With control.mode = active (the default), actuator.force_constant_n_a is not 0 (the gains \
-     divide by K_c).",
-);
-/// Positions and output abscissae lie on the beam.
-pub const POSITION_OUT_OF_BEAM: CrossRule = CrossRule::invalid(
-    "POSITION_OUT_OF_BEAM",
-    &[
-        "/beam/length_m",
-        "/absorber/position_m",
-        "/excitation/position_m",
-        "/outputs/frequency_response/points_m/*",
-        "/outputs/time_response/points_m/*",
-    ],
-    "absorber.position_m, excitation.position_m and every output abscissa points_m are at most \
-     beam.length_m (default 1 m).",
-);
-/// A time grid of at most 2e6 samples.
-pub const TOO_MANY_SAMPLES: CrossRule = CrossRule::too_large(
-    "TOO_MANY_SAMPLES",
-    &[
-        "/outputs/time_response/t_end_s",
-        "/outputs/time_response/dt_s",
-    ],
-    "outputs.time_response.t_end_s / dt_s is at most 2e6 samples.",
-);
-/// `excitation.harmonics` excludes the single-harmonic members.
-pub const HARMONICS_CONFLICT: CrossRule = CrossRule::invalid(
-    "HARMONICS_CONFLICT",
-    &[
-        "/excitation/harmonics",
-        "/excitation/amplitude_n",
-        "/excitation/frequency_hz",
-        "/excitation/resonance_of_mode",
-        "/excitation/phase_rad",
-    ],
-    "With excitation.harmonics, the single harmonic's amplitude_n, frequency_hz, \
-     resonance_of_mode and phase_rad are absent.",
-);
-/// `excitation.harmonics` only with `type = harmonic`.
-pub const HARMONICS_TYPE: CrossRule = CrossRule::invalid(
-    "HARMONICS_TYPE",
-    &["/excitation/harmonics", "/excitation/type"],
-    "excitation.harmonics is given only with excitation.type = harmonic (the default).",
-);
-/// The beam section is given one way.
-pub const SECTION_CONFLICT: CrossRule = CrossRule::invalid(
-    "SECTION_CONFLICT",
-    &["/beam/section", "/beam/area_m2", "/beam/second_moment_m4"],
-    "beam.section and beam.area_m2 / beam.second_moment_m4 are not given together.",
-);
-/// Area and second moment go together.
-pub const SECTION_PAIR: CrossRule = CrossRule::invalid(
-    "SECTION_PAIR",
-    &["/beam/area_m2", "/beam/second_moment_m4"],
-    "beam.area_m2 and beam.second_moment_m4 are given together or not at all.",
-);
-/// One source of the absorber stiffness.
-pub const STIFFNESS_CONFLICT: CrossRule = CrossRule::invalid(
-    "STIFFNESS_CONFLICT",
-    &[
-        "/absorber/stiffness_n_m",
-        "/absorber/passive_tuning_hz",
-        "/absorber/passive_tuning_mode",
-    ],
-    "At most one of absorber.stiffness_n_m, passive_tuning_hz and passive_tuning_mode is given.",
-);
-/// One tuning target of the PD law.
-pub const TUNING_CONFLICT: CrossRule = CrossRule::invalid(
-    "TUNING_CONFLICT",
-    &["/control/tuning_hz", "/control/tuning_mode"],
-    "At most one of control.tuning_hz and control.tuning_mode is given.",
-);
-/// Explicit gains come in pairs.
-pub const GAIN_PAIR: CrossRule = CrossRule::invalid(
-    "GAIN_PAIR",
-    &["/control/kp_v_m", "/control/kd_v_s_m"],
-    "control.kp_v_m and control.kd_v_s_m are given together or not at all.",
-);
-/// One excitation frequency.
-pub const FREQUENCY_CONFLICT: CrossRule = CrossRule::invalid(
-    "FREQUENCY_CONFLICT",
-    &["/excitation/frequency_hz", "/excitation/resonance_of_mode"],
-    "At most one of excitation.frequency_hz and excitation.resonance_of_mode is given.",
-);
-/// A frequency grid runs upwards.
-pub const GRID_ORDER: CrossRule = CrossRule::invalid(
-    "GRID_ORDER",
-    &[
-        "/outputs/ava_frequency_response/f_max_hz",
-        "/outputs/frequency_response/f_max_hz",
-    ],
-    "A frequency grid's f_max_hz is greater than its f_min_hz (equal only with n_points = 1).",
-);
-
-/// The rules between fields of `POST /v1/vibration-absorber` and the failures of its
-/// computation, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    SECTION_CONFLICT,
-    SECTION_PAIR,
-    STIFFNESS_CONFLICT,
-    MODE_OUT_OF_RANGE,
-    POSITION_OUT_OF_BEAM,
-    ZERO_FORCE_CONSTANT,
-    TUNING_CONFLICT,
-    GAIN_PAIR,
-    FREQUENCY_CONFLICT,
-    HARMONICS_CONFLICT,
-    HARMONICS_TYPE,
-    GRID_ORDER,
-    TOO_MANY_SAMPLES,
-    RESPONSE_TOO_LARGE_RULE,
-    NON_FINITE_RULE,
-    EIGEN_NOT_CONVERGED_RULE,
-    DEADLINE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/vibration-absorber` and the failures of its
+    /// computation, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid SECTION_CONFLICT ["/beam/section", "/beam/area_m2", "/beam/second_moment_m4"]
+        "beam.section and beam.area_m2 / beam.second_moment_m4 are not given together.";
+    invalid SECTION_PAIR ["/beam/area_m2", "/beam/second_moment_m4"]
+        "beam.area_m2 and beam.second_moment_m4 are given together or not at all.";
+    invalid STIFFNESS_CONFLICT ["/absorber/stiffness_n_m", "/absorber/passive_tuning_hz",
+        "/absorber/passive_tuning_mode"]
+        "At most one of absorber.stiffness_n_m, passive_tuning_hz and passive_tuning_mode is given.";
+    invalid MODE_OUT_OF_RANGE ["/beam/n_modes", "/absorber/passive_tuning_mode",
+        "/control/tuning_mode", "/excitation/resonance_of_mode",
+        "/excitation/harmonics/*/resonance_of_mode"]
+        "Every mode reference (passive_tuning_mode, tuning_mode, resonance_of_mode) is at most \
+         beam.n_modes (default 3).";
+    invalid POSITION_OUT_OF_BEAM ["/beam/length_m", "/absorber/position_m",
+        "/excitation/position_m", "/outputs/frequency_response/points_m/*",
+        "/outputs/time_response/points_m/*"]
+        "absorber.position_m, excitation.position_m and every output abscissa points_m are at most \
+         beam.length_m (default 1 m).";
+    invalid ZERO_FORCE_CONSTANT ["/actuator/force_constant_n_a", "/control/mode"]
+        "With control.mode = active (the default), actuator.force_constant_n_a is not 0 (the gains \
+         divide by K_c).";
+    invalid TUNING_CONFLICT ["/control/tuning_hz", "/control/tuning_mode"]
+        "At most one of control.tuning_hz and control.tuning_mode is given.";
+    invalid GAIN_PAIR ["/control/kp_v_m", "/control/kd_v_s_m"]
+        "control.kp_v_m and control.kd_v_s_m are given together or not at all.";
+    invalid FREQUENCY_CONFLICT ["/excitation/frequency_hz", "/excitation/resonance_of_mode"]
+        "At most one of excitation.frequency_hz and excitation.resonance_of_mode is given.";
+    invalid HARMONICS_CONFLICT ["/excitation/harmonics", "/excitation/amplitude_n",
+        "/excitation/frequency_hz", "/excitation/resonance_of_mode", "/excitation/phase_rad"]
+        "With excitation.harmonics, the single harmonic's amplitude_n, frequency_hz, \
+         resonance_of_mode and phase_rad are absent.";
+    invalid HARMONICS_TYPE ["/excitation/harmonics", "/excitation/type"]
+        "excitation.harmonics is given only with excitation.type = harmonic (the default).";
+    invalid GRID_ORDER ["/outputs/ava_frequency_response/f_max_hz",
+        "/outputs/frequency_response/f_max_hz"]
+        "A frequency grid's f_max_hz is greater than its f_min_hz (equal only with n_points = 1).";
+    too_large TOO_MANY_SAMPLES ["/outputs/time_response/t_end_s", "/outputs/time_response/dt_s"]
+        "outputs.time_response.t_end_s / dt_s is at most 2e6 samples.";
+    listed RESPONSE_TOO_LARGE_RULE;
+    listed NON_FINITE_RULE;
+    listed EIGEN_NOT_CONVERGED_RULE;
+    listed DEADLINE_RULE;
+}
 
 /// Configuration (which states the model has).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

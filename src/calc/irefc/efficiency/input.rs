@@ -2,43 +2,28 @@
 
 use std::f64::consts::PI;
 
-use super::wire::{self, IrefcEfficiencyRequest, phase_deg_range};
+use super::wire::{IrefcEfficiencyRequest, phase_deg_range};
+use crate::calc::CalcFailure;
 use crate::calc::irefc::error::{self, IrefcError};
 use crate::calc::irefc::geometry::Geometry;
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::MM;
-use crate::calc::{CalcFailure, CrossRule};
 
-/// Exactly one load: both given is ambiguous.
-pub const AMBIGUOUS_LOAD: CrossRule = CrossRule::invalid(
-    error::AMBIGUOUS_LOAD,
-    &["/power_W", "/input_torque_Nm"],
-    "At most one of `power_W` and `input_torque_Nm` is given.",
-);
-/// Exactly one load: none given is a missing field.
-pub const LOAD_MISSING: CrossRule = CrossRule::invalid(
-    error::MISSING_FIELD,
-    &["/power_W", "/input_torque_Nm"],
-    "One of `power_W` and `input_torque_Nm` is given.",
-);
-/// The cage phase lies within one element pitch.
-pub const PHASE_BELOW_PITCH: CrossRule = CrossRule::invalid(
-    error::BAD_RANGE,
-    &["/phase_deg", "/Z2"],
-    "phase_deg < 360/Z2 (one element pitch).",
-);
-
-/// The rules between fields of `POST /v1/irefc-efficiency`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    AMBIGUOUS_LOAD,
-    LOAD_MISSING,
-    PHASE_BELOW_PITCH,
-    design::UNDERCUT,
-    design::ELEMENT_OVERLAP,
-    design::NON_FINITE,
-    design::DEADLINE,
-    crate::calc::common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/irefc-efficiency`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid AMBIGUOUS_LOAD(error::AMBIGUOUS_LOAD) ["/power_W", "/input_torque_Nm"]
+        "At most one of `power_W` and `input_torque_Nm` is given.";
+    invalid LOAD_MISSING(error::MISSING_FIELD) ["/power_W", "/input_torque_Nm"]
+        "One of `power_W` and `input_torque_Nm` is given.";
+    invalid PHASE_BELOW_PITCH(error::BAD_RANGE) ["/phase_deg", "/Z2"]
+        "phase_deg < 360/Z2 (one element pitch).";
+    listed design::UNDERCUT;
+    listed design::ELEMENT_OVERLAP;
+    listed design::NON_FINITE;
+    listed design::DEADLINE;
+    listed crate::calc::common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// The paper's rolling-friction lever arm μ = 0.001 m \[mm\].
 pub const ROLLING_FRICTION_PAPER_MM: f64 = 1.0;
@@ -47,27 +32,8 @@ pub const ROLLING_FRICTION_HIGH_MM: f64 = 0.5;
 /// The paper's sliding friction coefficient.
 pub const SLIDING_FRICTION_PAPER: f64 = 0.1;
 
-/// Loss model of the element slip speeds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EfficiencyModel {
-    /// The paper's equations exactly as printed (signed slip speed); reproduces its Table 1.
-    PaperTable,
-    /// The paper's equations with |Vs| in the sliding loss (what the paper's text says).
-    PaperAbs,
-    /// Not in the paper: rigid-body relative speeds in the carrier frame (pure rolling at the
-    /// crown, slip at the cam).
-    RigidBody,
-}
-
-impl From<wire::EfficiencyModel> for EfficiencyModel {
-    fn from(m: wire::EfficiencyModel) -> Self {
-        match m {
-            wire::EfficiencyModel::PaperTable => Self::PaperTable,
-            wire::EfficiencyModel::PaperAbs => Self::PaperAbs,
-            wire::EfficiencyModel::RigidBody => Self::RigidBody,
-        }
-    }
-}
+/// The efficiency model: the request's `model`.
+pub use super::wire::EfficiencyModel;
 
 /// Validated efficiency input \[SI\].
 #[derive(Debug, Clone, PartialEq)]
@@ -159,7 +125,7 @@ impl EfficiencyInput {
             p_in,
             mu: mu_mm / MM,
             fs,
-            model: req.model.unwrap_or_default().into(),
+            model: req.model.unwrap_or_default(),
             phase_fraction,
             n_phase,
             elements: req.include.and_then(|i| i.elements).unwrap_or(true),

@@ -5,24 +5,14 @@ use std::time::Instant;
 
 use super::CONFIGURATION;
 use super::compute::{self, EfficiencyOutput, PhaseTotals};
-use super::input::{EfficiencyInput, EfficiencyModel, ROLLING_FRICTION_HIGH_MM};
+use super::input::{EfficiencyInput, ROLLING_FRICTION_HIGH_MM};
 use super::wire::{
-    self, EfficiencyElement, EfficiencyMeta, EfficiencyTotals, IrefcEfficiencyResponse,
-    NullableStat, PhaseStats, Stat,
+    EfficiencyElement, EfficiencyMeta, EfficiencyTotals, IrefcEfficiencyResponse, NullableStat,
+    PhaseStats, Stat,
 };
 use crate::calc::irefc::error::IrefcError;
 use crate::calc::irefc::output::geometry_warnings;
 use crate::calc::irefc::wire::{GeometryOut, MM, Warning};
-
-impl From<EfficiencyModel> for wire::EfficiencyModel {
-    fn from(m: EfficiencyModel) -> Self {
-        match m {
-            EfficiencyModel::PaperTable => Self::PaperTable,
-            EfficiencyModel::PaperAbs => Self::PaperAbs,
-            EfficiencyModel::RigidBody => Self::RigidBody,
-        }
-    }
-}
 
 /// Builds the response (`meta.compute_ms` counted from `t0`, the request's arrival).
 ///
@@ -101,7 +91,7 @@ pub fn respond(
         eta_linear: stat(s.eta_linear),
     });
     Ok(IrefcEfficiencyResponse {
-        model: inp.model.into(),
+        model: inp.model,
         configuration: CONFIGURATION.to_owned(),
         geometry,
         omega1_rad_s: inp.omega1,

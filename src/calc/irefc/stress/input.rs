@@ -4,83 +4,41 @@
 //! codes.
 
 use super::wire::{
-    self, GRID_INTERVALS_MAX, IntRange, IrefcStressRequest, LB_MAX_OVER_R2, LB_MM, STEP_DEG,
-    StepRange, StressInclude, StressMode,
+    GRID_INTERVALS_MAX, IntRange, IrefcStressRequest, LB_MAX_OVER_R2, LB_MM, STEP_DEG, StepRange,
+    StressInclude, StressMode,
 };
 use crate::calc::common::{self, Shard};
 use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, MISSING_FIELD, SWEEP_TOO_LARGE};
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::{MM, PROFILE_POINTS_DEFAULT, Warning};
-use crate::calc::{CalcFailure, CrossRule, Range, Validator};
+use crate::calc::{CalcFailure, Range, Validator};
 
-/// A sweep goes with mode "sweep".
-pub const SWEEP_NEEDS_MODE: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/sweep", "/mode"],
-    "`sweep` is given only with mode \"sweep\" (the default when `sweep` is present).",
-);
-/// A shard splits a sweep.
-pub const SHARD_NEEDS_SWEEP: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/shard", "/mode"],
-    "`shard` is given only in mode \"sweep\" (mode \"single\" has one design).",
-);
-/// The fields of the chosen mode are given.
-pub const MODE_FIELDS: CrossRule = CrossRule::invalid(
-    MISSING_FIELD,
-    &[
-        "/r2_mm",
-        "/rb_mm",
-        "/Z2",
-        "/chi",
-        "/sweep",
-        "/sweep/r2_mm",
-        "/sweep/rb_mm",
-    ],
-    "Mode \"single\" needs r2_mm, rb_mm, Z2 and chi; mode \"sweep\" needs `sweep`, and r2_mm \
-     and rb_mm unless `sweep.r2_mm`/`sweep.rb_mm` are given.",
-);
-/// Sweep ranges run upwards.
-pub const SWEEP_RANGE_ORDER: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/sweep/Z2/to", "/sweep/chi/to"],
-    "sweep.Z2.to ≥ sweep.Z2.from and sweep.chi.to ≥ sweep.chi.from.",
-);
-/// The contact length is at most 100 cage radii.
-pub const LB_BELOW_R2: CrossRule = CrossRule::invalid(
-    BAD_RANGE,
-    &["/lb_mm", "/r2_mm", "/sweep/r2_mm"],
-    "lb_mm ≤ 100·r2 for every r2 of the request.",
-);
-/// The φ2 grid has at most 2·10⁶ intervals.
-pub const GRID_TOO_FINE_RULE: CrossRule = CrossRule::too_large(
-    GRID_TOO_FINE,
-    &["/step_deg"],
-    "180/step_deg ≤ 2e6 (step_deg ≥ 9e-5).",
-);
-/// The sweep's size is bounded.
-pub const SWEEP_TOO_LARGE_RULE: CrossRule = CrossRule::too_large(
-    SWEEP_TOO_LARGE,
-    &["/sweep", "/step_deg"],
-    "The sweep has at most 1e5 combinations and at most 5e8 grid points in all.",
-);
-
-/// The rules between fields of `POST /v1/irefc-stress`, as the document lists them.
-pub const CROSS_FIELD_RULES: &[CrossRule] = &[
-    SWEEP_NEEDS_MODE,
-    SHARD_NEEDS_SWEEP,
-    common::SHARD_INDEX_BELOW_COUNT,
-    MODE_FIELDS,
-    SWEEP_RANGE_ORDER,
-    LB_BELOW_R2,
-    GRID_TOO_FINE_RULE,
-    SWEEP_TOO_LARGE_RULE,
-    design::UNDERCUT,
-    design::ELEMENT_OVERLAP,
-    design::NON_FINITE,
-    design::DEADLINE,
-    common::RESPONSE_TOO_LARGE_RULE,
-];
+crate::calc::rules::cross_rules! {
+    /// The rules between fields of `POST /v1/irefc-stress`, as the document lists them.
+    pub const CROSS_FIELD_RULES: &[CrossRule];
+    invalid SWEEP_NEEDS_MODE(BAD_RANGE) ["/sweep", "/mode"]
+        "`sweep` is given only with mode \"sweep\" (the default when `sweep` is present).";
+    invalid SHARD_NEEDS_SWEEP(BAD_RANGE) ["/shard", "/mode"]
+        "`shard` is given only in mode \"sweep\" (mode \"single\" has one design).";
+    listed common::SHARD_INDEX_BELOW_COUNT;
+    invalid MODE_FIELDS(MISSING_FIELD) ["/r2_mm", "/rb_mm", "/Z2", "/chi", "/sweep", "/sweep/r2_mm",
+        "/sweep/rb_mm"]
+        "Mode \"single\" needs r2_mm, rb_mm, Z2 and chi; mode \"sweep\" needs `sweep`, and r2_mm \
+         and rb_mm unless `sweep.r2_mm`/`sweep.rb_mm` are given.";
+    invalid SWEEP_RANGE_ORDER(BAD_RANGE) ["/sweep/Z2/to", "/sweep/chi/to"]
+        "sweep.Z2.to ≥ sweep.Z2.from and sweep.chi.to ≥ sweep.chi.from.";
+    invalid LB_BELOW_R2(BAD_RANGE) ["/lb_mm", "/r2_mm", "/sweep/r2_mm"]
+        "lb_mm ≤ 100·r2 for every r2 of the request.";
+    too_large GRID_TOO_FINE_RULE(GRID_TOO_FINE) ["/step_deg"]
+        "180/step_deg ≤ 2e6 (step_deg ≥ 9e-5).";
+    too_large SWEEP_TOO_LARGE_RULE(SWEEP_TOO_LARGE) ["/sweep", "/step_deg"]
+        "The sweep has at most 1e5 combinations and at most 5e8 grid points in all.";
+    listed design::UNDERCUT;
+    listed design::ELEMENT_OVERLAP;
+    listed design::NON_FINITE;
+    listed design::DEADLINE;
+    listed common::RESPONSE_TOO_LARGE_RULE;
+}
 
 /// Default φ2 grid step \[deg\]: 1° + refinement is ≤ 1e-10 from the exact maximum and ~40× cheaper than the
 /// paper's 0.02° grid (whose error is 1.8e-8); see `benches/RESULTS.md` (## irefc).
@@ -94,41 +52,11 @@ pub const SWEEP_WORK_MAX: f64 = 5e8;
 /// Tolerance on the last χ of a sweep range: χ_i = from + i·step is kept while ≤ to + this (spec).
 pub const CHI_RANGE_TOL: f64 = 1e-12;
 
-/// Which link carries the output torque.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum OutputLink {
-    /// Cam output, crown fixed (T_cam = T_out).
-    Cam,
-    /// Crown output, cam rotation locked (T_cam = T_out·(Z2−1)/(Z2+1)).
-    Crown,
-}
+/// The output link: the request's `output_link`.
+pub use super::wire::OutputLink;
 
-/// How the torque is shared over the elements when an element sits at φ2.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LoadSharing {
-    /// The paper: F(φ2) = Fmax·sin α with Fmax from the phase-0 element set (eqs 16–17).
-    PaperPhase0,
-    /// F(φ2) = T_cam·sin α/(r1·Σsin²α) with Σ over the cage phase that puts an element at φ2.
-    PhaseExact,
-}
-
-impl From<wire::OutputLink> for OutputLink {
-    fn from(l: wire::OutputLink) -> Self {
-        match l {
-            wire::OutputLink::Cam => Self::Cam,
-            wire::OutputLink::Crown => Self::Crown,
-        }
-    }
-}
-
-impl From<wire::LoadSharing> for LoadSharing {
-    fn from(l: wire::LoadSharing) -> Self {
-        match l {
-            wire::LoadSharing::PaperPhase0 => Self::PaperPhase0,
-            wire::LoadSharing::PhaseExact => Self::PhaseExact,
-        }
-    }
-}
+/// How the load is shared: the request's `load_sharing`.
+pub use super::wire::LoadSharing;
 
 /// Scalar settings shared by every combination \[SI\].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -359,13 +287,13 @@ fn check_params(
     let n_intervals = grid_intervals(v, step_deg).unwrap_or(0);
     StressParams {
         torque: req.torque_nm,
-        output_link: req.output_link.unwrap_or_default().into(),
+        output_link: req.output_link.unwrap_or_default(),
         lb: None,
         e_star: 1.0 / (wm.compliance() + rm.compliance()),
         step_deg,
         n_intervals,
         refine: req.refine.unwrap_or(true),
-        load_sharing: req.load_sharing.unwrap_or_default().into(),
+        load_sharing: req.load_sharing.unwrap_or_default(),
         subsurface: include.subsurface.unwrap_or(false),
     }
 }

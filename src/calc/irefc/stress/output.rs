@@ -4,9 +4,9 @@
 use std::time::Instant;
 
 use super::compute::{self, ComboOutcome, DesignResult, SweepResult, WheelMaxResult};
-use super::input::{LoadSharing, SingleInput, SweepInput};
+use super::input::{SingleInput, SweepInput};
 use super::wire::{
-    self, Curves, ElementOut, MaxOut, Reason, StressMeta, StressMode, StressSingleResponse,
+    Curves, ElementOut, MaxOut, Reason, StressMeta, StressMode, StressSingleResponse,
     StressSweepResponse, SweepMeta, SweepRecord, WheelMax,
 };
 use crate::calc::common::{ResponseSize, Shard, ShardOut};
@@ -18,15 +18,6 @@ use crate::numerics::SolverReport;
 
 /// Pascals per MPa.
 const MPA: f64 = 1e6;
-
-impl From<LoadSharing> for wire::LoadSharing {
-    fn from(l: LoadSharing) -> Self {
-        match l {
-            LoadSharing::PaperPhase0 => Self::PaperPhase0,
-            LoadSharing::PhaseExact => Self::PhaseExact,
-        }
-    }
-}
 
 /// Upper estimate of a single-design answer (before computing): fixed fields, then the element
 /// table (Z2 rows), the curves ((N/stride + 2) points × 6 series) and the profiles (2 wheels ×
@@ -135,7 +126,7 @@ pub fn respond_single(
         meta: StressMeta {
             step_deg: p.step_deg,
             refine: p.refine,
-            load_sharing: p.load_sharing.into(),
+            load_sharing: p.load_sharing,
             n_grid: r.n_intervals as u64 + 1,
             evaluations: r.evaluations,
             compute_ms: t0.elapsed().as_secs_f64() * 1e3,
@@ -272,7 +263,7 @@ pub fn respond_sweep(
         meta: SweepMeta {
             step_deg: p.step_deg,
             refine: p.refine,
-            load_sharing: p.load_sharing.into(),
+            load_sharing: p.load_sharing,
             n_grid: p.n_intervals as u64 + 1,
             n_combinations: records.len() as u64,
             threads: res.threads,
