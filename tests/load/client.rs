@@ -198,6 +198,18 @@ pub fn request_bytes(
     r
 }
 
+/// A JSON POST of raw `body` bytes on a connection closed after the answer.
+pub fn request_bytes_raw(method: &str, path: &str, body: &[u8]) -> Vec<u8> {
+    let mut r = format!(
+        "{method} {path} HTTP/1.1\r\nhost: t\r\ncontent-type: application/json\r\n\
+         content-length: {}\r\nconnection: close\r\n\r\n",
+        body.len()
+    )
+    .into_bytes();
+    r.extend_from_slice(body);
+    r
+}
+
 /// Send prepared request bytes on a fresh connection (closed after the answer).
 pub async fn send(addr: SocketAddr, request: Vec<u8>) -> std::io::Result<Reply> {
     exchange(addr, request).await
@@ -352,7 +364,7 @@ pub fn thread_count(pid: u32) -> u64 {
 }
 
 /// The first number of a `/proc/<pid>/status` line (0 when absent).
-fn status_field(pid: u32, key: &str) -> u64 {
+pub fn status_field(pid: u32, key: &str) -> u64 {
     std::fs::read_to_string(format!("/proc/{pid}/status"))
         .ok()
         .and_then(|s| {

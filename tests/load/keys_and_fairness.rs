@@ -484,7 +484,10 @@ async fn soak_mixed_load_from_several_keys() {
                         note_5xx(&r, t0, "plm sweep", &mut lost);
                         st.push(r.status);
                     }
-                    Err(e) => lost.push(format!("{:.1} s plm sweep: {e}", t0.elapsed().as_secs_f64())),
+                    Err(e) => lost.push(format!(
+                        "{:.1} s plm sweep: {e}",
+                        t0.elapsed().as_secs_f64()
+                    )),
                 }
             }
             (st, Vec::new(), lost)
@@ -516,10 +519,9 @@ async fn soak_mixed_load_from_several_keys() {
                             note_5xx(&r, t0, "ci sweep", &mut lost);
                             st.push(r.status);
                         }
-                        Err(e) => lost.push(format!(
-                            "{:.1} s ci sweep: {e}",
-                            t0.elapsed().as_secs_f64()
-                        )),
+                        Err(e) => {
+                            lost.push(format!("{:.1} s ci sweep: {e}", t0.elapsed().as_secs_f64()))
+                        }
                     }
                     continue;
                 }

@@ -10,7 +10,7 @@ mod keys_and_fairness;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use client::{Server, cpu_seconds, get, post, rss_kib, thread_count};
+use client::{Server, cpu_seconds, get, post, rss_kib, status_field, thread_count};
 use serde_json::{Value, json};
 
 /// The scenarios run one at a time: each starts its own server and floods it, and two floods at
@@ -316,6 +316,74 @@ async fn slow_readers_are_dropped_and_memory_returns() {
     assert!(
         after < base + 64 * 1024,
         "RSS {after} KiB after the slow readers left (baseline {base}, peak {peak})"
+    );
+    server.stop().await;
+}
+
+/// A machining-size training body of `rows` × 20 features (one shallow tree: the reading, not
+/// the model, is what the memory follows).
+fn training_body(rows: usize) -> Vec<u8> {
+    let mut rng = 7_u64;
+    let mut next = || {
+        // xorshift: a fixed, dependency-free stream of numbers in [0, 100).
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng % 1_000_000) as f64 / 1e4
+    };
+    let x: Vec<Vec<f64>> = (0..rows)
+        .map(|_| (0..20).map(|_| next()).collect())
+        .collect();
+    let y: Vec<f64> = x
+        .iter()
+        .map(|r| r.iter().enumerate().map(|(j, v)| v * (j + 1) as f64).sum())
+        .collect();
+    serde_json::to_vec(&json!({
+        "feature_names": (0..20).map(|j| format!("f{j}")).collect::<Vec<_>>(),
+        "rows": x, "target": y,
+        "params": {"n_estimators": 1, "max_depth": 2, "tree_method": "hist"},
+        "validation": {"test_fraction": 0.2}, "time_limit_ms": 60_000
+    }))
+    .expect("serializes")
+}
+
+/// Issue 26 item 7: a request body of B bytes raises peak RSS by at most 5·B + 32 MiB, and the
+/// memory goes back to the system after the answer (the binary's allocator purges freed pages
+/// in the background; glibc's kept tens of MiB).
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn memory_follows_a_large_body_and_goes_back() {
+    let _serial = SERIAL.lock().await;
+    let server = Server::start(&[("MECHCALC_MAX_BODY_BYTES", "33554432")]).await;
+    let pid = server.pid();
+    let body = training_body(40_000);
+    let b_mib = body.len() / (1 << 20);
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let idle = rss_kib(pid);
+    let hwm0 = status_field(pid, "VmHWM:").max(idle);
+    let r = client::send(
+        server.addr,
+        client::request_bytes_raw("POST", "/v1/machining-size/train", &body),
+    )
+    .await
+    .expect("answers");
+    assert_eq!(r.status, 200, "{}", r.text());
+    let rise_mib = (status_field(pid, "VmHWM:") - hwm0) / 1024;
+    assert!(
+        rise_mib as usize <= 5 * b_mib + 32,
+        "peak RSS rose {rise_mib} MiB for a {b_mib} MiB body (limit 5·B + 32 MiB)"
+    );
+    // Up to 4 s for the background purge (1-s decay).
+    let mut after = rss_kib(pid);
+    for _ in 0..40 {
+        if after <= idle + 16 * 1024 {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+        after = rss_kib(pid);
+    }
+    assert!(
+        after <= idle + 16 * 1024,
+        "RSS {after} KiB 4 s after a {b_mib} MiB body; idle was {idle} KiB"
     );
     server.stop().await;
 }
