@@ -46,6 +46,8 @@ struct Conn {
 struct Answer {
     status: u16,
     server_us: f64,
+    /// The `door` metric (parse, rules, rules between fields) [µs]: part of the boundary.
+    door_us: f64,
     bytes: usize,
 }
 
@@ -76,6 +78,7 @@ impl Conn {
             .unwrap_or(0);
         let mut length = 0usize;
         let mut server_us = 0.0;
+        let mut door_us = 0.0;
         loop {
             line.clear();
             self.reader.read_line(&mut line).expect("header");
@@ -87,11 +90,22 @@ impl Conn {
             if let Some(v) = lower.strip_prefix("content-length:") {
                 length = v.trim().parse().expect("length");
             } else if let Some(v) = lower.strip_prefix("server-timing:") {
+                // queue + compute + encode only: `door` and `handback` are part of the boundary.
                 server_us = v
                     .split(',')
+                    .filter(|m| {
+                        let name = m.trim().split(';').next().unwrap_or("");
+                        matches!(name, "queue" | "compute" | "encode")
+                    })
                     .filter_map(|m| m.split("dur=").nth(1))
                     .filter_map(|d| d.trim().parse::<f64>().ok())
                     .sum::<f64>()
+                    * 1e3;
+                door_us = v
+                    .split(',')
+                    .find_map(|m| m.trim().strip_prefix("door;dur="))
+                    .and_then(|d| d.trim().parse::<f64>().ok())
+                    .unwrap_or(0.0)
                     * 1e3;
             }
         }
@@ -100,6 +114,7 @@ impl Conn {
         Answer {
             status,
             server_us,
+            door_us,
             bytes: length,
         }
     }
@@ -176,12 +191,12 @@ fn main() {
     println!("binary: {bin}");
     println!("/healthz round trip (best of 50): {health:.1} µs\n");
     println!(
-        "| example | endpoint | answer bytes | round trip µs | server (queue+compute+encode) µs | boundary µs |"
+        "| example | endpoint | answer bytes | round trip µs | server (queue+compute+encode) µs | of the boundary: door µs | boundary µs |"
     );
-    println!("|---|---|---:|---:|---:|---:|");
+    println!("|---|---|---:|---:|---:|---:|---:|");
     let mut costs = Vec::new();
     for (file, endpoint, body) in examples() {
-        let mut best: Option<(f64, f64, f64, usize)> = None;
+        let mut best: Option<(f64, f64, f64, f64, usize)> = None;
         for _ in 0..REPEATS {
             let t = Instant::now();
             let a = conn.request("POST", &endpoint, &body);
@@ -189,11 +204,13 @@ fn main() {
             assert_eq!(a.status, 200, "api/{file} answered {}", a.status);
             let cost = rtt - a.server_us - health;
             if best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, rtt, a.server_us, a.bytes));
+                best = Some((cost, rtt, a.server_us, a.door_us, a.bytes));
             }
         }
-        let (cost, rtt, server, bytes) = best.expect("measured");
-        println!("| {file} | {endpoint} | {bytes} | {rtt:.0} | {server:.0} | {cost:.0} |");
+        let (cost, rtt, server, door, bytes) = best.expect("measured");
+        println!(
+            "| {file} | {endpoint} | {bytes} | {rtt:.0} | {server:.0} | {door:.0} | {cost:.0} |"
+        );
         costs.push(cost);
     }
     child.kill().ok();

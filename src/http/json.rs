@@ -181,6 +181,14 @@ async fn off_the_connection<R: Send + 'static>(
         .map_err(|_| ApiError::internal())?
 }
 
+/// Note the door's time on the request in flight (reported as `door` in `Server-Timing`).
+fn record_door(took: Duration) {
+    let ns = u64::try_from(took.as_nanos()).unwrap_or(u64::MAX).max(1);
+    let _ = super::pool::REQUEST_INFO.try_with(|i| {
+        i.door_ns.store(ns, std::sync::atomic::Ordering::Relaxed);
+    });
+}
+
 /// Decode a body as `T` (one typed parse) and check every per-field rule `T` declares.
 ///
 /// # Errors
@@ -196,7 +204,10 @@ impl<T: DeserializeOwned + Rules + Send + 'static> FromRequest<AppState> for Api
 
     async fn from_request(req: Request, state: &AppState) -> Result<Self, Self::Rejection> {
         let bytes = body_bytes(req, state).await?;
-        off_the_connection(bytes, |b| decode_checked(&b).map(ApiJson)).await
+        let door = std::time::Instant::now();
+        let decoded = off_the_connection(bytes, |b| decode_checked(&b).map(ApiJson)).await;
+        record_door(door.elapsed());
+        decoded
     }
 }
 
@@ -221,7 +232,8 @@ where
 
     async fn from_request(req: Request, state: &AppState) -> Result<Self, Self::Rejection> {
         let bytes = body_bytes(req, state).await?;
-        off_the_connection(bytes, |b| {
+        let door = std::time::Instant::now();
+        let valid = off_the_connection(bytes, |b| {
             let wire: R = decode_checked(&b)?;
             drop(b);
             let limit = wire.time_limit();
@@ -232,7 +244,9 @@ where
                 _wire: std::marker::PhantomData,
             })
         })
-        .await
+        .await;
+        record_door(door.elapsed());
+        valid
     }
 }
 

@@ -98,6 +98,7 @@ pub async fn log_request(req: Request, next: Next) -> Response {
         body_bytes,
         progress: None,
         client: std::sync::Arc::from(""),
+        door_ns: std::sync::Arc::default(),
     };
     let resp = REQUEST_INFO
         .scope(info, next.run(req).instrument(span))

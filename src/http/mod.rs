@@ -401,7 +401,7 @@ where
 {
     let max_bytes = state.config.max_response_bytes;
     let arrived = std::time::Instant::now();
-    let (body, compute, encoding, started) = state
+    let (body, compute, encoding, started, ended) = state
         .pool
         .run(demand, move |budget| {
             let started = std::time::Instant::now();
@@ -422,18 +422,37 @@ where
                     ),
                 )));
             }
-            Ok((body, computed - started, computed.elapsed(), started))
+            Ok((
+                body,
+                computed - started,
+                computed.elapsed(),
+                started,
+                std::time::Instant::now(),
+            ))
         })
         .await??;
+    // From the job's end to this task running again (the hand-back from a compute thread).
+    let handback = ended.elapsed();
     let mut r = json_response(body);
     // Server-Timing (W3C): where the time of this answer went, for clients and benchmarks.
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let queue = started.saturating_duration_since(arrived);
+    // The door (parse, rules) ran before `arrived`; reported apart so the three stages after it
+    // keep their meaning.
+    let door_ns = pool::REQUEST_INFO
+        .try_with(|i| i.door_ns.load(std::sync::atomic::Ordering::Relaxed))
+        .unwrap_or(0);
+    let door = if door_ns == 0 {
+        String::new()
+    } else {
+        format!("door;dur={:.3}, ", door_ns as f64 * 1e-6)
+    };
     if let Ok(v) = HeaderValue::from_str(&format!(
-        "queue;dur={:.3}, compute;dur={:.3}, encode;dur={:.3}",
+        "{door}queue;dur={:.3}, compute;dur={:.3}, encode;dur={:.3}, handback;dur={:.3}",
         ms(queue),
         ms(compute),
-        ms(encoding)
+        ms(encoding),
+        ms(handback)
     )) {
         r.headers_mut()
             .insert(HeaderName::from_static("server-timing"), v);

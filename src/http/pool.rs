@@ -99,6 +99,9 @@ pub struct RequestInfo {
     /// Who the request belongs to for fair queueing: its API key id, else its remote address
     /// (set by [`crate::http::auth::authenticate`]); empty means in-process.
     pub client: Arc<str>,
+    /// Time the door took on this request (typed parse, per-field rules, rules between fields)
+    /// \[ns\], 0 until it ran: reported as `door` in `Server-Timing`.
+    pub door_ns: Arc<AtomicU64>,
 }
 
 /// Where a job runs.
