@@ -294,6 +294,13 @@ pub fn app(state: AppState) -> Router {
     let body_limit = state.config.max_body_bytes;
     let authenticate = middleware::from_fn_with_state(state.clone(), auth::authenticate);
     let cors = layers::cors(&state.config.cors_origins);
+    // The idle keep-alive limit (the request-head timeout), announced so clients replace a pooled
+    // connection before the server closes it rather than write a request into a closed one.
+    let keep_alive = HeaderValue::from_str(&format!(
+        "timeout={}",
+        (state.config.header_timeout_ms / 1000).max(1)
+    ))
+    .unwrap_or_else(|_| HeaderValue::from_static("timeout=1"));
     let mut app = router
         .route("/", get(meta::page))
         .route("/openapi.json", get(meta::openapi_json))
@@ -315,6 +322,10 @@ pub fn app(state: AppState) -> Router {
     for (name, value) in layers::hardening_headers() {
         app = app.layer(SetResponseHeaderLayer::if_not_present(name, value));
     }
+    app = app.layer(SetResponseHeaderLayer::if_not_present(
+        HeaderName::from_static("keep-alive"),
+        keep_alive,
+    ));
     if let Some(cors) = cors {
         app = app.layer(cors);
     }

@@ -14,6 +14,20 @@ async fn healthz_answers_ok() {
     assert_eq!(r.json()["status"], "ok");
 }
 
+/// Every answer announces the idle keep-alive limit (the request-head timeout, 10 s by default),
+/// so pooled client connections are replaced before the server closes them.
+#[tokio::test]
+async fn answers_announce_the_keep_alive_limit() {
+    for path in ["/healthz", "/v1", "/no-such-path"] {
+        let r = get(path).await;
+        assert_eq!(
+            r.headers.get("keep-alive").and_then(|v| v.to_str().ok()),
+            Some("timeout=10"),
+            "{path}"
+        );
+    }
+}
+
 #[tokio::test]
 async fn index_lists_every_documented_endpoint() {
     let r = get("/v1").await;

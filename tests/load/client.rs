@@ -217,6 +217,7 @@ pub async fn send(addr: SocketAddr, request: Vec<u8>) -> std::io::Result<Reply> 
 
 /// A keep-alive connection that sends one request after another (as load generators do).
 pub struct KeepAlive {
+    addr: SocketAddr,
     stream: TcpStream,
     buf: Vec<u8>,
 }
@@ -226,13 +227,26 @@ impl KeepAlive {
         let stream = TcpStream::connect(addr).await?;
         stream.set_nodelay(true)?;
         Ok(Self {
+            addr,
             stream,
             buf: Vec::new(),
         })
     }
 
     /// Send `request` and read one answer (its head and `content-length` bytes of body).
+    ///
+    /// Like the connection pools of HTTP client libraries (urllib3's `is_connection_dropped`,
+    /// hyper-util's pool), a connection the server has already closed (idle past its keep-alive
+    /// limit, announced in the `keep-alive: timeout=` header) is replaced before the request is
+    /// sent, not written into.
     pub async fn exchange(&mut self, request: &[u8]) -> std::io::Result<Reply> {
+        let mut probe = [0u8; 1];
+        match self.stream.try_read(&mut probe) {
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+            Ok(n) if n > 0 => self.buf.extend_from_slice(&probe[..n]),
+            // Closed by the server (Ok(0)) or reset: a fresh connection.
+            _ => *self = Self::connect(self.addr).await?,
+        }
         self.stream.write_all(request).await?;
         let mut chunk = [0u8; 16 * 1024];
         loop {
