@@ -288,9 +288,29 @@ pub fn openapi_yaml() -> Result<String, serde_norway::Error> {
     serde_norway::to_string(openapi::document())
 }
 
+/// The routes of the application, built once per process (generating the routes' OpenAPI
+/// items is most of the cost of building the app; tests and `mechcalc run` build many apps).
+fn routes() -> Router<AppState> {
+    static ROUTES: std::sync::OnceLock<Router<AppState>> = std::sync::OnceLock::new();
+    ROUTES
+        .get_or_init(|| {
+            let (router, _api) = api_router().0.split_for_parts();
+            router
+                .route("/", get(meta::page))
+                .route("/openapi.json", get(meta::openapi_json))
+                .route("/metrics", get(meta::metrics))
+                .route("/docs", get(meta::docs))
+                .route("/docs/", get(meta::docs))
+                .route("/docs/swagger-ui-bundle.js", get(meta::swagger_js))
+                .route("/docs/swagger-ui.css", get(meta::swagger_css))
+                .fallback(not_found)
+                .method_not_allowed_fallback(method_not_allowed)
+        })
+        .clone()
+}
+
 /// The whole application. Tests drive it without a socket.
 pub fn app(state: AppState) -> Router {
-    let (router, _api) = api_router().0.split_for_parts();
     let body_limit = state.config.max_body_bytes;
     let authenticate = middleware::from_fn_with_state(state.clone(), auth::authenticate);
     let cors = layers::cors(&state.config.cors_origins);
@@ -301,16 +321,7 @@ pub fn app(state: AppState) -> Router {
         (state.config.header_timeout_ms / 1000).max(1)
     ))
     .unwrap_or_else(|_| HeaderValue::from_static("timeout=1"));
-    let mut app = router
-        .route("/", get(meta::page))
-        .route("/openapi.json", get(meta::openapi_json))
-        .route("/metrics", get(meta::metrics))
-        .route("/docs", get(meta::docs))
-        .route("/docs/", get(meta::docs))
-        .route("/docs/swagger-ui-bundle.js", get(meta::swagger_js))
-        .route("/docs/swagger-ui.css", get(meta::swagger_css))
-        .fallback(not_found)
-        .method_not_allowed_fallback(method_not_allowed)
+    let mut app = routes()
         .with_state(state)
         .layer(DefaultBodyLimit::max(body_limit))
         .layer(CatchPanicLayer::custom(panic_response))

@@ -123,12 +123,36 @@ pub async fn send_to(
     content_type: Option<&str>,
     body: Vec<u8>,
 ) -> Reply {
+    send_via(app(state), method, path, content_type, body).await
+}
+
+/// POST a JSON value through an app already built (a test that sends thousands of requests
+/// builds its app once).
+pub async fn post_json_via(router: axum::Router, path: &str, body: &Value) -> Reply {
+    send_via(
+        router,
+        "POST",
+        path,
+        Some("application/json"),
+        serde_json::to_vec(body).expect("serializable"),
+    )
+    .await
+}
+
+/// Send one request through `router`.
+pub async fn send_via(
+    router: axum::Router,
+    method: &str,
+    path: &str,
+    content_type: Option<&str>,
+    body: Vec<u8>,
+) -> Reply {
     let mut req = Request::builder().method(method).uri(path);
     if let Some(ct) = content_type {
         req = req.header("content-type", ct);
     }
     let req = req.body(Body::from(body)).expect("valid request");
-    let resp = app(state).oneshot(req).await.expect("router is infallible");
+    let resp = router.oneshot(req).await.expect("router is infallible");
     let status = resp.status();
     let headers = resp.headers().clone();
     let bytes = resp
