@@ -297,7 +297,7 @@ pub enum StopReason {
 
 /// What a solver cost and how it stopped; every endpoint with iterative or swept work returns one
 /// as `report` (one shape across the service).
-#[derive(Debug, Clone, Serialize, ToSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[schema(as = Report)]
 pub struct SolverReport {
     /// How the solver stopped.

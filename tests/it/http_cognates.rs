@@ -233,7 +233,7 @@ fn untimed(mut v: Value) -> Value {
     fn strip(v: &mut Value) {
         match v {
             Value::Object(m) => {
-                m.retain(|k, _| k != "compute_us");
+                m.retain(|k, _| k != "compute_us" && k != "elapsed_ms");
                 m.values_mut().for_each(strip);
             }
             Value::Array(a) => a.iter_mut().for_each(strip),

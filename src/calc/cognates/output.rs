@@ -4,6 +4,8 @@
 
 use std::time::Instant;
 
+use crate::numerics::{SolverReport, StopReason};
+
 use super::compute::{
     CognatesOutput, Curve, FiveBar, MechOutput, Metrics, Notice, NoticeKind, SnapStatus,
     SnapshotResult,
@@ -19,8 +21,8 @@ use super::wire::{
     Verification, Warning, WarningCode,
 };
 
-/// Builds the response: the normalised output back in the caller's units, and `meta.compute_us`
-/// counted from `start` (the request's arrival in [`run`](super::run)).
+/// Builds the response: the normalised output back in the caller's units, and its cost
+/// (`report`, and the deprecated `meta.compute_us`) counted from `start` (the request's arrival in [`run`](super::run)).
 #[must_use]
 pub fn respond(input: &CognatesInput, out: &CognatesOutput, start: Instant) -> CognatesResponse {
     let fr = Frame {
@@ -88,12 +90,23 @@ pub fn respond(input: &CognatesInput, out: &CognatesOutput, start: Instant) -> C
             .as_ref()
             .map(|f| f.iter().map(|b| fivebar_out(&fr, b)).collect()),
         warnings: out.warnings.iter().map(warning).collect(),
+        report: SolverReport {
+            stop_reason: StopReason::Completed,
+            iterations: 0,
+            evaluations: 0,
+            elapsed_ms: 0.0,
+        },
         meta: Meta {
             points_total: out.points_total,
             compute_us: 0,
         },
     };
-    resp.meta.compute_us = u64::try_from(start.elapsed().as_micros()).unwrap_or(u64::MAX);
+    let elapsed = start.elapsed();
+    let points = u64::try_from(out.points_total).unwrap_or(u64::MAX);
+    resp.report.iterations = points;
+    resp.report.evaluations = points;
+    resp.report.elapsed_ms = elapsed.as_secs_f64() * 1e3;
+    resp.meta.compute_us = u64::try_from(elapsed.as_micros()).unwrap_or(u64::MAX);
     resp
 }
 

@@ -4,6 +4,7 @@
 
 use crate::calc::Range;
 use crate::calc::common::Sign;
+use crate::numerics::SolverReport;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
@@ -380,7 +381,12 @@ pub struct CognatesResponse {
     pub geared_fivebars: Option<Vec<GearedFiveBar>>,
     /// Warnings about fragile or special geometry.
     pub warnings: Vec<Warning>,
-    /// Cost of the request.
+    /// How the calculation stopped and what it cost (closed form: always `completed`;
+    /// `iterations` and `evaluations` count the curve points computed), as on every endpoint.
+    pub report: SolverReport,
+    /// Deprecated: the same cost as `report` (`compute_us` = `report.elapsed_ms` in µs); kept for
+    /// one release for clients that read it.
+    #[schema(deprecated)]
     pub meta: Meta,
 }
 
@@ -935,9 +941,9 @@ pub struct Warning {
     pub angles_deg: Option<Vec<f64>>,
 }
 
-/// Cost of the request.
+/// Cost of the request (deprecated: read `report`).
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
-#[schema(as = cognates::Meta)]
+#[schema(as = cognates::Meta, deprecated)]
 pub struct Meta {
     /// Curve points returned (all mechanisms).
     pub points_total: usize,
