@@ -624,10 +624,7 @@ fn adaptive(
         let t_new = if t + h >= 1.0 - T_SNAP { 1.0 } else { t + h };
         let last = t_new >= 1.0;
         let on_coarse = coarse.is_some() && !last;
-        let model = match &coarse {
-            Some(c) if on_coarse => c,
-            _ => model,
-        };
+        let model = coarse.as_ref().filter(|_| on_coarse).unwrap_or(model);
         let p = path.at(t_new);
         let guess = path.predict(model, &sol, t, t_new);
         let trust = TRUST * max_diff(&guess, &sol.v).max(TRUST_FLOOR);
