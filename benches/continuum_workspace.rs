@@ -392,6 +392,51 @@ fn fk_cold_table() {
         }
     }
 
+    // The warm solve of the same request: start from the solution of a 10 mm neighbour.
+    let neighbour = run(
+        serde_json::from_value(json!({"mode": "fk", "design": {"preset": "keops_d1"},
+            "inputs_m": [-0.14, 0.2225], "load": {"force_n": [0, -50]},
+            "solver": {"rk4_steps": 32, "tol": 1e-10}, "outputs": {"stability": false}}))
+        .expect("valid"),
+        &Budget::unlimited(),
+    )
+    .expect("fk");
+    let state = serde_json::to_value(&neighbour).expect("json")["solver_state"].clone();
+    let cold = spec_fk_request(
+        json!({"kind": "home"}),
+        json!({"rk4_steps": 32, "tol": 1e-10}),
+    );
+    let warm = spec_fk_request(
+        json!({"kind": "guess", "state": state}),
+        json!({"rk4_steps": 32, "tol": 1e-10}),
+    );
+    // Interleaved, so that both see the same load.
+    let (mut tc, mut tw) = (Vec::new(), Vec::new());
+    for _ in 0..5 {
+        for (r, v) in [(&cold, &mut tc), (&warm, &mut tw)] {
+            let (t, _) = support::time_for(Duration::from_millis(200), 2000, || {
+                run(r.clone(), &Budget::unlimited()).expect("fk")
+            });
+            v.push((t.median_us(), t.cpu_s.map_or(f64::NAN, |c| c * 1e6)));
+        }
+    }
+    let med = |v: &mut Vec<(f64, f64)>, i: usize| {
+        let mut x: Vec<f64> = v.iter().map(|p| if i == 0 { p.0 } else { p.1 }).collect();
+        x.sort_by(f64::total_cmp);
+        x[x.len() / 2]
+    };
+    let (cw, cc, ww, wc) = (
+        med(&mut tc, 0),
+        med(&mut tc, 1),
+        med(&mut tw, 0),
+        med(&mut tw, 1),
+    );
+    println!(
+        "\nCold (home, default adaptive) vs warm (guess = solution at a 10 mm neighbour, (-0.14, 0.2225) m) `run()` of the spec 9 request, interleaved, medians of 5 rounds: cold {cw:.0} µs wall / {cc:.0} µs CPU, warm {ww:.0} µs wall / {wc:.0} µs CPU: cold = {:.2}x warm (wall), {:.2}x (CPU)",
+        cw / ww,
+        cc / wc
+    );
+
     let n: usize = std::env::var("CW_BENCH_TARGETS")
         .ok()
         .and_then(|s| s.parse().ok())

@@ -119,54 +119,61 @@ fn accuracy() -> f64 {
 
 fn tables() {
     println!(
-        "\nspatial_coupling: time per point of a θ1 sweep (α = 15°, β = 5°; one thread; 2-core shared machine)"
+        "\nspatial_coupling: time per point of a θ1 sweep (α = 15°, β = 5°; 2-core shared machine; load average {})",
+        std::fs::read_to_string("/proc/loadavg")
+            .unwrap_or_default()
+            .trim()
     );
-    println!("| points | outputs | path | median ns/point | worst ns/point |");
-    println!("|---|---|---|---|---|");
+    println!("| points | outputs | path | threads | median ns/point | worst ns/point |");
+    println!("|---|---|---|---|---|---|");
     for n in [361u64, 3601, 1_000_000] {
         for all in [false, true] {
             if n == 1_000_000 && all {
                 continue; // the series of 10⁶ points with every group is a 1.5 GB answer
             }
-            let r = req(&sweep(n, all));
-            let input = SpatialCouplingInput::try_from(r.clone()).expect("valid");
-            let budget = Budget::unlimited();
-            let target = Duration::from_millis(if n > 10_000 { 2000 } else { 600 });
-            let (t, _) = time_for(target, 2000, || {
-                black_box(compute(&input, &budget).expect("computes"))
-            });
-            let per = |s: f64| s * 1e9 / n as f64;
-            let what = if all {
-                "all groups + series"
-            } else {
-                "core + summary"
-            };
-            println!(
-                "| {n} | {what} | compute | {:.1} | {:.1} |",
-                per(t.median_s),
-                per(t.worst_s)
-            );
-            let (t, _) = time_for(target, 2000, || {
-                black_box(run(r.clone(), &budget).expect("runs"))
-            });
-            println!(
-                "| {n} | {what} | run (no JSON) | {:.1} | {:.1} |",
-                per(t.median_s),
-                per(t.worst_s)
-            );
-            if n <= 3601 {
+            // One chunk of work below 4096 points: more threads change nothing there.
+            let thread_counts: &[usize] = if n > 10_000 { &[1, 2] } else { &[1] };
+            for &threads in thread_counts {
+                let r = req(&sweep(n, all));
+                let input = SpatialCouplingInput::try_from(r.clone()).expect("valid");
+                let budget = Budget::unlimited().with_threads(threads);
+                let target = Duration::from_millis(if n > 10_000 { 2000 } else { 600 });
                 let (t, _) = time_for(target, 2000, || {
-                    black_box(
-                        serde_json::to_vec(&run(r.clone(), &budget).expect("runs"))
-                            .expect("json")
-                            .len(),
-                    )
+                    black_box(compute(&input, &budget).expect("computes"))
                 });
+                let per = |s: f64| s * 1e9 / n as f64;
+                let what = if all {
+                    "all groups + series"
+                } else {
+                    "core + summary"
+                };
                 println!(
-                    "| {n} | {what} | run + JSON | {:.1} | {:.1} |",
+                    "| {n} | {what} | compute | {threads} | {:.1} | {:.1} |",
                     per(t.median_s),
                     per(t.worst_s)
                 );
+                let (t, _) = time_for(target, 2000, || {
+                    black_box(run(r.clone(), &budget).expect("runs"))
+                });
+                println!(
+                    "| {n} | {what} | run (no JSON) | {threads} | {:.1} | {:.1} |",
+                    per(t.median_s),
+                    per(t.worst_s)
+                );
+                if n <= 3601 {
+                    let (t, _) = time_for(target, 2000, || {
+                        black_box(
+                            serde_json::to_vec(&run(r.clone(), &budget).expect("runs"))
+                                .expect("json")
+                                .len(),
+                        )
+                    });
+                    println!(
+                        "| {n} | {what} | run + JSON | {threads} | {:.1} | {:.1} |",
+                        per(t.median_s),
+                        per(t.worst_s)
+                    );
+                }
             }
         }
     }
@@ -227,7 +234,7 @@ fn benches(c: &mut Criterion) {
     g.sample_size(20)
         .measurement_time(Duration::from_secs(2))
         .warm_up_time(Duration::from_secs(1));
-    let budget = Budget::unlimited();
+    let budget = Budget::unlimited().with_threads(1);
     for (name, all) in [
         ("sweep_3600_core_summary", false),
         ("sweep_3600_all_groups", true),
@@ -237,6 +244,25 @@ fn benches(c: &mut Criterion) {
             b.iter(|| black_box(compute(&input, &budget).expect("computes")))
         });
     }
+    g.finish();
+    // The 10⁶-point sweep (core + summary), on one thread and on the job's two threads.
+    let mut g = c.benchmark_group("spatial_coupling_1e6");
+    g.sample_size(10)
+        .measurement_time(Duration::from_secs(2))
+        .warm_up_time(Duration::from_secs(1));
+    let input = SpatialCouplingInput::try_from(req(&sweep(1_000_000, false))).expect("valid");
+    for threads in [1usize, 2] {
+        let budget = Budget::unlimited().with_threads(threads);
+        g.bench_function(format!("sweep_core_summary_{threads}t"), |b| {
+            b.iter(|| black_box(compute(&input, &budget).expect("computes")))
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("spatial_coupling");
+    g.sample_size(20)
+        .measurement_time(Duration::from_secs(2))
+        .warm_up_time(Duration::from_secs(1));
+    let budget = Budget::unlimited().with_threads(1);
     let one = req(
         &json!({"theta1_deg": [30], "outputs": {"contact": true, "relative_1": true, "relative_2": true}}),
     );

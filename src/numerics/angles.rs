@@ -52,8 +52,10 @@ pub fn unwrap_in_place(angles: &mut [f64]) {
 /// angle is reduced modulo 360° first (exact in floating point), then to the nearest multiple of
 /// 90° plus a remainder in [−45°, 45°]. Zero results are `+0.0`.
 #[must_use]
+#[inline]
 pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
-    let d = deg % 360.0;
+    // `%` is exact and the identity below 360° in magnitude: skip its libm call there (sweeps).
+    let d = if deg.abs() < 360.0 { deg } else { deg % 360.0 };
     let q = (d / 90.0).round();
     let r = d - 90.0 * q;
     let (s, c) = if r == 0.0 {

@@ -593,3 +593,40 @@ fn rates_match_central_differences_of_positions() {
         );
     }
 }
+
+/// The answer to `body` with the job allowed `threads` threads, serialized (the elapsed time
+/// zeroed).
+fn answer_on(body: &Value, threads: usize) -> String {
+    use mechcalc::calc::spatial_coupling::{SpatialCouplingRequest, run};
+    use mechcalc::numerics::Budget;
+    let req: SpatialCouplingRequest = serde_json::from_value(body.clone()).expect("valid request");
+    let mut v = serde_json::to_value(
+        run(req, &Budget::unlimited().with_threads(threads)).expect("request succeeds"),
+    )
+    .expect("serializes");
+    v["report"]["elapsed_ms"] = json!(0);
+    serde_json::to_string(&v).expect("serializes")
+}
+
+/// Large sweeps are split over the job's threads in chunks; the answer (series and summary,
+/// reduced in chunk order) is byte for byte the same for any number of threads.
+#[test]
+fn sweep_answers_do_not_depend_on_thread_count() {
+    let bodies = [
+        json!({"alpha_deg": 15, "beta_deg": 5, "sweep": {"start_deg": -30, "end_deg": 750, "n_points": 100_001},
+               "outputs": {"summary": true}}),
+        json!({"alpha_deg": 30, "beta_deg": 10, "branch": -1, "a_m": 0.07, "omega1_rad_s": 3,
+               "sweep": {"start_deg": 0, "end_deg": 360, "n_points": 20_001},
+               "body3_points_m": [[0.01, 0.02, 0.03]],
+               "outputs": {"contact": true, "relative_1": true, "relative_2": true, "frames": true,
+                           "check": true, "summary": true, "series": true, "decimate": 7}}),
+        json!({"alpha_deg": 15, "beta_deg": 15, "sweep": {"start_deg": 0, "end_deg": 360, "n_points": 30_001},
+               "outputs": {"contact": true, "summary": false, "series": true, "decimate": 1000}}),
+    ];
+    for body in &bodies {
+        let one = answer_on(body, 1);
+        for threads in [2, 3] {
+            assert!(answer_on(body, threads) == one, "{threads} threads: {body}");
+        }
+    }
+}

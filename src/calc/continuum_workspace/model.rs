@@ -183,6 +183,16 @@ impl Model {
         }
     }
 
+    /// The same model with `base_steps` RK4 steps per rod at the base of the step rule (the
+    /// coarse discretisation of a continuation's intermediate points).
+    #[must_use]
+    pub fn with_base_steps(&self, base_steps: usize) -> Self {
+        Self {
+            base_steps,
+            ..self.clone()
+        }
+    }
+
     /// Number of rods `N`.
     #[must_use]
     pub fn n_rods(&self) -> usize {

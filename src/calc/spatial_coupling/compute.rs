@@ -222,6 +222,130 @@ impl SweepSummary {
     }
 }
 
+/// Relative margin of the squared-norm pre-test of [`NormRange`]: far above the rounding of a
+/// squared norm (3 ε) and of [`norm`] (two `hypot`s, under 2 ε), far below the change of |rB| or
+/// |vB| between two sweep points.
+const NORM_MARGIN: f64 = 1e-12;
+/// Squared norms in this range carry no underflow or overflow: the pre-test's error bound holds.
+const SAFE_SQUARE: std::ops::RangeInclusive<f64> = 1e-280..=1e280;
+/// Candidates held per end of a [`NormRange`] before their norms are taken.
+const CANDIDATES: usize = 16;
+
+/// Vectors whose squared norm is within [`NORM_MARGIN`] of the smallest (or largest) so far.
+#[derive(Clone, Copy)]
+struct Candidates {
+    len: usize,
+    v: [(f64, V3); CANDIDATES],
+}
+
+impl Candidates {
+    const EMPTY: Self = Self {
+        len: 0,
+        v: [(0.0, [0.0; 3]); CANDIDATES],
+    };
+
+    /// Keep only the candidates whose squared norm passes `keep`.
+    #[inline]
+    fn retain(&mut self, keep: impl Fn(f64) -> bool) {
+        let mut n = 0;
+        for i in 0..self.len {
+            if keep(self.v[i].0) {
+                self.v[n] = self.v[i];
+                n += 1;
+            }
+        }
+        self.len = n;
+    }
+
+    /// Take the norms of the candidates into `range` and forget them.
+    fn flush(&mut self, range: &mut [f64; 2]) {
+        for &(_, x) in &self.v[..self.len] {
+            widen(range, norm(x));
+        }
+        self.len = 0;
+    }
+
+    #[inline]
+    fn push(&mut self, s: f64, x: V3, range: &mut [f64; 2]) {
+        if self.len == CANDIDATES {
+            self.flush(range);
+        }
+        self.v[self.len] = (s, x);
+        self.len += 1;
+    }
+}
+
+/// [min, max] of [`norm`] over a run of vectors, with `norm` (two `hypot` calls) taken only where
+/// the squared norm comes within [`NORM_MARGIN`] of the extremes so far. The result is exactly
+/// the extremes of `norm` over every vector: a vector whose squared norm exceeds the smallest
+/// by more than the margin has a larger `norm` than that vector, whatever the rounding (and
+/// likewise at the top); vectors outside [`SAFE_SQUARE`] (or not finite) have their norm taken.
+struct NormRange {
+    /// Extremes of the norms taken.
+    range: [f64; 2],
+    /// Smallest and largest squared norm seen (in [`SAFE_SQUARE`]).
+    square: [f64; 2],
+    lo: Candidates,
+    hi: Candidates,
+}
+
+impl NormRange {
+    const EMPTY: Self = Self {
+        range: EMPTY,
+        square: EMPTY,
+        lo: Candidates::EMPTY,
+        hi: Candidates::EMPTY,
+    };
+
+    #[inline]
+    fn add(&mut self, x: V3) {
+        let s = dot(x, x);
+        if !SAFE_SQUARE.contains(&s) {
+            widen(&mut self.range, norm(x));
+            return;
+        }
+        if s <= self.square[0] * (1.0 + NORM_MARGIN) {
+            if s < self.square[0] {
+                self.square[0] = s;
+                let cut = s * (1.0 + NORM_MARGIN);
+                self.lo.retain(|c| c <= cut);
+            }
+            self.lo.push(s, x, &mut self.range);
+        }
+        if s >= self.square[1] * (1.0 - NORM_MARGIN) {
+            if s > self.square[1] {
+                self.square[1] = s;
+                let cut = s * (1.0 - NORM_MARGIN);
+                self.hi.retain(|c| c >= cut);
+            }
+            self.hi.push(s, x, &mut self.range);
+        }
+    }
+
+    /// The extremes of the norms of every vector added.
+    fn finish(mut self) -> [f64; 2] {
+        self.lo.flush(&mut self.range);
+        self.hi.flush(&mut self.range);
+        self.range
+    }
+}
+
+/// A chunk's summary, with |rB| and |vB| through their [`NormRange`]s.
+struct SummaryAcc {
+    summary: SweepSummary,
+    r_b: NormRange,
+    v_b: NormRange,
+}
+
+impl SummaryAcc {
+    fn finish(self) -> SweepSummary {
+        let mut s = self.summary;
+        join(&mut s.r_b, self.r_b.finish());
+        join(&mut s.v_b, self.v_b.finish());
+        s
+    }
+}
+
 /// Result of a sweep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepOut {
@@ -287,7 +411,7 @@ impl Ctx<'_> {
             theta2_deg: if continuous {
                 self.cpl.theta2_continuous_deg(theta1_deg, &core)
             } else {
-                wrap_360(core.theta2.to_degrees())
+                wrap_360(self.cpl.theta2(&core).to_degrees())
             },
             i12: core.i12,
             di12: core.di12,
@@ -358,6 +482,41 @@ impl Ctx<'_> {
             }
         }
         Ok(p)
+    }
+
+    /// The summary's quantities at θ1 \[deg\] added to `s` (a sweep point that is not kept): the
+    /// same arithmetic as [`Ctx::eval`] with `continuous`, without θ2, the rates the summary does
+    /// not read, or a [`PointKin`]. False where B is at infinity.
+    #[inline]
+    fn add_to_summary(&self, theta1_deg: f64, acc: &mut SummaryAcc) -> bool {
+        let cpl = &self.cpl;
+        let core = cpl.core(theta1_deg);
+        let Some(b) = cpl.contact(core.s1, core.c1) else {
+            return false;
+        };
+        let (a, w) = (self.a, self.omega1);
+        acc.r_b.add(b.r.map(|x| a * x));
+        acc.v_b.add(b.dr.map(|x| a * w * x));
+        let s = &mut acc.summary;
+        s.n += 1;
+        widen(&mut s.i12, core.i12);
+        widen(&mut s.i12_abs, core.i12.abs());
+        widen(&mut s.d_abs, b.d.abs());
+        let k1 = cpl.relative_1(&core, &b);
+        widen(
+            &mut s.theta31,
+            about_centre(k1.theta, cpl.theta31_centre()).to_degrees(),
+        );
+        s.omega31 = s.omega31.max((w * k1.omega).abs());
+        let k2 = cpl.relative_2(&core, &b);
+        widen(
+            &mut s.theta32,
+            about_centre(k2.theta, cpl.theta32_centre()).to_degrees(),
+        );
+        widen(&mut s.x2, a * k2.x);
+        widen(&mut s.z2, a * k2.z);
+        s.omega32 = s.omega32.max((w * k2.omega).abs());
+        true
     }
 
     fn check(&self, f: &FrameKin, b: &ContactKin) -> CheckOut {
@@ -565,33 +724,44 @@ fn sweep(
             return None;
         }
         budget.progress((done_before + lo) as f64 / total.max(1) as f64, None);
-        let mut summary = SweepSummary::default();
+        let mut acc = SummaryAcc {
+            summary: SweepSummary::default(),
+            r_b: NormRange::EMPTY,
+            v_b: NormRange::EMPTY,
+        };
         let mut kept = Vec::new();
         for k in lo..hi {
             let t = s.theta1_deg(k);
+            if !keep(k) {
+                // Only the summary reads this point; without one, only its |rB| for the largest
+                // radius of the answer (which the summary's extremes carry), when B is asked.
+                if input.summary || input.groups.contact {
+                    // The plane passed the validity test: B is finite at every θ1.
+                    ctx.add_to_summary(t, &mut acc);
+                }
+                continue;
+            }
             // The plane passed the validity test: B is finite at every θ1.
             let Ok(p) = ctx.eval(t, need, true) else {
                 continue;
             };
-            summary.add(&p);
-            if keep(k) {
-                // The summary needed B and both relative motions; the series carries only what
-                // was asked.
-                let g = input.groups;
-                let mut p = p;
-                if !g.contact {
-                    p.contact = None;
-                }
-                if !g.relative_1 {
-                    p.rel1 = None;
-                }
-                if !g.relative_2 {
-                    p.rel2 = None;
-                }
-                kept.push(p);
+            acc.summary.add(&p);
+            // The summary needed B and both relative motions; the series carries only what was
+            // asked.
+            let g = input.groups;
+            let mut p = p;
+            if !g.contact {
+                p.contact = None;
             }
+            if !g.relative_1 {
+                p.rel1 = None;
+            }
+            if !g.relative_2 {
+                p.rel2 = None;
+            }
+            kept.push(p);
         }
-        Some((summary, kept))
+        Some((acc.finish(), kept))
     });
     let mut summary = SweepSummary::default();
     let mut series = input.series.then(Vec::new);
@@ -636,6 +806,69 @@ fn first_in_first_turn(v: &mut [PointKin]) {
         }
         if let Some(r) = &mut p.rel2 {
             r.theta_deg = shift(r.theta_deg, o32);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`NormRange`] gives exactly the extremes of `norm` taken at every vector: smooth runs,
+    /// constant norms (every vector a candidate), ties within rounding, tiny and huge vectors.
+    #[test]
+    fn norm_range_is_exact() {
+        let mut runs: Vec<Vec<V3>> = Vec::new();
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut rnd = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for scale in [1.0, 1e-150, 1e145, 3.7e-3] {
+            runs.push(
+                (0..5000)
+                    .map(|_| [rnd(), rnd(), rnd()].map(|c| c * scale))
+                    .collect(),
+            );
+            runs.push(
+                (0..5000)
+                    .map(|k| {
+                        let t = k as f64 * 1e-3;
+                        [t.cos() * scale, t.sin() * scale, 0.5 * scale]
+                    })
+                    .collect(),
+            );
+            // Norms equal up to rounding: every vector stays a candidate.
+            runs.push(
+                (0..5000)
+                    .map(|k| {
+                        let t = k as f64 * 0.37;
+                        [t.cos() * scale, t.sin() * scale, 0.0]
+                    })
+                    .collect(),
+            );
+        }
+        runs.push(vec![
+            [0.0; 3],
+            [f64::NAN, 1.0, 0.0],
+            [f64::INFINITY, 0.0, 0.0],
+            [1.0, 2.0, 3.0],
+        ]);
+        for run in &runs {
+            let mut want = EMPTY;
+            let mut r = NormRange::EMPTY;
+            for &v in run {
+                widen(&mut want, norm(v));
+                r.add(v);
+            }
+            let got = r.finish();
+            assert_eq!(
+                got.map(f64::to_bits),
+                want.map(f64::to_bits),
+                "{got:?} {want:?}"
+            );
         }
     }
 }

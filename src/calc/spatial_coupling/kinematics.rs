@@ -55,8 +55,6 @@ pub struct Core {
     pub c2: f64,
     /// ρ = √(s1² + cos²2α·c1²).
     pub rho: f64,
-    /// θ2 = atan2(σ cos2α c1, σ s1) \[rad\], wrapped to [0, 2π).
-    pub theta2: f64,
     /// i12 = dθ2/dθ1.
     pub i12: f64,
     /// di12/dθ1 [1/rad].
@@ -208,13 +206,16 @@ impl Coupling {
 
     /// Core at θ1 given in degrees.
     #[must_use]
+    #[inline]
     pub fn core(&self, theta1_deg: f64) -> Core {
         let (s1, c1) = sin_cos_deg(theta1_deg);
         self.core_sc(s1, c1)
     }
 
-    /// Core from sin θ1, cos θ1 (spec §3.2, with the cancellation-free denominator).
+    /// Core from sin θ1, cos θ1 (spec §3.2, with the cancellation-free denominator). θ2 itself
+    /// is [`Coupling::theta2`] (an `atan2` that sweeps need only at the points they keep).
     #[must_use]
+    #[inline]
     pub fn core_sc(&self, s1: f64, c1: f64) -> Core {
         let c = self.c2a;
         let den = s1 * s1 + c * c * c1 * c1;
@@ -229,20 +230,28 @@ impl Coupling {
             s2,
             c2,
             rho,
-            theta2: wrap_2pi(y.atan2(x)),
             i12,
             di12,
         }
     }
 
+    /// θ2 = atan2(σ cos2α c1, σ s1) \[rad\], wrapped to [0, 2π).
+    #[must_use]
+    pub fn theta2(&self, core: &Core) -> f64 {
+        let (y, x) = (self.sigma * self.c2a * core.c1, self.sigma * core.s1);
+        wrap_2pi(y.atan2(x))
+    }
+
     /// D(θ1).
     #[must_use]
+    #[inline]
     pub fn d(&self, s1: f64, c1: f64) -> f64 {
         self.d0 * c1 * c1 + self.d90 * s1 * s1
     }
 
     /// Whether D is zero to round-off at this θ1 (B at infinity, spec §7.2).
     #[must_use]
+    #[inline]
     pub fn d_is_zero(&self, d: f64) -> bool {
         d.abs() <= D_ZERO_ULPS * f64::EPSILON * self.d_max()
     }
@@ -250,6 +259,7 @@ impl Coupling {
     /// Contact point per unit a (branch-free closed form of spec §3.3), or `None` where D is zero
     /// to round-off.
     #[must_use]
+    #[inline]
     pub fn contact(&self, s1: f64, c1: f64) -> Option<ContactKin> {
         let d = self.d(s1, c1);
         if self.d_is_zero(d) {
@@ -299,6 +309,7 @@ impl Coupling {
     /// Motion relative to shaft 1 (spec §3.4): frame-rotation terms vanish because
     /// (rB − A1)·j1 = 0, so d/dθ1 of (rB − A1)·i1 is (drB/dθ1)·i1.
     #[must_use]
+    #[inline]
     pub fn relative_1(&self, core: &Core, b: &ContactKin) -> RelKin {
         let (sa, ca, s1, c1) = (self.sa, self.ca, core.s1, core.c1);
         let i1 = [c1, sa * s1, ca * s1];
@@ -318,6 +329,7 @@ impl Coupling {
 
     /// Motion relative to shaft 2 (spec §3.4).
     #[must_use]
+    #[inline]
     pub fn relative_2(&self, core: &Core, b: &ContactKin) -> RelKin {
         let (sa, ca, s2, c2) = (self.sa, self.ca, core.s2, core.c2);
         let i2 = [c2, sa * s2, -ca * s2];
