@@ -8,7 +8,7 @@ use crate::calc::{CalcFailure, Validator};
 
 use super::error::{DEADLINE_RULE, EIGEN_NOT_CONVERGED_RULE, NON_FINITE_RULE};
 use super::wire::{
-    self, ControlMode, ExcitationIn, ExcitationType, GridIn, HarmonicIn, TimeResponseIn,
+    self, ExcitationIn, ExcitationType, GridIn, HarmonicIn, TimeResponseIn,
     VibrationAbsorberRequest,
 };
 
@@ -59,18 +59,8 @@ crate::calc::rules::cross_rules! {
     listed DEADLINE_RULE;
 }
 
-/// Configuration (which states the model has).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Config {
-    /// No absorber.
-    None,
-    /// Coil open.
-    Passive,
-    /// Coil shorted.
-    PassiveShorted,
-    /// PD control.
-    Active,
-}
+/// Configuration (which states the model has): the request's `control.mode`.
+pub use super::wire::ControlMode as Config;
 
 /// A frequency given in Hz or as a bare-beam mode index.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -550,12 +540,7 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
         };
 
         let c = &req.control;
-        let config = match c.mode {
-            ControlMode::None => Config::None,
-            ControlMode::Passive => Config::Passive,
-            ControlMode::PassiveShorted => Config::PassiveShorted,
-            ControlMode::Active => Config::Active,
-        };
+        let config = c.mode;
         if config == Config::Active {
             v.ensure_rule(
                 actuator.kc != 0.0,
