@@ -199,6 +199,12 @@ fn same_length(v: &mut Validator, ptr: &str, ys: &[f64], n: usize, axis: &str) -
     })
 }
 
+/// An axis `{base}/{x}` (strictly increasing) and the list `{base}/{y}` paired with it.
+fn paired(v: &mut Validator, base: &str, (x, xs): (&str, &[f64]), (y, ys): (&str, &[f64])) {
+    axis(v, &format!("{base}/{x}"), xs);
+    same_length(v, &format!("{base}/{y}"), ys, xs.len(), x);
+}
+
 /// A table `[rows][cols]` (its values are checked at the door).
 fn table(v: &mut Validator, ptr: &str, t: &[Vec<f64>], (rows, cols): (usize, usize)) -> bool {
     if t.len() != rows {
@@ -298,8 +304,7 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
             let cap = b.capacity_kwh.unwrap_or(256.0);
             let (soc_t, ocv_t) = match (&b.ocv_soc, &b.ocv_v) {
                 (Some(s), Some(o)) => {
-                    axis(v, "/battery/ocv_soc", s);
-                    same_length(v, "/battery/ocv_v", o, s.len(), "ocv_soc");
+                    paired(v, "/battery", ("ocv_soc", s), ("ocv_v", o));
                     (s.clone(), o.clone())
                 }
                 _ => {
@@ -410,13 +415,11 @@ fn envelope(
                 &p,
                 || "give either envelope or t_peak_nm/p_peak_w, not both".to_owned(),
             );
-            axis(v, &format!("{p}/speed_rpm"), &t.speed_rpm);
-            same_length(
+            paired(
                 v,
-                &format!("{p}/t_max_nm"),
-                &t.t_max_nm,
-                t.speed_rpm.len(),
-                "speed_rpm",
+                &p,
+                ("speed_rpm", &t.speed_rpm),
+                ("t_max_nm", &t.t_max_nm),
             );
             Envelope::Table {
                 speed: t.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
@@ -456,14 +459,7 @@ fn ac_factor(v: &mut Validator, p: &str, spec: Option<&AcFactorSpec>) -> AcFacto
     match spec {
         None | Some(AcFactorSpec::NoAc(_)) => AcFactor::None,
         Some(AcFactorSpec::Table(t)) => {
-            axis(v, &format!("{ap}/freq_hz"), &t.freq_hz);
-            same_length(
-                v,
-                &format!("{ap}/k_ac"),
-                &t.k_ac,
-                t.freq_hz.len(),
-                "freq_hz",
-            );
+            paired(v, &ap, ("freq_hz", &t.freq_hz), ("k_ac", &t.k_ac));
             AcFactor::Table {
                 freq_hz: t.freq_hz.clone(),
                 k_ac: t.k_ac.clone(),
