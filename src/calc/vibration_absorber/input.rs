@@ -161,34 +161,31 @@ pub enum Forcing {
     None,
 }
 
-/// A frequency grid.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Grid {
-    /// \[Hz\].
-    pub f_min: f64,
-    /// \[Hz\].
-    pub f_max: f64,
-    /// Points.
-    pub n: usize,
-    /// Log spacing.
-    pub log: bool,
-}
+/// A frequency grid: the request's (its ranges checked at the door, its order here).
+pub use super::wire::GridIn as Grid;
 
 impl Grid {
+    /// Points (at least 1 at the door).
+    #[must_use]
+    pub fn n(&self) -> usize {
+        self.n_points.max(1) as usize
+    }
+
     /// The frequencies \[Hz\].
     #[must_use]
     pub fn frequencies(&self) -> Vec<f64> {
-        if self.n == 1 {
-            return vec![self.f_min];
+        let (n, f_min, f_max) = (self.n(), self.f_min_hz, self.f_max_hz);
+        if n == 1 {
+            return vec![f_min];
         }
-        let last = (self.n - 1) as f64;
-        (0..self.n)
+        let last = (n - 1) as f64;
+        (0..n)
             .map(|i| {
                 let t = i as f64 / last;
                 if self.log {
-                    self.f_min * (self.f_max / self.f_min).powf(t)
+                    f_min * (f_max / f_min).powf(t)
                 } else {
-                    self.f_min + (self.f_max - self.f_min) * t
+                    f_min + (f_max - f_min) * t
                 }
             })
             .collect()
@@ -318,12 +315,7 @@ fn grid(v: &mut Validator, base: &str, g: &GridIn) -> Grid {
             g.f_min_hz, g.f_max_hz
         )
     });
-    Grid {
-        f_min: g.f_min_hz,
-        f_max: g.f_max_hz,
-        n: g.n_points.max(1) as usize,
-        log: g.log,
-    }
+    g.clone()
 }
 
 fn time(v: &mut Validator, t: &TimeResponseIn, length: f64) -> TimeRequest {
