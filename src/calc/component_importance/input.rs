@@ -15,7 +15,7 @@ use super::graph::{Digraph, GraphError};
 use super::structure::LevelMode;
 use super::wire::{
     ComponentImportanceRequest, ComponentSpec, ConstantWeights, DEFAULT_MAX_SIMPLE_PATHS,
-    DEFAULT_O_OUT, DEFAULT_PATH_CAP, DEFAULT_Q_IN, FailureMode, Options,
+    DEFAULT_O_OUT, DEFAULT_PATH_CAP, DEFAULT_Q_IN, FailureMode, Options, Outputs,
 };
 pub use super::wire::{MAX_COMPONENTS, MAX_ID_CHARS, MAX_TIMES, MIN_COMPONENTS};
 use crate::calc::{CalcFailure, Validator};
@@ -131,8 +131,29 @@ pub use super::wire::PathMethod as Paths;
 /// Which edge betweenness is used: the request's `options.betweenness`.
 pub use super::wire::BetweennessMode as Betweenness;
 
-/// The optional output groups asked for: the request's `outputs`.
-pub use super::wire::Outputs as OutputFlags;
+/// The optional output groups asked for (the request's `outputs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputFlags {
+    /// Time-independent matrices.
+    pub matrices: bool,
+    /// The indices and their weights per time.
+    pub indices: bool,
+    /// F, λ and RI per time.
+    pub reliability: bool,
+    /// The five centralities and their Kendall τ-b against CI.
+    pub centralities: bool,
+}
+
+impl From<Outputs> for OutputFlags {
+    fn from(o: Outputs) -> Self {
+        Self {
+            matrices: o.matrices,
+            indices: o.indices,
+            reliability: o.reliability,
+            centralities: o.centralities,
+        }
+    }
+}
 
 /// A non-fatal finding of validation or computation (a response warning).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -547,7 +568,7 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
             levels: o.levels,
             betweenness: o.betweenness,
             max_simple_paths,
-            outputs: req.outputs,
+            outputs: req.outputs.into(),
             warnings: data.warnings,
         })
     }
