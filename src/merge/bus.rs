@@ -123,7 +123,7 @@ fn comparison(results: &[Value], request: Option<&Value>) -> Result<Option<Value
                 })
         })
         .collect::<Result<_, _>>()?;
-    let weights = &input.options.weights;
+    let weights = &input.weights;
     let c = compare(&fe, &energy, n_m, n_c, weights);
     let wire = crate::calc::bus_fuel_economy::output::comparison_wire(&ids, cycles, weights, &c);
     serde_json::to_value(wire)

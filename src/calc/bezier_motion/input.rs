@@ -11,10 +11,9 @@ use super::error::{
 use super::history::HistorySpec;
 use super::optimize::Objective;
 use super::plant::Plant;
-use super::shaper::{Baseline, Shaper, ShaperSpec};
+use super::shaper::ShaperSpec;
 use super::wire::{
-    self, BaselineIn, BezierMotionRequest, FREE_P, GAMMA_OVER_PHI_MAX, MAX_ACCEL_DEGREE, ORDER_M,
-    ObjectiveIn, ShaperIn,
+    self, BezierMotionRequest, FREE_P, GAMMA_OVER_PHI_MAX, MAX_ACCEL_DEGREE, ORDER_M, ObjectiveIn,
 };
 use crate::calc::rules::door_skipped;
 use crate::calc::{CalcFailure, Validator};
@@ -230,20 +229,8 @@ fn shaper_spec(sc: &wire::ShaperComparisonIn, v: &mut Validator) -> ShaperSpec {
         }
     }
     ShaperSpec {
-        baseline: match sc.baseline {
-            BaselineIn::Trapezoid => Baseline::Trapezoid,
-            BaselineIn::Cycloidal => Baseline::Cycloidal,
-        },
-        shapers: sc
-            .shapers
-            .iter()
-            .map(|s| match s {
-                ShaperIn::None => Shaper::None,
-                ShaperIn::Zv => Shaper::Zv,
-                ShaperIn::Zvd => Shaper::Zvd,
-                ShaperIn::Ei => Shaper::Ei,
-            })
-            .collect(),
+        baseline: sc.baseline,
+        shapers: sc.shapers.clone(),
         ei_tolerance: sc.ei_tolerance,
     }
 }

@@ -7,11 +7,11 @@ use super::history::History;
 use super::input::BezierInput;
 use super::optimize::Objective;
 use super::plant::{EndStateMethod, Plant};
-use super::shaper::{Baseline, Comparison, Shaper};
+use super::shaper::{Comparison, Shaper};
 use super::wire::{
-    BaselineIn, BezierMotionResponse, BezierRowOut, EndState, FactorEnergyOut, HistoryOut,
-    ImpulseOut, KinematicsOut, LawOut, MethodOut, ObjectiveIn, OptimizerOut, ReferenceOut,
-    ResidualOut, SensitivityRow, ShaperComparisonOut, ShaperIn, ShaperRowOut, SystemOut,
+    BezierMotionResponse, BezierRowOut, EndState, FactorEnergyOut, HistoryOut, ImpulseOut,
+    KinematicsOut, LawOut, MethodOut, ObjectiveIn, OptimizerOut, ReferenceOut, ResidualOut,
+    SensitivityRow, ShaperComparisonOut, ShaperRowOut, SystemOut,
 };
 use crate::calc::common::{ResponseSize, Warning};
 use crate::numerics::{Budget, SolverReport, StopReason};
@@ -322,10 +322,7 @@ fn factor_energies(s: Option<&Vec<(f64, f64)>>) -> Option<Vec<FactorEnergyOut>> 
 
 fn comparison_out(c: &Comparison) -> ShaperComparisonOut {
     ShaperComparisonOut {
-        baseline: match c.spec.baseline {
-            Baseline::Trapezoid => BaselineIn::Trapezoid,
-            Baseline::Cycloidal => BaselineIn::Cycloidal,
-        },
+        baseline: c.spec.baseline,
         ei_tolerance: c.spec.ei_tolerance,
         damped_period_s: c.td,
         rows: c
@@ -333,12 +330,7 @@ fn comparison_out(c: &Comparison) -> ShaperComparisonOut {
             .iter()
             .map(|r| {
                 r.as_ref().map(|r| ShaperRowOut {
-                    shaper: match r.shaper {
-                        Shaper::None => ShaperIn::None,
-                        Shaper::Zv => ShaperIn::Zv,
-                        Shaper::Zvd => ShaperIn::Zvd,
-                        Shaper::Ei => ShaperIn::Ei,
-                    },
+                    shaper: r.shaper,
                     baseline_time_s: r.motion.t0,
                     e_t_j: r.energy,
                     peak_accel_rad_s2: r.peak_accel,

@@ -31,27 +31,11 @@ use crate::numerics::linalg::expm;
 /// most one baseline period: 5 suffice).
 const QUARTER_POINTS_MAX: u32 = 8;
 
-/// An input shaper (impulse train) of the comparison.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Shaper {
-    /// The unshaped baseline: one unit impulse at 0.
-    None,
-    /// Zero vibration: two impulses.
-    Zv,
-    /// Zero vibration and derivative: three impulses.
-    Zvd,
-    /// Extra-insensitive: three impulses with tolerance `V`.
-    Ei,
-}
+/// An input shaper (impulse train) of the comparison: the request's shaper.
+pub use super::wire::ShaperIn as Shaper;
 
-/// The baseline move the shapers filter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Baseline {
-    /// Equal thirds: `+a0`, coast, `−a0`, `a0 = 4.5 Phi/T0²`.
-    Trapezoid,
-    /// `φ'' = (2π Phi/T0²) sin(2πt/T0)`.
-    Cycloidal,
-}
+/// The baseline move the shapers filter: the request's baseline.
+pub use super::wire::BaselineIn as Baseline;
 
 /// What the comparison computes.
 #[derive(Debug, Clone, PartialEq)]

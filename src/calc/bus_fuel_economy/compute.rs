@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use super::compare::{desirability, overall_desirability};
 use super::cycles::{Cycle, discretise};
 use super::error::BusFuelEconomyError;
-use super::input::{BusFuelEconomyInput, MotorEval};
+use super::input::{BusFuelEconomyInput, MotorEval, OutputKind};
 use super::ipmsm::{Currents, Ipmsm, LossSplit, rad_s_to_rpm, rpm_to_rad_s};
 use super::motor::{
     IpmsmMap, MotorEvaluator, MotorInput, MotorKind, build_ipmsm_map, grid_axes, grid_size,
@@ -312,21 +312,21 @@ pub fn compute(
     let intervals: Vec<Vec<_>> = input
         .cycles
         .iter()
-        .map(|c| discretise(c, o.substeps, input.grade))
+        .map(|c| discretise(c, o.k(), input.grade))
         .collect();
     let settings = SimSettings {
         mode: o.mode,
-        convention: o.convention,
+        convention: o.power_convention,
         regen: o.regen,
         regen_limit: o.regen_limit,
         inverter_eff: input.inverter_eff,
-        breakdown: o.breakdown,
-        histogram: o.histogram,
-        traces: o.traces,
+        breakdown: o.has(OutputKind::LossBreakdown),
+        histogram: o.has(OutputKind::OpHistogram),
+        traces: o.has(OutputKind::Traces),
     };
     let mut results = Vec::with_capacity(input.motors.len() * input.cycles.len());
     let mut motor_warnings = Vec::with_capacity(input.motors.len());
-    let mut maps = o.efficiency_map.then(Vec::new);
+    let mut maps = o.has(OutputKind::EfficiencyMap).then(Vec::new);
     let (mut n_iv, mut n_eval) = (0u64, 0u64);
     for (mi, m) in input.motors.iter().enumerate() {
         let mut warnings = m.warnings.clone();
@@ -336,9 +336,9 @@ pub fn compute(
             motor_warnings.push(warnings);
             continue;
         }
-        let ipmsm_map: Option<IpmsmMap> = match (&m.kind, o.motor_eval) {
+        let ipmsm_map: Option<IpmsmMap> = match (&m.kind, o.eval()) {
             (MotorKind::Ipmsm(im), MotorEval::LossMap) => {
-                let map = ipmsm_loss_map(m, im, o.grid, budget)?;
+                let map = ipmsm_loss_map(m, im, o.loss_map_grid.steps(), budget)?;
                 n_eval += map.evaluations;
                 if map.fallbacks > 0 {
                     warnings.push(format!(
@@ -375,15 +375,15 @@ pub fn compute(
             )?;
             n_iv += sim.n_intervals;
             n_eval += sim.evaluations;
-            let histogram = if o.histogram {
-                Some(histogram(&sim.hist_samples, o.hist_bins)?)
+            let histogram = if o.has(OutputKind::OpHistogram) {
+                Some(histogram(&sim.hist_samples, o.hist_bins())?)
             } else {
                 None
             };
             results.push(run_result(mi, ci, c, sim, histogram));
         }
         if let Some(maps) = maps.as_mut().filter(|_| pairs.contains(&(mi * n_c))) {
-            let md = motor_map(m, o.grid, false, budget)?;
+            let md = motor_map(m, o.loss_map_grid.steps(), false, budget)?;
             n_eval += md.evaluations;
             maps.push((mi, md));
         }
@@ -396,7 +396,7 @@ pub fn compute(
             .collect();
         // f_i = energy drawn over cycle i [kWh].
         let energy: Vec<f64> = results.iter().map(|r| r.sim.e_in / 3.6e6).collect();
-        compare(&fe, &energy, input.motors.len(), n_c, &o.weights)
+        compare(&fe, &energy, input.motors.len(), n_c, &input.weights)
     });
     Ok(BusFuelEconomyOutput {
         results,

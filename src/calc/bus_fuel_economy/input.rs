@@ -13,12 +13,11 @@ use super::error::{
 use super::ipmsm::{Ipmsm, IpmsmParams, psi_from_back_emf, rpm_to_rad_s};
 use super::maps::{Envelope, Grid2, efficiency_to_loss};
 use super::motor::{MotorInput, MotorKind};
-use super::sim::{Mode, PowerConvention, Vehicle};
+use super::sim::Vehicle;
 use super::wire as w;
 use super::wire::{
     AcFactorSpec, BatteryModel, BatterySpec, BusFuelEconomyRequest, CycleSpec, EfficiencyMapMotor,
-    EnvelopeTable, GridSpec, IpmsmMotor, LossMapMotor, MotorMapRequest, MotorSpec, OutputKind,
-    VehicleSpec,
+    EnvelopeTable, GridSpec, IpmsmMotor, LossMapMotor, MotorMapRequest, MotorSpec, VehicleSpec,
 };
 pub use super::wire::{MAX_CYCLE_SAMPLES, MAX_CYCLES, MAX_MOTORS};
 use crate::calc::common::{RESPONSE_TOO_LARGE_RULE, SHARD_INDEX_BELOW_COUNT};
@@ -121,35 +120,36 @@ const DEFAULT_N_MAX: f64 = 5200.0;
 /// How an `ipmsm` motor's loss is evaluated: the request's `motor_eval`.
 pub use super::wire::MotorEval;
 
-/// Validated options.
-#[derive(Debug, Clone)]
-pub struct Options {
-    /// Envelope policy.
-    pub mode: Mode,
-    /// Power convention.
-    pub convention: PowerConvention,
-    /// Substeps k.
-    pub substeps: usize,
-    /// Regeneration allowed.
-    pub regen: bool,
-    /// Regeneration limited by the envelope.
-    pub regen_limit: bool,
-    /// ipmsm evaluation.
-    pub motor_eval: MotorEval,
-    /// Map grid: speed step \[rpm\], torque step [N·m].
-    pub grid: (f64, f64),
-    /// Loss breakdown requested.
-    pub breakdown: bool,
-    /// Histogram requested.
-    pub histogram: bool,
-    /// Traces requested.
-    pub traces: bool,
-    /// Efficiency maps requested.
-    pub efficiency_map: bool,
+/// The request's options (their ranges are checked at the door).
+pub use super::wire::{OptionsSpec as Options, OutputKind};
+
+impl Options {
+    /// Substeps k (in [1, 32] at the door).
+    #[must_use]
+    pub fn k(&self) -> usize {
+        usize::try_from(self.substeps).unwrap_or(1)
+    }
+
+    /// Whether the output `kind` was requested.
+    #[must_use]
+    pub fn has(&self, kind: OutputKind) -> bool {
+        self.outputs.contains(&kind)
+    }
+
+    /// How an ipmsm's loss is evaluated (default: a precomputed loss map).
+    #[must_use]
+    pub fn eval(&self) -> MotorEval {
+        self.motor_eval.unwrap_or(MotorEval::LossMap)
+    }
+
     /// Histogram bins: speed \[rpm\], torque [N·m].
-    pub hist_bins: (f64, f64),
-    /// Normalised desirability weights per cycle.
-    pub weights: Vec<f64>,
+    #[must_use]
+    pub const fn hist_bins(&self) -> (f64, f64) {
+        (
+            self.op_histogram.speed_bin_rpm,
+            self.op_histogram.torque_bin_nm,
+        )
+    }
 }
 
 /// A validated request in SI units.
@@ -169,6 +169,8 @@ pub struct BusFuelEconomyInput {
     pub motors: Vec<MotorInput>,
     /// Options.
     pub options: Options,
+    /// Normalised desirability weights per cycle.
+    pub weights: Vec<f64>,
     /// The block of motor × cycle pairs to simulate (all when `None`).
     pub shard: Option<crate::calc::common::Shard>,
 }
@@ -195,6 +197,12 @@ fn same_length(v: &mut Validator, ptr: &str, ys: &[f64], n: usize, axis: &str) -
     v.ensure_rule(ys.len() == n, &LENGTH_MISMATCH, ptr, || {
         format!("must have {n} values like {axis}, got {}", ys.len())
     })
+}
+
+/// An axis `{base}/{x}` (strictly increasing) and the list `{base}/{y}` paired with it.
+fn paired(v: &mut Validator, base: &str, (x, xs): (&str, &[f64]), (y, ys): (&str, &[f64])) {
+    axis(v, &format!("{base}/{x}"), xs);
+    same_length(v, &format!("{base}/{y}"), ys, xs.len(), x);
 }
 
 /// A table `[rows][cols]` (its values are checked at the door).
@@ -296,8 +304,7 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
             let cap = b.capacity_kwh.unwrap_or(256.0);
             let (soc_t, ocv_t) = match (&b.ocv_soc, &b.ocv_v) {
                 (Some(s), Some(o)) => {
-                    axis(v, "/battery/ocv_soc", s);
-                    same_length(v, "/battery/ocv_v", o, s.len(), "ocv_soc");
+                    paired(v, "/battery", ("ocv_soc", s), ("ocv_v", o));
                     (s.clone(), o.clone())
                 }
                 _ => {
@@ -408,13 +415,11 @@ fn envelope(
                 &p,
                 || "give either envelope or t_peak_nm/p_peak_w, not both".to_owned(),
             );
-            axis(v, &format!("{p}/speed_rpm"), &t.speed_rpm);
-            same_length(
+            paired(
                 v,
-                &format!("{p}/t_max_nm"),
-                &t.t_max_nm,
-                t.speed_rpm.len(),
-                "speed_rpm",
+                &p,
+                ("speed_rpm", &t.speed_rpm),
+                ("t_max_nm", &t.t_max_nm),
             );
             Envelope::Table {
                 speed: t.speed_rpm.iter().map(|&n| rpm_to_rad_s(n)).collect(),
@@ -454,14 +459,7 @@ fn ac_factor(v: &mut Validator, p: &str, spec: Option<&AcFactorSpec>) -> AcFacto
     match spec {
         None | Some(AcFactorSpec::NoAc(_)) => AcFactor::None,
         Some(AcFactorSpec::Table(t)) => {
-            axis(v, &format!("{ap}/freq_hz"), &t.freq_hz);
-            same_length(
-                v,
-                &format!("{ap}/k_ac"),
-                &t.k_ac,
-                t.freq_hz.len(),
-                "freq_hz",
-            );
+            paired(v, &ap, ("freq_hz", &t.freq_hz), ("k_ac", &t.k_ac));
             AcFactor::Table {
                 freq_hz: t.freq_hz.clone(),
                 k_ac: t.k_ac.clone(),
@@ -675,9 +673,12 @@ fn motor(v: &mut Validator, i: usize, spec: &MotorSpec) -> MotorInput {
     }
 }
 
-/// A map grid: speed step \[rpm\], torque step [N·m] (ranges checked at the door).
-fn grid(g: &GridSpec) -> (f64, f64) {
-    (g.speed_step_rpm, g.torque_step_nm)
+impl GridSpec {
+    /// The map grid: speed step \[rpm\], torque step [N·m] (ranges checked at the door).
+    #[must_use]
+    pub const fn steps(&self) -> (f64, f64) {
+        (self.speed_step_rpm, self.torque_step_nm)
+    }
 }
 
 /// A validated motor-map request: the motor, the grid and whether to return the components.
@@ -707,7 +708,7 @@ impl TryFrom<MotorMapRequest> for MotorMapInput {
         })?;
         Ok(Self {
             motor: m,
-            grid: grid(&req.grid),
+            grid: req.grid.steps(),
             include_components: req.include_components,
         })
     }
@@ -843,9 +844,7 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
         }
 
         let o = &req.options;
-        // substeps ∈ [1, 32] (the door).
-        let substeps = usize::try_from(o.substeps).unwrap_or(1);
-        let total: usize = cycles_ok.iter().map(|(_, c)| c.intervals(substeps)).sum();
+        let total: usize = cycles_ok.iter().map(|(_, c)| c.intervals(o.k())).sum();
         if total > MAX_TOTAL_INTERVALS {
             return Err(TOO_MANY_SAMPLES.fail(
                 "/options/substeps",
@@ -854,7 +853,6 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
                 ),
             ));
         }
-        let has = |k: OutputKind| o.outputs.contains(&k);
         Ok(Self {
             vehicle: veh,
             grade: req.vehicle.grade,
@@ -862,21 +860,8 @@ impl TryFrom<&BusFuelEconomyRequest> for BusFuelEconomyInput {
             battery: bat,
             cycles: cycles_ok.into_iter().map(|(_, c)| c).collect(),
             motors,
-            options: Options {
-                mode: o.mode,
-                convention: o.power_convention,
-                substeps,
-                regen: o.regen,
-                regen_limit: o.regen_limit,
-                motor_eval: o.motor_eval.map_or(MotorEval::LossMap, MotorEval::from),
-                grid: grid(&o.loss_map_grid),
-                breakdown: has(OutputKind::LossBreakdown),
-                histogram: has(OutputKind::OpHistogram),
-                traces: has(OutputKind::Traces),
-                efficiency_map: has(OutputKind::EfficiencyMap),
-                hist_bins: (o.op_histogram.speed_bin_rpm, o.op_histogram.torque_bin_nm),
-                weights,
-            },
+            options: o.clone(),
+            weights,
             shard,
         })
     }

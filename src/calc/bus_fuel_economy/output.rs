@@ -9,7 +9,7 @@ use super::compute::{
     self, BusFuelEconomyOutput, ComparisonData, Histogram, MapData, RunResult, fuel_economy,
 };
 use super::cycles;
-use super::input::BusFuelEconomyInput;
+use super::input::{BusFuelEconomyInput, OutputKind};
 use super::ipmsm::{self, rad_s_to_rpm};
 use super::motor::{self, MotorInput};
 use super::sim::{Mode, SimOutcome};
@@ -104,7 +104,9 @@ fn result_wire(
     let mut warnings = sim_warnings(o.mode, &r, fe.is_none());
     let (soc_end, flags) = battery_out(s, &mut warnings);
     warnings.extend(motor_warnings.iter().cloned());
-    let loss_breakdown = o.breakdown.then(|| loss_breakdown(motor, s));
+    let loss_breakdown = o
+        .has(OutputKind::LossBreakdown)
+        .then(|| loss_breakdown(motor, s));
     let op_histogram = r.histogram.map(op_histogram);
     let n = s.n_intervals;
     let traces = r.sim.traces.clone().map(|t| Traces {
@@ -302,23 +304,27 @@ pub fn response_size(input: &BusFuelEconomyInput) -> ResponseSize {
     let mut size = ResponseSize::fixed(16 * 1024 + motors * 2048)
         .bytes("/motors", motors * input.cycles.len() as u64 * RESULT_BYTES);
     for c in &input.cycles {
-        let intervals = (c.time_s.len().saturating_sub(1) * o.substeps.max(1)) as u64;
-        if o.traces {
+        let intervals = (c.time_s.len().saturating_sub(1) * o.k()) as u64;
+        if o.has(OutputKind::Traces) {
             size = size.numbers("/options/outputs", motors * 8 * intervals);
         }
-        if o.histogram {
+        if o.has(OutputKind::OpHistogram) {
             let rpm = rad_s_to_rpm(input.vehicle.motor_speed(c.max_speed_mps()));
             for m in &input.motors {
-                let speed_bins = (rpm / o.hist_bins.0).floor() + 2.0;
-                let torque_bins = 2.0 * (compute::t_top(m) / o.hist_bins.1).ceil() + 3.0;
+                let speed_bins = (rpm / o.op_histogram.speed_bin_rpm).floor() + 2.0;
+                let torque_bins =
+                    2.0 * (compute::t_top(m) / o.op_histogram.torque_bin_nm).ceil() + 3.0;
                 let bins = (speed_bins * torque_bins).clamp(0.0, compute::MAX_HIST_BINS) as u64;
                 size = size.numbers("/options/op_histogram", bins + 64);
             }
         }
     }
-    if o.efficiency_map {
+    if o.has(OutputKind::EfficiencyMap) {
         for m in &input.motors {
-            size = size.numbers("/options/loss_map_grid", map_points(m, o.grid) + 64);
+            size = size.numbers(
+                "/options/loss_map_grid",
+                map_points(m, o.loss_map_grid.steps()) + 64,
+            );
         }
     }
     size
@@ -403,7 +409,7 @@ pub fn respond(
     let comparison = out
         .comparison
         .as_ref()
-        .map(|c| comparison_wire(&ids, cycle_names, &o.weights, c));
+        .map(|c| comparison_wire(&ids, cycle_names, &input.weights, c));
     let motor_maps = out.maps.map(|maps| {
         maps.into_iter()
             .map(|(mi, m)| map_wire(&input.motors[mi].id, m))
@@ -425,9 +431,9 @@ pub fn respond(
         shard: input.shard.map(|s| s.out(pairs)),
         echo: Echo {
             mode: o.mode,
-            power_convention: o.convention,
-            substeps: u32::try_from(o.substeps).unwrap_or(u32::MAX),
-            motor_eval: o.motor_eval,
+            power_convention: o.power_convention,
+            substeps: o.substeps,
+            motor_eval: o.eval(),
             regen: o.regen,
             regen_limit: o.regen_limit,
             cycle_data_version: cycles::CYCLE_DATA_VERSION.to_owned(),

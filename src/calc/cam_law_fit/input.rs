@@ -10,9 +10,7 @@ use crate::calc::cam_law::wire::Units;
 use crate::calc::{CalcFailure, Validator};
 
 use super::optim::ga::GaParams;
-use super::wire::{
-    Channels, FitCamLawRequest, GaIn, MAX_CURVE_COUNT, Method, MetricName, OptimizerIn,
-};
+use super::wire::{Channels, FitCamLawRequest, GaIn, MAX_CURVE_COUNT, Method, MetricName};
 use crate::numerics::grid;
 
 crate::calc::rules::cross_rules! {
@@ -339,19 +337,16 @@ fn check_constraints(
     let s_b = c.s_b.or_else(|| s_data.and_then(|s| s.last().copied()));
     // (With no channel at all, `/channels` already says what is missing.)
     let any_channel = supplied.iter().any(Option::is_some);
-    if s_a.is_none() && s_data.is_none() && any_channel {
-        v.rule(
-            &END_DISPLACEMENT,
-            "/constraints/s_a",
-            "required when no displacement channel is supplied (the start displacement)",
-        );
-    }
-    if s_b.is_none() && s_data.is_none() && any_channel {
-        v.rule(
-            &END_DISPLACEMENT,
-            "/constraints/s_b",
-            "required when no displacement channel is supplied (the end displacement)",
-        );
+    for (name, given, end) in [("s_a", s_a, "start"), ("s_b", s_b, "end")] {
+        if given.is_none() && s_data.is_none() && any_channel {
+            v.rule(
+                &END_DISPLACEMENT,
+                format!("/constraints/{name}"),
+                format!(
+                    "required when no displacement channel is supplied (the {end} displacement)"
+                ),
+            );
+        }
     }
     let mut bc = None;
     if let (Some(t_a), Some(t_b), Some(s_a), Some(s_b)) = (t_a, t_b, s_a, s_b)
@@ -415,60 +410,25 @@ fn check_constraints(
     bc
 }
 
-/// The optimizer's budgets and settings: `(max_evaluations, dtw_global_restarts, snap_tol)`
-/// (their ranges are checked at the door).
-fn check_optimizer(o: &OptimizerIn, metric: MetricName, v: &mut Validator) -> (u64, u32, f64) {
-    let method = o.method;
-    if metric == MetricName::Dtw && method == Method::Lsq {
-        v.rule(
-            &METHOD_METRIC,
-            "/optimizer/method",
-            "`lsq` minimizes a sum of squares and cannot fit the DTW metric: use `auto`, `cmaes`, `de` or `ga`",
-        );
-    }
-    let max_evaluations = o.max_evaluations.unwrap_or(DEFAULT_MAX_EVALUATIONS);
-    let dtw_global_restarts = o.dtw_global_restarts.unwrap_or(DEFAULT_DTW_RESTARTS);
-    let snap_tol = o.snap_tol.unwrap_or(DEFAULT_SNAP_TOL);
-    (max_evaluations, dtw_global_restarts, snap_tol)
-}
-
 /// The GA settings (spec §3.5.1 defaults for every field not given; ranges checked at the door).
 fn ga_params(ga_in: Option<GaIn>) -> GaParams {
-    let mut ga = GaParams::default();
-    let Some(g) = ga_in else {
-        return ga;
-    };
-    if let Some(p) = g.population {
+    let d = GaParams::default();
+    let Some(g) = ga_in else { return d };
+    GaParams {
         // ≤ 10 000 (checked at the door): the conversion cannot fail.
-        ga.population = usize::try_from(p).unwrap_or(100);
+        population: g
+            .population
+            .map_or(d.population, |p| usize::try_from(p).unwrap_or(100)),
+        generations: g.generations.unwrap_or(d.generations),
+        p_crossover: g.p_crossover.unwrap_or(d.p_crossover),
+        p_inversion: g.p_inversion.unwrap_or(d.p_inversion),
+        p_range_mutation: g.p_range_mutation.unwrap_or(d.p_range_mutation),
+        range0: g.range0.unwrap_or(d.range0),
+        range_factor: g.range_factor.unwrap_or(d.range_factor),
+        range_every: g.range_every.unwrap_or(d.range_every),
+        p_mutation: g.p_mutation.unwrap_or(d.p_mutation),
+        stall_generations: g.stall_generations.unwrap_or(d.stall_generations),
     }
-    if let Some(p) = g.generations {
-        ga.generations = p;
-    }
-    if let Some(p) = g.range_every {
-        ga.range_every = p;
-    }
-    if let Some(p) = g.stall_generations {
-        ga.stall_generations = p;
-    }
-    let probs = [
-        ("p_crossover", g.p_crossover, &mut ga.p_crossover),
-        ("p_inversion", g.p_inversion, &mut ga.p_inversion),
-        (
-            "p_range_mutation",
-            g.p_range_mutation,
-            &mut ga.p_range_mutation,
-        ),
-        ("range0", g.range0, &mut ga.range0),
-        ("range_factor", g.range_factor, &mut ga.range_factor),
-        ("p_mutation", g.p_mutation, &mut ga.p_mutation),
-    ];
-    for (_, value, slot) in probs {
-        if let Some(x) = value {
-            *slot = x;
-        }
-    }
-    ga
 }
 
 /// Initial coefficients (normalized, fixed genes zeroed), the fixed-zero mask, and the pointer
@@ -483,19 +443,17 @@ fn check_initial(
         && fz.len() == 7
     {
         fixed_zero.copy_from_slice(fz);
-        if fixed_zero[..3].iter().all(|z| *z) {
-            v.rule(
-                &EMPTY_PULSE,
-                "/fixed_zero",
-                "fixes all of c0, c1, c2: the first acceleration pulse would be empty; free at least one of them",
-            );
-        }
-        if fixed_zero[4..].iter().all(|z| *z) {
-            v.rule(
-                &EMPTY_PULSE,
-                "/fixed_zero",
-                "fixes all of c4, c5, c6: the second acceleration pulse would be empty; free at least one of them",
-            );
+        for (pulse, cs, which) in [
+            (0..3, "c0, c1, c2", "first"),
+            (4..7, "c4, c5, c6", "second"),
+        ] {
+            if fixed_zero[pulse].iter().all(|z| *z) {
+                v.rule(
+                    &EMPTY_PULSE,
+                    "/fixed_zero",
+                    format!("fixes all of {cs}: the {which} acceleration pulse would be empty; free at least one of them"),
+                );
+            }
         }
     }
     let mut initial = [1.0 / 7.0; 7];
@@ -540,19 +498,17 @@ fn check_initial(
     let p = initial_pointer.unwrap_or("/fixed_zero");
     if sum.is_finite() && sum > 0.0 {
         initial.iter_mut().for_each(|c| *c /= sum);
-        if pulse1 <= 0.0 {
-            v.rule(
-                &EMPTY_PULSE,
-                p,
-                "c0, c1, c2 (after fixed_zero) are all zero: the first acceleration pulse is empty; give at least one of them a positive value",
-            );
-        }
-        if pulse2 <= 0.0 {
-            v.rule(
-                &EMPTY_PULSE,
-                p,
-                "c4, c5, c6 (after fixed_zero) are all zero: the second acceleration pulse is empty; give at least one of them a positive value",
-            );
+        for (pulse, cs, which) in [
+            (pulse1, "c0, c1, c2", "first"),
+            (pulse2, "c4, c5, c6", "second"),
+        ] {
+            if pulse <= 0.0 {
+                v.rule(
+                    &EMPTY_PULSE,
+                    p,
+                    format!("{cs} (after fixed_zero) are all zero: the {which} acceleration pulse is empty; give at least one of them a positive value"),
+                );
+            }
         }
     } else if sum.is_finite() {
         v.rule(
@@ -693,7 +649,14 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     // Optimizer.
     let o = req.optimizer;
     let method = o.method;
-    let (max_evaluations, dtw_global_restarts, snap_tol) = check_optimizer(&o, metric, &mut v);
+    if metric == MetricName::Dtw && method == Method::Lsq {
+        v.rule(
+            &METHOD_METRIC,
+            "/optimizer/method",
+            "`lsq` minimizes a sum of squares and cannot fit the DTW metric: use `auto`, `cmaes`, `de` or `ga`",
+        );
+    }
+    let max_evaluations = o.max_evaluations.unwrap_or(DEFAULT_MAX_EVALUATIONS);
     let ga = ga_params(o.ga);
 
     let (initial, fixed_zero, initial_pointer) = check_initial(&req, &mut v);
@@ -756,9 +719,9 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
             method,
             seed: o.seed.unwrap_or(0),
             ga,
-            dtw_global_restarts,
+            dtw_global_restarts: o.dtw_global_restarts.unwrap_or(DEFAULT_DTW_RESTARTS),
             polish: o.polish.unwrap_or(true),
-            snap_tol,
+            snap_tol: o.snap_tol.unwrap_or(DEFAULT_SNAP_TOL),
             initial,
             fixed_zero,
             max_evaluations,

@@ -9,7 +9,7 @@ use super::geometry::{
     ASSEMBLY_SLACK_REL, C64, Family, FourBar, Grashof, GrashofClass, InputRange, SINGULAR_REL,
     Sign, Solve, Special, TOGGLE_REL, cognate1_branch, cognates, map_pose, wrap_pi,
 };
-use super::input::{CognatesInput, CurveMode, Options, SnapshotSpec};
+use super::input::{CognatesInput, CurveMode, Options, SnapshotSpec, VerifyKind};
 use super::sampling::{Spacing, Sweep, circuit_sweeps, fixed_sweeps};
 use super::verify::{ImplicitResult, SyncAcc, hausdorff, implicit_check, segments};
 // Request options carried by the validated input (read only: no wire type is built here).
@@ -232,11 +232,13 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
         }
     }
 
-    let n = opts.points_per_circuit;
+    let n = opts.points();
     let need_circuits = work_plan(opts, &mechs)?;
 
     let mut counter = 0_u64;
-    let mut sync = opts.verify_sync.then(|| SyncAcc::new(&family));
+    let mut sync = opts
+        .verifies(VerifyKind::Sync)
+        .then(|| SyncAcc::new(&family));
     let mut circuit_curves: Vec<Vec<Curve>> = Vec::new();
     if need_circuits {
         for (idx, m) in mechs.iter_mut().enumerate() {
@@ -257,7 +259,7 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
             circuit_curves.push(curves);
         }
     }
-    let implicit = opts.verify_implicit.then(|| {
+    let implicit = opts.verifies(VerifyKind::Implicit).then(|| {
         implicit_check(
             &family,
             circuit_curves
@@ -267,7 +269,7 @@ pub fn compute(input: &CognatesInput, budget: &Budget) -> Result<CognatesOutput,
                 .flat_map(|c| c.points.iter()),
         )
     });
-    let hausdorff_out = opts.verify_hausdorff.then(|| {
+    let hausdorff_out = opts.verifies(VerifyKind::Hausdorff).then(|| {
         let segs: Vec<_> = circuit_curves
             .iter()
             .map(|cs| segments(cs.iter().map(|c| (c.points.as_slice(), c.closed))))
@@ -322,7 +324,7 @@ fn work_plan(opts: &Options, mechs: &[MechOutput]) -> Result<bool, CognatesError
         || opts.any_verify()
         || opts.metrics;
     let need_fixed = opts.curves && opts.curve_mode == CurveMode::FixedBranch;
-    let n_u64 = u64::try_from(opts.points_per_circuit).unwrap_or(u64::MAX);
+    let n_u64 = opts.points_per_circuit;
     let circuits: u64 = mechs.iter().map(|m| m.range.circuits().len() as u64).sum();
     let intervals: u64 = mechs.iter().map(|m| m.range.intervals().len() as u64).sum();
     let requested = n_u64
@@ -362,7 +364,7 @@ fn fixed_branch_curves(
             family,
             idx,
             &sweeps,
-            (opts.points_per_circuit, opts.spacing, false),
+            (opts.points(), opts.spacing, false),
             None,
             budget,
             counter,

@@ -13,13 +13,9 @@ use crate::calc::common;
 use crate::calc::{CalcFailure, Validator};
 
 use super::geometry::{C64, FourBar, Sign, cis, cross};
-use super::sampling::Spacing;
-use super::wire::{
-    AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec, VerifyKind,
-};
+use super::wire::{AngleReference, CognatesRequest, CouplerPoint, GroundSpec, JointsSpec};
 
-pub use super::wire::MAX_MAGNITUDE;
-use super::wire::POINTS_PER_CIRCUIT;
+pub use super::wire::{MAX_MAGNITUDE, VerifyKind};
 
 crate::calc::rules::cross_rules! {
     /// The rules between fields of `POST /v1/cognates`, as the document lists them.
@@ -82,36 +78,26 @@ pub struct SnapshotSpec {
 /// How curves are traced: the request's curve mode.
 pub use super::wire::CurveMode;
 
-/// Validated options.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Options {
-    /// Return curves.
-    pub curves: bool,
-    /// Samples per circuit N.
-    pub points_per_circuit: usize,
-    /// Spacing.
-    pub spacing: Spacing,
-    /// Curve mode.
-    pub curve_mode: CurveMode,
-    /// Run the `sync` check.
-    pub verify_sync: bool,
-    /// Run the `implicit` check.
-    pub verify_implicit: bool,
-    /// Run the `hausdorff` check.
-    pub verify_hausdorff: bool,
-    /// Return geared five-bars.
-    pub geared_fivebars: bool,
-    /// Return metrics.
-    pub metrics: bool,
-    /// Grashof tolerance.
-    pub grashof_rtol: f64,
-}
+/// The request's options (their ranges are checked at the door).
+pub use super::wire::CognatesOptions as Options;
 
 impl Options {
+    /// Whether the verification `kind` was requested.
+    #[must_use]
+    pub fn verifies(&self, kind: VerifyKind) -> bool {
+        self.verify.contains(&kind)
+    }
+
     /// Whether any verification was requested.
     #[must_use]
     pub fn any_verify(&self) -> bool {
-        self.verify_sync || self.verify_implicit || self.verify_hausdorff
+        !self.verify.is_empty()
+    }
+
+    /// Samples per circuit N (in `POINTS_PER_CIRCUIT` at the door: the conversion is exact).
+    #[must_use]
+    pub fn points(&self) -> usize {
+        usize::try_from(self.points_per_circuit).unwrap_or(usize::MAX)
     }
 }
 
@@ -173,31 +159,12 @@ struct CouplerData {
     side: Option<Sign>,
 }
 
-/// The options (shared by both modes; their ranges are checked at the door).
-fn validate_options(req: &CognatesRequest) -> Options {
-    let o = &req.options;
-    // The ends of POINTS_PER_CIRCUIT are whole numbers far below 2^53: the conversions are exact.
-    let (lo, hi) = (POINTS_PER_CIRCUIT.lo as u64, POINTS_PER_CIRCUIT.hi as u64);
-    Options {
-        curves: o.curves,
-        points_per_circuit: usize::try_from(o.points_per_circuit.clamp(lo, hi)).unwrap_or(360),
-        spacing: o.spacing,
-        curve_mode: o.curve_mode,
-        verify_sync: o.verify.contains(&VerifyKind::Sync),
-        verify_implicit: o.verify.contains(&VerifyKind::Implicit),
-        verify_hausdorff: o.verify.contains(&VerifyKind::Hausdorff),
-        geared_fivebars: o.geared_fivebars,
-        metrics: o.metrics,
-        grashof_rtol: o.grashof_rtol,
-    }
-}
-
 impl TryFrom<CognatesRequest> for CognatesInput {
     type Error = CalcFailure;
 
     fn try_from(req: CognatesRequest) -> Result<Self, Self::Error> {
         let v = Validator::new();
-        let options = validate_options(&req);
+        let options = req.options.clone();
         if let Some(j) = req.joints {
             joints_mode(&req, &j, options, v)
         } else {

@@ -14,9 +14,8 @@ use super::error::{
 use super::graph::{Digraph, GraphError};
 use super::structure::LevelMode;
 use super::wire::{
-    BetweennessMode, ComponentImportanceRequest, ComponentSpec, ConstantWeights,
-    DEFAULT_MAX_SIMPLE_PATHS, DEFAULT_O_OUT, DEFAULT_PATH_CAP, DEFAULT_Q_IN, FailureMode,
-    LevelsMode, Options, Outputs, PathMethod,
+    ComponentImportanceRequest, ComponentSpec, ConstantWeights, DEFAULT_MAX_SIMPLE_PATHS,
+    DEFAULT_O_OUT, DEFAULT_PATH_CAP, DEFAULT_Q_IN, FailureMode, Options, Outputs,
 };
 pub use super::wire::{MAX_COMPONENTS, MAX_ID_CHARS, MAX_TIMES, MIN_COMPONENTS};
 use crate::calc::{CalcFailure, Validator};
@@ -126,23 +125,11 @@ pub struct ComponentImportanceInput {
     pub warnings: Vec<Finding>,
 }
 
-/// Which paths the propagation sum runs over (the request's `options.path_method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Paths {
-    /// Simple paths only (paper); exact.
-    Exact,
-    /// Walks (matrix powers): equal to `Exact` on a DAG, an upper bound with cycles.
-    Walks,
-}
+/// Which paths the propagation sum runs over: the request's `options.path_method`.
+pub use super::wire::PathMethod as Paths;
 
-/// Which edge betweenness is used (the request's `options.betweenness`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Betweenness {
-    /// All simple paths, own pair excluded (paper Table 1).
-    AllSimplePaths,
-    /// Brandes shortest-path edge betweenness.
-    ShortestPaths,
-}
+/// Which edge betweenness is used: the request's `options.betweenness`.
+pub use super::wire::BetweennessMode as Betweenness;
 
 /// The optional output groups asked for (the request's `outputs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -577,18 +564,9 @@ impl TryFrom<ComponentImportanceRequest> for ComponentImportanceInput {
             o_out: o.o_out.unwrap_or(DEFAULT_O_OUT),
             weights,
             path_cap: o.path_cap.unwrap_or(DEFAULT_PATH_CAP) as usize,
-            path_method: match o.path_method {
-                PathMethod::Exact => Paths::Exact,
-                PathMethod::Walks => Paths::Walks,
-            },
-            levels: match o.levels {
-                LevelsMode::Paper => LevelMode::Paper,
-                LevelsMode::Ism => LevelMode::Ism,
-            },
-            betweenness: match o.betweenness {
-                BetweennessMode::AllSimplePaths => Betweenness::AllSimplePaths,
-                BetweennessMode::ShortestPaths => Betweenness::ShortestPaths,
-            },
+            path_method: o.path_method,
+            levels: o.levels,
+            betweenness: o.betweenness,
             max_simple_paths,
             outputs: req.outputs.into(),
             warnings: data.warnings,

@@ -5,10 +5,10 @@
 use std::time::Instant;
 
 use super::compute::ComponentImportanceOutput;
-use super::input::{Betweenness, ComponentImportanceInput, Finding};
+use super::input::{ComponentImportanceInput, Finding};
 use super::wire::{
-    BetweennessMode, Centralities, ComponentImportanceResponse, EdgeValue, KendallTau, Matrices,
-    Meta, TailBound, TimeResult, Warning,
+    Centralities, ComponentImportanceResponse, EdgeValue, KendallTau, Matrices, Meta, TailBound,
+    TimeResult, Warning,
 };
 use crate::numerics::{SolverReport, StopReason};
 
@@ -110,10 +110,7 @@ pub fn respond(
             n_levels: st.levels.n_levels,
             longest_path_edges: out.longest_path_edges,
             simple_paths_enumerated: out.work.paths,
-            betweenness: match input.betweenness {
-                Betweenness::AllSimplePaths => BetweennessMode::AllSimplePaths,
-                Betweenness::ShortestPaths => BetweennessMode::ShortestPaths,
-            },
+            betweenness: input.betweenness,
             betweenness_algorithm: out.betweenness_algorithm.label().to_owned(),
             propagation_algorithm: out.propagation_algorithm.label().to_owned(),
             path_cap: u32::try_from(input.path_cap).unwrap_or(u32::MAX),

@@ -502,14 +502,9 @@ pub fn shortest_path_betweenness(
     })
 }
 
-/// How hierarchy numbers are derived from the ISM partition (spec §3.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LevelMode {
-    /// ISM levels with every source (in-degree 0) lifted to level 1 (reproduces the paper).
-    Paper,
-    /// Plain reversed ISM levels.
-    Ism,
-}
+/// How hierarchy numbers are derived from the ISM partition (spec §3.4): the request's
+/// `options.levels`.
+pub use super::wire::LevelsMode as LevelMode;
 
 /// Hierarchy numbers (spec §3.4).
 #[derive(Debug, Clone)]

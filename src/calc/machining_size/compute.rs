@@ -9,7 +9,7 @@ use super::boost::{Boosted, ExactIndex, Method, SplitIndex, TrainData, boost};
 use super::data::{self, Matrix, Metrics};
 use super::error::MachiningSizeError;
 use super::gra;
-use super::input::{AnalyzeInput, PredictInput, ShapKind, TrainInput};
+use super::input::{AnalyzeInput, PredictInput, ShapKind, TrainInput, TrainOutputKind};
 use super::model::{Model, Tree};
 use super::pca::{self, Pca};
 use super::rng;
@@ -221,8 +221,11 @@ pub fn train(input: &TrainInput, budget: &Budget) -> Result<TrainOutput, Machini
         trees_built += built;
         cv
     });
-    let importance = input.outputs.importance.then(|| importance(&model));
-    let want_shap = input.outputs.shap_summary;
+    let importance = input
+        .outputs
+        .contains(&TrainOutputKind::Importance)
+        .then(|| importance(&model));
+    let want_shap = input.outputs.contains(&TrainOutputKind::ShapSummary);
     let shap_summary = if want_shap && !budget.expired() {
         shap_summary(
             &model,

@@ -6,14 +6,8 @@
 //! largest magnitude before differencing: no difference overflows whatever the data. When
 //! Δmax = 0 every series equals the reference and every grade is 1 (hazard 8.7).
 
-/// Normalisation of each series before comparison.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Normalise {
-    /// x(k)/mean(x).
-    Mean,
-    /// The raw values.
-    None,
-}
+/// Normalisation of each series before comparison: the request's `gra.normalise`.
+pub use super::wire::GraNormalise as Normalise;
 
 /// Why GRA cannot be computed.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -22,9 +22,9 @@ use super::gra::Normalise;
 use super::model::Model;
 use super::smogn::SmognParams;
 use super::wire::{
-    AnalyzeRequest, GraNormalise, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
+    AnalyzeRequest, MAX_FEATURES, MAX_INTERACTION_CELLS, MAX_INTERACTION_ROWS,
     MAX_INTERVENTIONAL_PAIRS, MAX_SCORE_CELLS, MAX_SHAP_CELLS, MAX_TREES, PredictRequest,
-    RELEVANCE_PHI, TrainOutputKind, TrainRequest, TreeMethod,
+    RELEVANCE_PHI, TrainRequest, TreeMethod,
 };
 
 crate::calc::rules::cross_rules! {
@@ -161,20 +161,12 @@ pub struct TrainInput {
     pub shard: Option<crate::calc::common::Shard>,
     /// Seed of the holdout and fold permutations.
     pub split_seed: u64,
-    /// Optional outputs.
-    pub outputs: TrainOutputs,
+    /// Optional outputs asked for.
+    pub outputs: Vec<TrainOutputKind>,
 }
 
-/// Which optional outputs `/train` computes.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct TrainOutputs {
-    /// Importances.
-    pub importance: bool,
-    /// SHAP summary.
-    pub shap_summary: bool,
-    /// Holdout predictions.
-    pub test_predictions: bool,
-}
+/// An optional output of `/train`: the request's output kind.
+pub use super::wire::TrainOutputKind;
 
 /// Which SHAP values `/predict` computes: the request's `shap`.
 pub use super::wire::ShapKind;
@@ -428,11 +420,6 @@ impl TryFrom<TrainRequest> for TrainInput {
             );
         }
         v.finish()?;
-        let outputs = TrainOutputs {
-            importance: req.outputs.contains(&TrainOutputKind::Importance),
-            shap_summary: req.outputs.contains(&TrainOutputKind::ShapSummary),
-            test_predictions: req.outputs.contains(&TrainOutputKind::TestPredictions),
-        };
         Ok(Self {
             names: req.feature_names,
             x,
@@ -463,7 +450,7 @@ impl TryFrom<TrainRequest> for TrainInput {
             k_fold: val.k_fold.map(|k| k as usize),
             shard,
             split_seed: val.seed,
-            outputs,
+            outputs: req.outputs,
         })
     }
 }
@@ -618,15 +605,7 @@ impl TryFrom<AnalyzeRequest> for AnalyzeInput {
     fn try_from(req: AnalyzeRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         check_data(&mut v, &req.feature_names, &req.rows, &req.target);
-        let gra = req.gra.as_ref().map(|g| {
-            (
-                g.rho,
-                match g.normalise {
-                    GraNormalise::Mean => Normalise::Mean,
-                    GraNormalise::None => Normalise::None,
-                },
-            )
-        });
+        let gra = req.gra.as_ref().map(|g| (g.rho, g.normalise));
         let pca = req.pca.as_ref().map(|p| {
             if p.scores {
                 let k = p.components.map_or(req.feature_names.len(), |k| k as usize);

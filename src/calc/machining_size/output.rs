@@ -8,16 +8,15 @@ use super::boost::{BoostParams, Method};
 use super::compute::{AnalyzeOutput, Importance, PredictOutput, ShapSummary, TrainOutput};
 use super::data::{Metrics, mean_sd};
 use super::document::{FORMAT, OBJECTIVE};
-use super::input::{AnalyzeInput, PredictInput, TrainInput};
+use super::input::{AnalyzeInput, PredictInput, TrainInput, TrainOutputKind};
 use super::model::{Model, ModelSource, Routing, Tree};
 use super::pca::Pca;
 use super::smogn::Smogn;
 use super::wire::{
     AnalyzeResponse, ConstantColumn, CvMetrics, FeatureImportance, FeatureShap, GbdtModel,
-    GraGrade, GraNormalise, GraOut, LevelShap, MetricsOut, ModelSummary, OffGrid, PcaOut,
-    PredictResponse, PreprocessingOut, ShapOut, ShapSummary as ShapSummaryWire, SmognBinOut,
-    SmognData, SmognOut, SplitMetrics, TestPredictions, TrainParams, TrainResponse, TreeDoc,
-    TreeMethod,
+    GraGrade, GraOut, LevelShap, MetricsOut, ModelSummary, OffGrid, PcaOut, PredictResponse,
+    PreprocessingOut, ShapOut, ShapSummary as ShapSummaryWire, SmognBinOut, SmognData, SmognOut,
+    SplitMetrics, TestPredictions, TrainParams, TrainResponse, TreeDoc, TreeMethod,
 };
 
 /// Local accuracy is flagged when the residual exceeds this share of the output scale (f64
@@ -347,11 +346,14 @@ pub fn respond_train(input: &TrainInput, out: &TrainOutput, budget: &Budget) -> 
         .importance
         .as_ref()
         .map(|imp| importance_out(imp, &input.names));
-    let test_predictions = input.outputs.test_predictions.then(|| TestPredictions {
-        rows: out.test_rows.clone(),
-        target: out.test_rows.iter().map(|&r| input.y[r as usize]).collect(),
-        prediction: out.test.as_ref().map(|t| t.1.clone()).unwrap_or_default(),
-    });
+    let test_predictions = input
+        .outputs
+        .contains(&TrainOutputKind::TestPredictions)
+        .then(|| TestPredictions {
+            rows: out.test_rows.clone(),
+            target: out.test_rows.iter().map(|&r| input.y[r as usize]).collect(),
+            prediction: out.test.as_ref().map(|t| t.1.clone()).unwrap_or_default(),
+        });
     TrainResponse {
         model: model_doc(model, Some(p)),
         effective_trees: u32_of(effective),
@@ -531,10 +533,7 @@ pub fn respond_analyze(
             let ranks = ranks(grades);
             GraOut {
                 rho,
-                normalise: match norm {
-                    super::gra::Normalise::Mean => GraNormalise::Mean,
-                    super::gra::Normalise::None => GraNormalise::None,
-                },
+                normalise: norm,
                 grades: out
                     .varying
                     .iter()

@@ -288,7 +288,7 @@ pub fn compute(
                 .as_ref()
                 .map(|e| e.values.as_slice())
                 .unwrap_or_default();
-            evaluations += grid.n as u64;
+            evaluations += grid.n() as u64;
             Some(coupled_frf(
                 &model,
                 (&a, &b),

@@ -8,7 +8,7 @@ use crate::calc::{CalcFailure, Validator};
 
 use super::error::{DEADLINE_RULE, EIGEN_NOT_CONVERGED_RULE, NON_FINITE_RULE};
 use super::wire::{
-    self, ControlMode, ExcitationIn, ExcitationType, GridIn, HarmonicIn, TimeResponseIn,
+    self, ExcitationIn, ExcitationType, GridIn, HarmonicIn, TimeResponseIn,
     VibrationAbsorberRequest,
 };
 
@@ -59,18 +59,8 @@ crate::calc::rules::cross_rules! {
     listed DEADLINE_RULE;
 }
 
-/// Configuration (which states the model has).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Config {
-    /// No absorber.
-    None,
-    /// Coil open.
-    Passive,
-    /// Coil shorted.
-    PassiveShorted,
-    /// PD control.
-    Active,
-}
+/// Configuration (which states the model has): the request's `control.mode`.
+pub use super::wire::ControlMode as Config;
 
 /// A frequency given in Hz or as a bare-beam mode index.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -171,34 +161,31 @@ pub enum Forcing {
     None,
 }
 
-/// A frequency grid.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Grid {
-    /// \[Hz\].
-    pub f_min: f64,
-    /// \[Hz\].
-    pub f_max: f64,
-    /// Points.
-    pub n: usize,
-    /// Log spacing.
-    pub log: bool,
-}
+/// A frequency grid: the request's (its ranges checked at the door, its order here).
+pub use super::wire::GridIn as Grid;
 
 impl Grid {
+    /// Points (at least 1 at the door).
+    #[must_use]
+    pub fn n(&self) -> usize {
+        self.n_points.max(1) as usize
+    }
+
     /// The frequencies \[Hz\].
     #[must_use]
     pub fn frequencies(&self) -> Vec<f64> {
-        if self.n == 1 {
-            return vec![self.f_min];
+        let (n, f_min, f_max) = (self.n(), self.f_min_hz, self.f_max_hz);
+        if n == 1 {
+            return vec![f_min];
         }
-        let last = (self.n - 1) as f64;
-        (0..self.n)
+        let last = (n - 1) as f64;
+        (0..n)
             .map(|i| {
                 let t = i as f64 / last;
                 if self.log {
-                    self.f_min * (self.f_max / self.f_min).powf(t)
+                    f_min * (f_max / f_min).powf(t)
                 } else {
-                    self.f_min + (self.f_max - self.f_min) * t
+                    f_min + (f_max - f_min) * t
                 }
             })
             .collect()
@@ -328,12 +315,7 @@ fn grid(v: &mut Validator, base: &str, g: &GridIn) -> Grid {
             g.f_min_hz, g.f_max_hz
         )
     });
-    Grid {
-        f_min: g.f_min_hz,
-        f_max: g.f_max_hz,
-        n: g.n_points.max(1) as usize,
-        log: g.log,
-    }
+    g.clone()
 }
 
 fn time(v: &mut Validator, t: &TimeResponseIn, length: f64) -> TimeRequest {
@@ -550,12 +532,7 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
         };
 
         let c = &req.control;
-        let config = match c.mode {
-            ControlMode::None => Config::None,
-            ControlMode::Passive => Config::Passive,
-            ControlMode::PassiveShorted => Config::PassiveShorted,
-            ControlMode::Active => Config::Active,
-        };
+        let config = c.mode;
         if config == Config::Active {
             v.ensure_rule(
                 actuator.kc != 0.0,

@@ -30,14 +30,14 @@ pub fn response_size(input: &VibrationAbsorberInput) -> ResponseSize {
         size = size.numbers("/outputs/ava_step_series", 4 * samples);
     }
     if let Some(g) = &o.ava_frf {
-        size = size.numbers("/outputs/ava_frequency_response/n_points", 3 * g.n as u64);
+        size = size.numbers("/outputs/ava_frequency_response/n_points", 3 * g.n() as u64);
     }
     if let Some((g, points)) = &o.frf {
         let per_point = 1 + 2 * points.len() as u64;
         size = size
             .numbers(
                 "/outputs/frequency_response/n_points",
-                per_point * g.n as u64,
+                per_point * g.n() as u64,
             )
             .bytes(
                 "/outputs/frequency_response/n_points",

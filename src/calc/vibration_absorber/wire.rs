@@ -427,7 +427,7 @@ pub struct ModeShapesOut {
 }
 
 /// A frequency grid.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema, crate::calc::Rules)]
 #[schema(as = vibration_absorber::GridIn)]
 #[serde(deny_unknown_fields)]
 pub struct GridIn {
