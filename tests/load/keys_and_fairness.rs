@@ -50,7 +50,7 @@ fn fixed_heavy(n: u32) -> Value {
 }
 
 /// Grid of [`fixed_heavy`] in the fairness scenario (a job long enough to see the queue).
-const FIXED_GRID: u32 = 61;
+const FIXED_GRID: u32 = 41;
 /// Grid of [`fixed_heavy`] in the soak (a quarter of the work: more jobs per minute).
 const SOAK_GRID: u32 = 31;
 
