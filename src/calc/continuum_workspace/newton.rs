@@ -477,7 +477,7 @@ pub const TRUST_FLOOR: f64 = 1e-3;
 pub const MAX_STEP: f64 = 0.25;
 /// The adaptive path's intermediate points use half the request's base RK4 steps when that is at
 /// least this many (16 steps: position error 4.8e-7 m on the spec's example, below what the
-/// corrector's [`CORRECTOR_TOL`] leaves, and half the cost of an evaluation); the end point is
+/// corrector's `CORRECTOR_TOL` leaves, and half the cost of an evaluation); the end point is
 /// solved on the request's discretisation.
 pub const COARSE_MIN_STEPS: usize = 16;
 
