@@ -8,9 +8,9 @@ use mechcalc::{AppState, app};
 use tracing_subscriber::EnvFilter;
 
 /// jemalloc with a background purging thread (options in `.cargo/config.toml`): the memory a large
-/// request used goes back to the system soon after its answer; glibc's malloc kept ~55 MiB above
-/// idle after a 28 MiB training body (benches/RESULTS.md, "Memory per body").
-#[cfg(all(target_os = "linux", not(target_env = "msvc")))]
+/// request used goes back to the system about a second after its answer; glibc's malloc kept
+/// ~55 MiB above idle after a 28 MiB training body (benches/RESULTS.md, "Memory per body").
+#[cfg(all(feature = "jemalloc", target_os = "linux"))]
 #[global_allocator]
 static ALLOCATOR: tikv_jemallocator::Jemalloc = tikv_jemallocator::Jemalloc;
 

@@ -116,6 +116,9 @@ pub async fn log_request(req: Request, next: Next) -> Response {
     metrics::histogram!("mechcalc_request_duration_seconds", "route" => route.clone(), "key" => key.clone())
         .record(latency);
     tracing::info!(%method, %path, %route, status, latency_ms = latency * 1e3, %request_id, %key, "request");
+    if body_bytes >= super::memory::LARGE_BODY_BYTES {
+        super::memory::give_back();
+    }
     resp
 }
 

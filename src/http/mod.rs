@@ -18,6 +18,7 @@ pub mod irefc;
 pub mod json;
 pub mod layers;
 pub mod machining_size;
+pub mod memory;
 pub mod meta;
 pub mod openapi;
 pub mod picture;
