@@ -13,28 +13,10 @@ use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use serde_json::Value;
+#[path = "support/mod.rs"]
+mod support;
 
 const REPEATS: usize = 15;
-
-fn examples() -> Vec<(String, String, Vec<u8>)> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("api");
-    let index: Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("examples.json")).expect("api/examples.json"),
-    )
-    .expect("JSON");
-    index["examples"]
-        .as_array()
-        .expect("examples")
-        .iter()
-        .map(|e| {
-            let file = e["file"].as_str().expect("file").to_owned();
-            let endpoint = e["endpoint"].as_str().expect("endpoint").to_owned();
-            let body = std::fs::read(dir.join(&file)).expect("example");
-            (file, endpoint, body)
-        })
-        .collect()
-}
 
 /// A keep-alive HTTP/1.1 connection.
 struct Conn {
@@ -195,7 +177,7 @@ fn main() {
     );
     println!("|---|---|---:|---:|---:|---:|---:|");
     let mut costs = Vec::new();
-    for (file, endpoint, body) in examples() {
+    for (file, endpoint, body) in support::api_examples() {
         let mut best: Option<(f64, f64, f64, f64, usize)> = None;
         for _ in 0..REPEATS {
             let t = Instant::now();

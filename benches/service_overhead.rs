@@ -14,27 +14,10 @@ use axum::http::Request;
 use http_body_util::BodyExt;
 use mechcalc::config::ServiceConfig;
 use mechcalc::{AppState, app};
-use serde_json::Value;
 use tower::ServiceExt;
 
-fn examples() -> Vec<(String, String, Vec<u8>)> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("api");
-    let index: Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("examples.json")).expect("api/examples.json"),
-    )
-    .expect("JSON");
-    index["examples"]
-        .as_array()
-        .expect("examples")
-        .iter()
-        .map(|e| {
-            let file = e["file"].as_str().expect("file").to_owned();
-            let endpoint = e["endpoint"].as_str().expect("endpoint").to_owned();
-            let body = std::fs::read(dir.join(&file)).expect("example");
-            (file, endpoint, body)
-        })
-        .collect()
-}
+#[path = "support/mod.rs"]
+mod support;
 
 /// One metric of the service's `Server-Timing` header [ms].
 fn timing_ms(headers: &axum::http::HeaderMap, name: &str) -> f64 {
@@ -67,7 +50,7 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     rt.block_on(async {
-        for (file, endpoint, body) in examples() {
+        for (file, endpoint, body) in support::api_examples() {
             let send = || {
                 let req = Request::builder()
                     .method("POST")

@@ -125,3 +125,24 @@ pub fn sweep_filters(word: &str) -> Option<Vec<String>> {
     let filters: Vec<String> = args.into_iter().filter(|a| !a.starts_with('-')).collect();
     (filters.is_empty() || filters.iter().any(|f| f.contains(word))).then_some(filters)
 }
+
+/// Every `api/` example as (file, endpoint, body bytes), in the order of `api/examples.json`.
+#[must_use]
+pub fn api_examples() -> Vec<(String, String, Vec<u8>)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("api");
+    let index: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("examples.json")).expect("api/examples.json"),
+    )
+    .expect("JSON");
+    index["examples"]
+        .as_array()
+        .expect("examples")
+        .iter()
+        .map(|e| {
+            let file = e["file"].as_str().expect("file").to_owned();
+            let endpoint = e["endpoint"].as_str().expect("endpoint").to_owned();
+            let body = std::fs::read(dir.join(&file)).expect("example");
+            (file, endpoint, body)
+        })
+        .collect()
+}
