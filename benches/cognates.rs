@@ -3,7 +3,8 @@
 //! chord error against the closed-form truth (16 sub-samples per chord in the natural parameter),
 //! `sync` and `implicit` residuals.
 //!
-//! Run: `cargo bench --bench cognates`. Before criterion runs, plain tables (median and worst of
+//! Run: `cargo bench --bench cognates` (`-- encode` for one group). Before criterion runs (when no
+//! filter or a filter containing `tables` is given), plain tables (median and worst of
 //! repeated timings) are printed for `benches/RESULTS.md`, and the accuracy sweep is written as
 //! JSON to `target/cognates_accuracy.json`.
 
@@ -268,7 +269,9 @@ fn print_tables() {
 }
 
 fn benches(c: &mut Criterion) {
-    print_tables();
+    if support::sweep_filters("tables").is_some() {
+        print_tables();
+    }
     let budget = Budget::unlimited();
     let mut g = c.benchmark_group("cognates/request");
     g.sample_size(50).measurement_time(Duration::from_secs(3));
@@ -301,6 +304,28 @@ fn benches(c: &mut Criterion) {
         let r = req(&table1(opts));
         g.bench_function(name, |b| b.iter(|| run(black_box(r.clone()), &budget)));
     }
+    g.finish();
+    // The answer of the `api/` example (71 KB of JSON, 3375 numbers): the encoding the service
+    // runs on the compute pool (finite-number guard + JSON), and its two parts.
+    let ex: Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("api/cognates/table1.json"),
+        )
+        .expect("api example"),
+    )
+    .expect("json");
+    let out = run(req(&ex), &budget).expect("answer");
+    let mut g = c.benchmark_group("cognates/encode");
+    g.sample_size(50).measurement_time(Duration::from_secs(3));
+    g.bench_function("api_table1_encode", |b| {
+        b.iter(|| mechcalc::http::encode(black_box(&out)))
+    });
+    g.bench_function("api_table1_finite_guard", |b| {
+        b.iter(|| mechcalc::http::finite::all_finite(black_box(&out)))
+    });
+    g.bench_function("api_table1_serde_json", |b| {
+        b.iter(|| serde_json::to_vec(black_box(&out)))
+    });
     g.finish();
 }
 

@@ -5,16 +5,17 @@ use std::time::Duration;
 
 use clap::Parser;
 
+// A flag whose text names a unit in brackets carries an explicit `help`: rustdoc needs the
+// brackets escaped in the doc comment, and clap would print the escapes.
 /// mechcalc HTTP service configuration. Every flag can also be set through its environment
 /// variable; flags win.
-///
-/// A flag whose text names a unit in brackets carries an explicit `help`: rustdoc needs the
-/// brackets escaped in the doc comment, and clap would print the escapes.
 #[derive(Debug, Clone, Parser)]
 #[command(
     name = "mechcalc",
     version,
-    about = "Machine-design calculations over HTTP/JSON"
+    about = "Machine-design calculations over HTTP/JSON",
+    long_about = "Machine-design calculations over HTTP/JSON. Every flag can also be set through \
+                  its environment variable (shown with each flag); a flag wins over its variable."
 )]
 pub struct ServiceConfig {
     /// Address and port to listen on.

@@ -1,6 +1,7 @@
 //! A guard against silent NaN: serde_json writes a non-finite float as `null`, which a client
-//! cannot tell from "absent". Every response body is walked by [`first_non_finite`] before it is
-//! sent; a non-finite number is a bug in a calculation and becomes a logged 500.
+//! cannot tell from "absent". [`super::encode`] refuses to write any `null`; when one comes, the
+//! answer is walked by [`first_non_finite`]: a non-finite number is a bug in a calculation,
+//! logged as an error and answered with a 422 `NON_FINITE_ANSWER` naming the number.
 
 use serde::Serialize;
 use serde::ser::{self, Impossible};

@@ -370,14 +370,25 @@ pub fn respond<T: Serialize>(value: &T) -> Result<Response, ApiError> {
 /// First capacity of an answer's buffer [bytes].
 const ENCODE_CAPACITY: usize = 16 * 1024;
 
-/// The JSON body of a response: checked for non-finite numbers (one allocation-free pass), then
-/// written once into a buffer. Runs inside the compute job, so large answers are encoded on the
-/// bounded compute pool, not on the threads that accept connections.
+/// The JSON body of a response, written once into a pre-sized buffer, with the finite-number
+/// guard folded into that one pass: serde_json writes a non-finite float as `null`, so the
+/// writer refuses every `null`. Answers of calculations hold no `null` (absent fields are
+/// omitted), so the common case is one pass; when a `null` does come, the value is walked for a
+/// non-finite number (found: a 422 naming it) and, if it was a legitimate `null`, written again
+/// without the guard. Runs inside the compute job, so large answers are encoded on the bounded
+/// compute pool, not on the threads that accept connections.
 pub fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
-    if !finite::all_finite(value) {
+    // Pre-sized: most answers fit, and a large one (tens of KB) doubles a few times at most.
+    let mut body = Vec::with_capacity(ENCODE_CAPACITY);
+    let mut guarded = serde_json::Serializer::with_formatter(&mut body, NoNull);
+    match value.serialize(&mut guarded) {
+        Ok(()) => return Ok(body),
+        Err(e) if !e.is_io() => return Err(serialization_failed(&e)),
+        Err(_) => {}
+    }
+    if let Some(pointer) = finite::first_non_finite(value) {
         // Still a defect of the module (logged as an error for the developers), but the client
         // gets a typed refusal naming the number, never a NaN and never a 500.
-        let pointer = finite::first_non_finite(value).unwrap_or_default();
         tracing::error!(%pointer, "calculation produced a non-finite number");
         return Err(ApiError::from(
             crate::calc::common::NON_FINITE_ANSWER_RULE.fail_general(format!(
@@ -386,13 +397,23 @@ pub fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
             )),
         ));
     }
-    // Pre-sized: most answers fit, and a large one (tens of KB) doubles a few times at most.
-    let mut body = Vec::with_capacity(ENCODE_CAPACITY);
-    serde_json::to_writer(&mut body, value).map_err(|e| {
-        tracing::error!(error = %e, "response serialization failed");
-        ApiError::internal()
-    })?;
+    body.clear();
+    serde_json::to_writer(&mut body, value).map_err(|e| serialization_failed(&e))?;
     Ok(body)
+}
+
+fn serialization_failed(e: &serde_json::Error) -> ApiError {
+    tracing::error!(error = %e, "response serialization failed");
+    ApiError::internal()
+}
+
+/// serde_json's compact format, refusing to write `null` (where a non-finite float would go).
+struct NoNull;
+
+impl serde_json::ser::Formatter for NoNull {
+    fn write_null<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
+        Err(std::io::Error::other("null in an answer"))
+    }
 }
 
 /// An `application/json` response from an encoded body.
@@ -481,4 +502,61 @@ where
             .insert(HeaderName::from_static("server-timing"), v);
     }
     Ok(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::encode;
+    use serde::Serialize;
+
+    #[derive(Serialize)]
+    struct Answer {
+        x: Vec<f64>,
+        maybe: Option<f64>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        omitted: Option<f64>,
+    }
+
+    #[test]
+    fn encode_writes_what_serde_json_writes() {
+        for a in [
+            Answer {
+                x: vec![1.0, -2.5e-300, 3.0e12],
+                maybe: Some(0.1),
+                omitted: None,
+            },
+            // A legitimate `null` takes the slow path and still gives the same bytes.
+            Answer {
+                x: vec![],
+                maybe: None,
+                omitted: Some(7.0),
+            },
+        ] {
+            let got = encode(&a).expect("finite answer");
+            assert_eq!(got, serde_json::to_vec(&a).expect("json"));
+        }
+    }
+
+    #[test]
+    fn encode_refuses_a_non_finite_number_naming_it() {
+        for (bad, at) in [
+            (f64::NAN, "/x/1"),
+            (f64::INFINITY, "/x/1"),
+            (f64::NEG_INFINITY, "/x/1"),
+        ] {
+            let a = Answer {
+                x: vec![1.0, bad],
+                maybe: None,
+                omitted: None,
+            };
+            let e = encode(&a).expect_err("non-finite");
+            assert_eq!(e.status(), axum::http::StatusCode::UNPROCESSABLE_ENTITY);
+            let body = serde_json::to_value(e.body()).expect("problem");
+            assert_eq!(body["code"], "NON_FINITE_ANSWER", "{body}");
+            assert!(
+                body["detail"].as_str().is_some_and(|d| d.contains(at)),
+                "{body}"
+            );
+        }
+    }
 }

@@ -342,6 +342,8 @@ fn help_prints_units_in_plain_brackets() {
     assert!(!help.contains("\\["), "escaped brackets in --help:\n{help}");
     assert!(help.contains("[ms]") && help.contains("[bytes]"), "{help}");
     assert!(help.contains("--api-keys-file") && help.contains("--client-queue-depth"));
+    // The text is for the service's users: no notes about how the source is written.
+    assert!(!help.contains("rustdoc"), "{help}");
 }
 
 /// A log sink for one test.
