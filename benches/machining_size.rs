@@ -30,6 +30,7 @@ use mechcalc::calc::machining_size::boost::{
     BoostParams, Boosted, Method, SplitIndex, TrainData, boost,
 };
 use mechcalc::calc::machining_size::data::{Matrix, all_rows, complement, metrics};
+use mechcalc::calc::machining_size::doc_tree::Doc;
 use mechcalc::calc::machining_size::document::{DocLimits, read_xgboost};
 use mechcalc::calc::machining_size::model::Model;
 use mechcalc::calc::machining_size::rng;
@@ -406,7 +407,7 @@ fn sweep_shap(paper: &Set, reference: Option<&Value>) {
     let rows: Vec<Vec<f64>> = (0..paper.n).map(|r| x.row(r)).collect();
     let mut models: Vec<(String, Model, &str)> = Vec::new();
     if let Ok(s) = std::fs::read_to_string(dir().join("paper_xgb_model.json")) {
-        let v: Value = serde_json::from_str(&s).unwrap();
+        let v: Doc = serde_json::from_str(&s).unwrap();
         let limits = DocLimits {
             max_trees: 5000,
             max_features: 200,

@@ -4,6 +4,7 @@
 
 use mechcalc::calc::machining_size::boost::{BoostParams, Method};
 use mechcalc::calc::machining_size::data::{Matrix, all_rows};
+use mechcalc::calc::machining_size::doc_tree::Doc;
 use mechcalc::calc::machining_size::document::{DocLimits, read_xgboost};
 use mechcalc::calc::machining_size::model::Model;
 use mechcalc::calc::machining_size::shap::{
@@ -258,7 +259,8 @@ fn imported() -> (Model, serde_json::Value) {
         max_trees: 5000,
         max_features: 200,
     };
-    let m = read_xgboost(&s["xgboost_json"], "/model/xgboost_json", limits).expect("reads");
+    let doc = <Doc as serde::Deserialize>::deserialize(&s["xgboost_json"]).expect("a JSON tree");
+    let m = read_xgboost(&doc, "/model/xgboost_json", limits).expect("reads");
     (m, s)
 }
 

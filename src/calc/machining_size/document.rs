@@ -4,7 +4,9 @@
 //! hostile document (child index out of range, a cycle, absurd depth, non-finite numbers,
 //! a non-squared-error objective, too many nodes) is rejected, never followed.
 
-use serde_json::{Map, Value};
+use indexmap::IndexMap;
+
+use super::doc_tree::{Doc, Item};
 
 use super::model::{
     MAX_ABS_VALUE, MAX_TOTAL_NODES, Model, ModelSource, RawNames, RawTree, Routing, StructureIssue,
@@ -34,77 +36,84 @@ fn issue(pointer: impl Into<String>, detail: impl Into<String>) -> StructureIssu
     }
 }
 
-fn object<'a>(v: &'a Value, at: &str) -> Res<&'a Map<String, Value>> {
+type Obj = IndexMap<String, Doc>;
+
+fn object<'a>(v: &'a Doc, at: &str) -> Res<&'a Obj> {
     v.as_object()
-        .ok_or_else(|| issue(at, format!("must be an object, got {}", kind(v))))
+        .ok_or_else(|| issue(at, format!("must be an object, got {}", v.kind())))
 }
 
-fn kind(v: &Value) -> &'static str {
-    match v {
-        Value::Null => "null",
-        Value::Bool(_) => "a boolean",
-        Value::Number(_) => "a number",
-        Value::String(_) => "a string",
-        Value::Array(_) => "an array",
-        Value::Object(_) => "an object",
-    }
+fn kind(v: &Item<'_>) -> &'static str {
+    v.doc().map_or("a number", Doc::kind)
 }
 
-fn field<'a>(o: &'a Map<String, Value>, key: &str, at: &str) -> Res<&'a Value> {
+fn field<'a>(o: &'a Obj, key: &str, at: &str) -> Res<&'a Doc> {
     o.get(key)
         .ok_or_else(|| issue(format!("{at}/{key}"), format!("missing field `{key}`")))
 }
 
-fn array<'a>(v: &'a Value, at: &str) -> Res<&'a Vec<Value>> {
-    v.as_array()
-        .ok_or_else(|| issue(at, format!("must be an array, got {}", kind(v))))
+/// The elements of an array.
+fn items<'a>(v: &'a Doc, at: &str) -> Res<impl Iterator<Item = Item<'a>>> {
+    let n = v
+        .array_len()
+        .ok_or_else(|| issue(at, format!("must be an array, got {}", v.kind())))?;
+    Ok((0..n).filter_map(move |i| v.item(i)))
 }
 
-fn string<'a>(v: &'a Value, at: &str) -> Res<&'a str> {
-    v.as_str()
-        .ok_or_else(|| issue(at, format!("must be a string, got {}", kind(v))))
+fn string<'a>(v: &'a Doc, at: &str) -> Res<&'a str> {
+    match v {
+        Doc::String(s) => Ok(s),
+        _ => Err(issue(at, format!("must be a string, got {}", v.kind()))),
+    }
 }
 
-fn number(v: &Value, at: &str) -> Res<f64> {
-    v.as_f64()
+fn number(v: &Item<'_>, at: &str) -> Res<f64> {
+    v.number()
+        .and_then(serde_json::Number::as_f64)
         .filter(|x| x.is_finite())
         .ok_or_else(|| issue(at, format!("must be a finite number, got {v}")))
 }
 
-fn integer(v: &Value, at: &str) -> Res<i64> {
-    v.as_i64()
+fn integer(v: &Item<'_>, at: &str) -> Res<i64> {
+    let n = v.number();
+    n.and_then(serde_json::Number::as_i64)
         .or_else(|| {
-            v.as_f64()
+            n.and_then(serde_json::Number::as_f64)
                 .filter(|x| x.fract() == 0.0 && x.abs() < 9.0e15)
                 .map(|x| x as i64)
         })
         .ok_or_else(|| issue(at, format!("must be an integer, got {v}")))
 }
 
-fn numbers(v: &Value, at: &str) -> Res<Vec<f64>> {
-    array(v, at)?
-        .iter()
-        .enumerate()
-        .map(|(i, x)| number(x, &format!("{at}/{i}")))
-        .collect()
+fn numbers(v: &Doc, at: &str) -> Res<Vec<f64>> {
+    match v {
+        // Numbers of the JSON text are finite (serde_json refuses an overflowing literal).
+        Doc::Floats(xs) => Ok(xs.clone()),
+        Doc::Ints(xs) => Ok(xs.iter().map(|&x| x as f64).collect()),
+        _ => items(v, at)?
+            .enumerate()
+            .map(|(i, x)| number(&x, &format!("{at}/{i}")))
+            .collect(),
+    }
 }
 
-fn integers(v: &Value, at: &str) -> Res<Vec<i64>> {
-    array(v, at)?
-        .iter()
-        .enumerate()
-        .map(|(i, x)| integer(x, &format!("{at}/{i}")))
-        .collect()
+fn integers(v: &Doc, at: &str) -> Res<Vec<i64>> {
+    match v {
+        Doc::Ints(xs) => Ok(xs.clone()),
+        _ => items(v, at)?
+            .enumerate()
+            .map(|(i, x)| integer(&x, &format!("{at}/{i}")))
+            .collect(),
+    }
 }
 
 /// Booleans, also written as 0/1 (XGBoost's `default_left`).
-fn flags(v: &Value, at: &str) -> Res<Vec<bool>> {
-    array(v, at)?
-        .iter()
+fn flags(v: &Doc, at: &str) -> Res<Vec<bool>> {
+    items(v, at)?
         .enumerate()
         .map(|(i, x)| match x {
-            Value::Bool(b) => Ok(*b),
-            _ => match integer(x, &format!("{at}/{i}"))? {
+            Item::Doc(Doc::Bool(b)) => Ok(*b),
+            _ => match integer(&x, &format!("{at}/{i}"))? {
                 0 => Ok(false),
                 1 => Ok(true),
                 k => Err(issue(
@@ -116,26 +125,41 @@ fn flags(v: &Value, at: &str) -> Res<Vec<bool>> {
         .collect()
 }
 
-fn names(v: &Value, at: &str) -> Res<Vec<String>> {
-    array(v, at)?
-        .iter()
+fn names(v: &Doc, at: &str) -> Res<Vec<String>> {
+    items(v, at)?
         .enumerate()
-        .map(|(i, x)| string(x, &format!("{at}/{i}")).map(str::to_owned))
+        .map(|(i, x)| match x {
+            Item::Doc(Doc::String(s)) => Ok(s.clone()),
+            _ => Err(issue(
+                format!("{at}/{i}"),
+                format!("must be a string, got {}", kind(&x)),
+            )),
+        })
         .collect()
 }
 
-fn check_count(trees: &[Value], at: &str, limits: DocLimits) -> Res<()> {
-    if trees.len() > limits.max_trees {
+/// The trees of a model: an array of at most `limits.max_trees` elements.
+fn trees<'a>(v: &'a Doc, at: &str, limits: DocLimits) -> Res<impl Iterator<Item = Item<'a>>> {
+    let it = items(v, at)?;
+    let n = v.array_len().unwrap_or(0);
+    if n > limits.max_trees {
         return Err(issue(
             at,
             format!(
-                "a model may have at most {} trees, got {}",
+                "a model may have at most {} trees, got {n}",
                 limits.max_trees,
-                trees.len()
             ),
         ));
     }
-    Ok(())
+    Ok(it)
+}
+
+/// A tree of a model: an object.
+fn tree_object<'a>(tv: &Item<'a>, at: &str) -> Res<&'a Obj> {
+    match tv {
+        Item::Doc(d) => object(d, at),
+        Item::Number(_) => Err(issue(at, "must be an object, got a number")),
+    }
 }
 
 fn check_nodes(total: &mut usize, add: usize, at: &str) -> Res<()> {
@@ -169,7 +193,7 @@ const NATIVE_TREE_KEYS: [&str; 8] = [
     "loss_change",
 ];
 
-fn no_unknown(o: &Map<String, Value>, known: &[&str], at: &str) -> Res<()> {
+fn no_unknown(o: &Obj, known: &[&str], at: &str) -> Res<()> {
     match o.keys().find(|k| !known.contains(&k.as_str())) {
         Some(k) => Err(issue(
             format!("{at}/{k}"),
@@ -183,7 +207,7 @@ fn no_unknown(o: &Map<String, Value>, known: &[&str], at: &str) -> Res<()> {
 ///
 /// # Errors
 /// The first defect, with its pointer.
-pub fn read_native(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
+pub fn read_native(v: &Doc, at: &str, limits: DocLimits) -> Res<Model> {
     let o = object(v, at)?;
     no_unknown(o, &NATIVE_KEYS, at)?;
     let format = string(field(o, "format", at)?, &format!("{at}/format"))?;
@@ -200,14 +224,20 @@ pub fn read_native(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
             format!("only \"{OBJECTIVE}\" models are supported (v1), got \"{objective}\""),
         ));
     }
-    let base_score = number(field(o, "base_score", at)?, &format!("{at}/base_score"))?;
+    let base_score = number(
+        &Item::Doc(field(o, "base_score", at)?),
+        &format!("{at}/base_score"),
+    )?;
     if base_score.abs() > MAX_ABS_VALUE {
         return Err(issue(
             format!("{at}/base_score"),
             format!("must have magnitude ≤ 1e100, got {base_score}"),
         ));
     }
-    let n_features = integer(field(o, "n_features", at)?, &format!("{at}/n_features"))?;
+    let n_features = integer(
+        &Item::Doc(field(o, "n_features", at)?),
+        &format!("{at}/n_features"),
+    )?;
     let n_features = usize::try_from(n_features)
         .ok()
         .filter(|&n| (1..=limits.max_features).contains(&n))
@@ -234,13 +264,12 @@ pub fn read_native(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
         ));
     }
     let at_trees = format!("{at}/trees");
-    let trees_v = array(field(o, "trees", at)?, &at_trees)?;
-    check_count(trees_v, &at_trees, limits)?;
-    let mut trees = Vec::with_capacity(trees_v.len());
+    let trees_v = field(o, "trees", at)?;
+    let mut trees = Vec::with_capacity(trees_v.array_len().unwrap_or(0));
     let mut total = 0;
-    for (t, tv) in trees_v.iter().enumerate() {
+    for (t, tv) in self::trees(trees_v, &at_trees, limits)?.enumerate() {
         let at_t = format!("{at_trees}/{t}");
-        let to = object(tv, &at_t)?;
+        let to = tree_object(&tv, &at_t)?;
         no_unknown(to, &NATIVE_TREE_KEYS, &at_t)?;
         let get = |k: &str| field(to, k, &at_t);
         let raw = RawTree {
@@ -303,16 +332,16 @@ fn parse_base_score(s: &str, at: &str) -> Res<f64> {
 }
 
 /// A string-or-number integer parameter of XGBoost's JSON (`"5"`).
-fn param_int(o: &Map<String, Value>, key: &str, at: &str) -> Res<Option<i64>> {
+fn param_int(o: &Obj, key: &str, at: &str) -> Res<Option<i64>> {
     match o.get(key) {
         None => Ok(None),
-        Some(Value::String(s)) => s.trim().parse::<i64>().map(Some).map_err(|_| {
+        Some(Doc::String(s)) => s.trim().parse::<i64>().map(Some).map_err(|_| {
             issue(
                 format!("{at}/{key}"),
                 format!("must be an integer, got \"{s}\""),
             )
         }),
-        Some(v) => integer(v, &format!("{at}/{key}")).map(Some),
+        Some(v) => integer(&Item::Doc(v), &format!("{at}/{key}")).map(Some),
     }
 }
 
@@ -322,7 +351,7 @@ fn param_int(o: &Map<String, Value>, key: &str, at: &str) -> Res<Option<i64>> {
 /// The first defect, with its pointer: not a `gbtree` booster, an objective other than
 /// `reg:squarederror`, multi-target or multi-class models, categorical splits, vector leaves,
 /// and every structural defect of [`build_tree`].
-pub fn read_xgboost(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
+pub fn read_xgboost(v: &Doc, at: &str, limits: DocLimits) -> Res<Model> {
     let root = object(v, at)?;
     let at_l = format!("{at}/learner");
     let learner = object(field(root, "learner", at)?, &at_l)?;
@@ -403,13 +432,12 @@ pub fn read_xgboost(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
         }
     }
     let at_trees = format!("{at_m}/trees");
-    let trees_v = array(field(model, "trees", &at_m)?, &at_trees)?;
-    check_count(trees_v, &at_trees, limits)?;
-    let mut trees = Vec::with_capacity(trees_v.len());
+    let trees_v = field(model, "trees", &at_m)?;
+    let mut trees = Vec::with_capacity(trees_v.array_len().unwrap_or(0));
     let mut total = 0;
-    for (t, tv) in trees_v.iter().enumerate() {
+    for (t, tv) in self::trees(trees_v, &at_trees, limits)?.enumerate() {
         let at_t = format!("{at_trees}/{t}");
-        let tree = read_xgb_tree(tv, &at_t, n_features, &mut total)?;
+        let tree = read_xgb_tree(tree_object(&tv, &at_t)?, &at_t, n_features, &mut total)?;
         trees.push(tree);
     }
     Ok(Model {
@@ -422,8 +450,7 @@ pub fn read_xgboost(v: &Value, at: &str, limits: DocLimits) -> Res<Model> {
     })
 }
 
-fn read_xgb_tree(tv: &Value, at_t: &str, n_features: usize, total: &mut usize) -> Res<Tree> {
-    let to = object(tv, at_t)?;
+fn read_xgb_tree(to: &Obj, at_t: &str, n_features: usize, total: &mut usize) -> Res<Tree> {
     if let Some(tp) = to.get("tree_param") {
         let at_tp = format!("{at_t}/tree_param");
         let tp = object(tp, &at_tp)?;
@@ -486,7 +513,12 @@ fn read_xgb_tree(tv: &Value, at_t: &str, n_features: usize, total: &mut usize) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use serde_json::json;
+    use serde::Deserialize;
+    use serde_json::{Value, json};
+
+    fn doc(v: &Value) -> Doc {
+        Doc::deserialize(v).unwrap()
+    }
 
     const LIMITS: DocLimits = DocLimits {
         max_trees: 5000,
@@ -512,7 +544,7 @@ mod tests {
 
     #[test]
     fn reads_xgboost_t1() {
-        let m = read_xgboost(&xgb_t1(), "/m", LIMITS).unwrap();
+        let m = read_xgboost(&doc(&xgb_t1()), "/m", LIMITS).unwrap();
         assert_eq!((m.base_score).to_bits(), f64::to_bits(4.0));
         assert_eq!((m.predict_prepared(&[1.0])).to_bits(), f64::to_bits(2.5));
         assert_eq!((m.predict_prepared(&[4.0])).to_bits(), f64::to_bits(7.0));
@@ -522,18 +554,18 @@ mod tests {
     fn rejects_hostile_xgboost_documents() {
         let mut v = xgb_t1();
         v["learner"]["objective"]["name"] = json!("reg:pseudohubererror");
-        let e = read_xgboost(&v, "/m", LIMITS).unwrap_err();
+        let e = read_xgboost(&doc(&v), "/m", LIMITS).unwrap_err();
         assert_eq!(e.pointer, "/m/learner/objective/name");
         let mut v = xgb_t1();
         v["learner"]["gradient_booster"]["model"]["trees"][0]["left_children"] = json!([1, 0, -1]);
         v["learner"]["gradient_booster"]["model"]["trees"][0]["right_children"] = json!([2, 2, -1]);
-        let e = read_xgboost(&v, "/m", LIMITS).unwrap_err();
+        let e = read_xgboost(&doc(&v), "/m", LIMITS).unwrap_err();
         assert!(e.detail.contains("reached twice"), "{e:?}");
         assert!(e.pointer.ends_with("/left_children/1"), "{e:?}");
         let mut v = xgb_t1();
         v["learner"]["gradient_booster"]["model"]["trees"][0]["right_children"] =
             json!([99, -1, -1]);
-        let e = read_xgboost(&v, "/m", LIMITS).unwrap_err();
+        let e = read_xgboost(&doc(&v), "/m", LIMITS).unwrap_err();
         assert!(e.pointer.ends_with("/right_children/0"), "{e:?}");
     }
 

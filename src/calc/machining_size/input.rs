@@ -13,6 +13,7 @@ use crate::calc::{CalcFailure, CrossRule, Validator};
 
 use super::boost::{BoostParams, Method};
 use super::data::{Matrix, n_train_rows};
+use super::doc_tree::Doc;
 use super::document::{self, DocLimits};
 use super::error::{
     DEADLINE_EXCEEDED, GRA_ZERO_MEAN, MODEL_INVALID, SMOGN_DEGENERATE_RELEVANCE, TOO_LARGE,
@@ -461,7 +462,7 @@ const LIMITS: DocLimits = DocLimits {
 };
 
 /// Reads the `model` member: `{"xgboost_json": ...}` or our document.
-fn read_model(v: &mut Validator, doc: &serde_json::Value) -> Option<Model> {
+fn read_model(v: &mut Validator, doc: &Doc) -> Option<Model> {
     let wrapped = doc.as_object().filter(|o| o.contains_key("xgboost_json"));
     let result = match wrapped {
         Some(o) => {
@@ -507,9 +508,12 @@ fn read_model(v: &mut Validator, doc: &serde_json::Value) -> Option<Model> {
 impl TryFrom<PredictRequest> for PredictInput {
     type Error = CalcFailure;
 
-    fn try_from(req: PredictRequest) -> Result<Self, CalcFailure> {
+    fn try_from(mut req: PredictRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
-        let Some(model) = read_model(&mut v, &req.model) else {
+        let model = read_model(&mut v, &req.model);
+        // The document's tree is not needed once read: free it before the work is queued.
+        req.model = Doc::Null;
+        let Some(model) = model else {
             return Err(failure(v));
         };
         let d = model.n_features;

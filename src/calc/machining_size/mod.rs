@@ -60,6 +60,7 @@
 pub mod boost;
 pub mod compute;
 pub mod data;
+pub mod doc_tree;
 pub mod document;
 pub mod error;
 pub mod gra;

@@ -710,7 +710,7 @@ pub struct PredictRequest {
     /// documents (child out of range, a cycle, depth > 64, > 1 000 000 nodes, non-finite numbers)
     /// are rejected with a pointer.
     #[schema(value_type = ModelDocument)]
-    pub model: serde_json::Value,
+    pub model: super::doc_tree::Doc,
     /// Rows to predict, 1..100 000, each with one finite value per model feature.
     #[rule(min_items = 1, max_items = MAX_PREDICT_ROWS, items_items = Range::FINITE, code = "TOO_LARGE")]
     pub rows: Vec<Vec<f64>>,
