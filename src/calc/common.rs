@@ -406,8 +406,10 @@ impl ResponseSize {
 pub const RESPONSE_TOO_LARGE: &str = "RESPONSE_TOO_LARGE";
 
 /// Every number of an answer is finite (every endpoint lists it): the last guard before an answer
-/// is sent. Reaching it is a defect of the module, logged as an error.
-pub const NON_FINITE_ANSWER_RULE: CrossRule = CrossRule::too_large(
+/// is sent (`/problems/infeasible`: these inputs describe a design whose results leave f64, e.g.
+/// a beam with E·I near 1e-300 and an infinite compliance). Reaching it is logged as an error:
+/// the module should have refused such inputs with a code of its own.
+pub const NON_FINITE_ANSWER_RULE: CrossRule = CrossRule::infeasible(
     "NON_FINITE_ANSWER",
     &[],
     "Every number of the answer is finite in f64; inputs at the extremes of their ranges whose \

@@ -625,3 +625,31 @@ async fn null_means_absent() {
     assert_eq!(untimed(&post_json(PATH, &nulls).await), defaults);
     assert_eq!(untimed(&post_json(PATH, &empty).await), defaults);
 }
+
+/// A beam so soft (E·I near 1e-300) that its static compliance leaves f64: a typed 422
+/// (`/problems/infeasible`, `NON_FINITE_ANSWER` naming the number), never a `null` or a 500;
+/// E = 1e-200 Pa still answers with finite numbers.
+#[tokio::test]
+async fn results_beyond_f64_are_refused_by_name() {
+    let r = post_json(
+        PATH,
+        &patched(&json!({"beam": {"youngs_modulus_pa": 1e-300}})),
+    )
+    .await;
+    assert_eq!(r.status, 422, "{}", String::from_utf8_lossy(&r.bytes));
+    let p = r.json();
+    assert_eq!(p["code"], "NON_FINITE_ANSWER");
+    assert_eq!(p["type"], "/problems/infeasible");
+    assert!(
+        p["detail"]
+            .as_str()
+            .is_some_and(|d| d.contains("/beam/static_compliance_m_per_n")),
+        "{p}"
+    );
+    let r = post_json(
+        PATH,
+        &patched(&json!({"beam": {"youngs_modulus_pa": 1e-200}})),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.bytes));
+}
