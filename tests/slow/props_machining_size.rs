@@ -412,3 +412,53 @@ fn training_is_bit_identical_across_thread_counts() {
     };
     assert_eq!(cv(&one), cv(&two));
 }
+
+/// Any JSON value: numbers of every kind (integers beyond i64, negative zero, fractions,
+/// exponents), strings, nested arrays (flat-number, mixed and empty) and objects with
+/// repeated keys.
+fn json_text() -> impl Strategy<Value = String> {
+    let leaf = prop_oneof![
+        Just("null".to_owned()),
+        any::<bool>().prop_map(|b| b.to_string()),
+        any::<i64>().prop_map(|i| i.to_string()),
+        any::<u64>().prop_map(|u| u.to_string()),
+        (-1e300f64..1e300).prop_map(|x| format!("{x:e}")),
+        (-1e6f64..1e6).prop_map(|x| format!("{x}")),
+        Just("-0".to_owned()),
+        Just("-0.0".to_owned()),
+        "[a-c]{0,3}".prop_map(|s| format!("\"{s}\"")),
+    ];
+    leaf.prop_recursive(4, 48, 8, |inner| {
+        prop_oneof![
+            prop::collection::vec(inner.clone(), 0..8).prop_map(|v| format!("[{}]", v.join(","))),
+            prop::collection::vec(any::<i32>(), 0..8).prop_map(|v| format!("{v:?}")),
+            prop::collection::vec(-1e3f64..1e3, 0..8).prop_map(|v| format!("{v:?}")),
+            prop::collection::vec(("[a-c]", inner), 0..6).prop_map(|kv| {
+                let m: Vec<String> = kv.iter().map(|(k, v)| format!("\"{k}\":{v}")).collect();
+                format!("{{{}}}", m.join(","))
+            }),
+        ]
+    })
+}
+
+proptest! {
+    #![proptest_config(cases(256))]
+
+    /// The model document's compact tree reads any JSON exactly as `serde_json::Value` does: the
+    /// same text back (numbers, key order, the later of repeated keys) and the same numbers
+    /// element by element.
+    #[test]
+    fn model_document_tree_is_value_exactly(text in json_text()) {
+        use mechcalc::calc::machining_size::doc_tree::Doc;
+        let value: serde_json::Value = serde_json::from_str(&text).expect("value");
+        let doc: Doc = serde_json::from_str(&text).expect("doc");
+        prop_assert_eq!(doc.to_string(), value.to_string());
+        if let Some(items) = value.as_array() {
+            prop_assert_eq!(doc.array_len(), Some(items.len()));
+            for (i, x) in items.iter().enumerate() {
+                let it = doc.item(i).expect("item");
+                prop_assert_eq!(it.number(), x.as_number());
+            }
+        }
+    }
+}
