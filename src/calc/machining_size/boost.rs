@@ -26,6 +26,17 @@ const TIE_REL: f64 = 1e-12;
 /// scheduling costs more than the scan (benches/RESULTS.md, machining_size thread sweep).
 const PAR_MIN_WORK: usize = 60_000;
 
+/// Most histogram bytes of one level alive at once: a level with more nodes is processed in
+/// batches (deep trees over many features and bins would otherwise hold gigabytes).
+const HIST_BATCH_BYTES: usize = 64 << 20;
+
+/// Most bytes of parent histograms kept for the sibling subtraction of the next level; siblings
+/// beyond it are both summed directly.
+const HIST_KEEP_BYTES: usize = 128 << 20;
+
+/// Smallest histogram build (node rows × sampled features) split into per-thread feature chunks.
+const HIST_CHUNK_WORK: usize = 32_768;
+
 /// `pos` entry of a row that no node of the current level holds (not a training row of this
 /// model, or its node is finished).
 const NONE: u32 = 0x7FFF_FFFF;
@@ -190,12 +201,23 @@ impl ExactIndex {
 }
 
 /// Binned columns for the hist method: per candidate feature the interior cut values
-/// `c_1 < … < c_{B−1}` (from the training rows) and every row's bin `#{c ≤ x}` (2 bytes per cell).
+/// `c_1 < … < c_{B−1}` (from the training rows), and every row's bins `#{c ≤ x}` stored row by
+/// row, one byte per cell when every feature has at most 256 bins (two bytes otherwise): a
+/// histogram build reads one short contiguous run per row of the node it builds.
 #[derive(Debug, Clone)]
 pub struct HistIndex {
-    n_rows: usize,
-    bins: Vec<u16>,
+    n_feat: usize,
+    bins: Bins,
     cuts: Vec<Vec<f64>>,
+}
+
+/// Row-major bin numbers (`n_rows × n_feat`).
+#[derive(Debug, Clone)]
+enum Bins {
+    /// Every feature has at most 256 bins.
+    U8(Vec<u8>),
+    /// Some feature has more than 256 bins (`max_bin` ≤ 1024).
+    U16(Vec<u16>),
 }
 
 impl HistIndex {
@@ -210,6 +232,7 @@ impl HistIndex {
         threads: usize,
     ) -> Self {
         let n = x.n_rows();
+        let nf = features.len();
         let parts = par_map(threads, features, |_, &f| {
             let col = x.col(f);
             let cuts = cut_points(rows.iter().map(|&r| col[r as usize]).collect(), max_bin);
@@ -219,21 +242,34 @@ impl HistIndex {
                 .collect();
             (cuts, bins)
         });
-        let mut bins = Vec::with_capacity(n * features.len());
-        let mut cuts = Vec::with_capacity(features.len());
-        for (c, b) in parts {
-            cuts.push(c);
-            bins.extend(b);
-        }
+        // Bin numbers run 0..=cuts.len().
+        let bins = if parts.iter().all(|(c, _)| c.len() <= usize::from(u8::MAX)) {
+            let mut b = vec![0u8; n * nf];
+            for (k, (_, col)) in parts.iter().enumerate() {
+                for (r, &v) in col.iter().enumerate() {
+                    b[r * nf + k] = u8::try_from(v).unwrap_or(u8::MAX);
+                }
+            }
+            Bins::U8(b)
+        } else {
+            let mut b = vec![0u16; n * nf];
+            for (k, (_, col)) in parts.iter().enumerate() {
+                for (r, &v) in col.iter().enumerate() {
+                    b[r * nf + k] = v;
+                }
+            }
+            Bins::U16(b)
+        };
         Self {
-            n_rows: n,
+            n_feat: nf,
             bins,
-            cuts,
+            cuts: parts.into_iter().map(|(c, _)| c).collect(),
         }
     }
 
-    fn bins(&self, k: usize) -> &[u16] {
-        &self.bins[k * self.n_rows..(k + 1) * self.n_rows]
+    /// Number of bins of candidate feature `k`.
+    fn n_bins(&self, k: usize) -> usize {
+        self.cuts[k].len() + 1
     }
 }
 
@@ -341,6 +377,18 @@ impl Boosted {
 /// was used: every further round would build the same no-op tree.
 #[must_use]
 pub fn boost(data: &TrainData<'_>, p: &BoostParams, budget: &Budget, threads: usize) -> Boosted {
+    boost_with(data, p, budget, threads, true)
+}
+
+/// [`boost`], with the hist method's sibling subtraction switchable (`subtract` false: every
+/// node's histogram summed from its own rows; the tests compare the two).
+fn boost_with(
+    data: &TrainData<'_>,
+    p: &BoostParams,
+    budget: &Budget,
+    threads: usize,
+    subtract: bool,
+) -> Boosted {
     let n = data.x.n_rows();
     let m = data.rows.len();
     let base = p.base_score.unwrap_or_else(|| {
@@ -388,7 +436,19 @@ pub fn boost(data: &TrainData<'_>, p: &BoostParams, budget: &Budget, threads: us
             let r = r as usize;
             ws.row[r].g = ws.margin[r] - ws.yc[r];
         }
-        let tree = grow(data, p, &mut ws, &cols, sampled.as_deref(), threads);
+        let tree = match data.index {
+            SplitIndex::Exact(_) => grow(data, p, &mut ws, &cols, sampled.as_deref(), threads),
+            SplitIndex::Hist(ix) => grow_hist(
+                data,
+                ix,
+                p,
+                &mut ws,
+                &cols,
+                sampled.as_deref(),
+                threads,
+                subtract,
+            ),
+        };
         let no_op = tree.nodes.len() == 1 && tree.nodes[0].value == 0.0;
         trees.push(tree);
         if no_op && deterministic {
@@ -442,6 +502,9 @@ struct BNode {
     /// Children ids (valid once split, kept after pruning to map rows).
     left: u32,
     right: u32,
+    /// The node's sampled rows: `start..end` of the tree's row list (hist method).
+    start: usize,
+    end: usize,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -518,6 +581,8 @@ fn grow(
         split: None,
         left: LEAF,
         right: LEAF,
+        start: 0,
+        end: 0,
     }];
     let expandable = |b: &BNode| b.depth < p.max_depth && b.n >= 2;
     let mut level: Vec<u32> = if expandable(&nodes[0]) {
@@ -557,6 +622,8 @@ fn grow(
                 split: None,
                 left: LEAF,
                 right: LEAF,
+                start: 0,
+                end: 0,
             });
             nodes.push(BNode {
                 g: parent.g - gl,
@@ -565,6 +632,8 @@ fn grow(
                 split: None,
                 left: LEAF,
                 right: LEAF,
+                start: 0,
+                end: 0,
             });
             let b = &mut nodes[id];
             b.split = Some(Split {
@@ -587,7 +656,396 @@ fn grow(
         route(data, ws, &level, &nodes, &child_slot);
         level = next;
     }
-    finish_tree(data, p, ws, nodes)
+    let (tree, leaf_of) = finish_tree(p, nodes);
+    for &r in data.rows {
+        let r = r as usize;
+        ws.margin[r] += tree.nodes[leaf_of[ws.node_of[r] as usize] as usize].value;
+    }
+    tree
+}
+
+/// One bin of a node's histogram: Σ g and the number of its sampled rows (= Σ h).
+#[derive(Debug, Clone, Copy, Default)]
+struct HBin {
+    g: f64,
+    n: u32,
+}
+
+/// Where a node of the level gets its histogram from.
+#[derive(Debug, Clone, Copy)]
+enum Source {
+    /// Summed over the node's own rows.
+    Build,
+    /// Its parent's histogram (`kept[parent]`) minus its sibling's (level position `sibling`,
+    /// always built directly and in the same batch).
+    Subtract { parent: usize, sibling: usize },
+}
+
+/// A node of the level being grown by the hist method.
+#[derive(Debug, Clone, Copy)]
+struct Pending {
+    id: u32,
+    from: Source,
+}
+
+/// Histogram layout of one tree: the sampled features' bins back to back, `off[j]` the first
+/// bin of `cols[j]`, `off[cols.len()]` the total.
+struct Layout {
+    off: Vec<usize>,
+}
+
+impl Layout {
+    fn new(ix: &HistIndex, cols: &[usize]) -> Self {
+        let mut off = Vec::with_capacity(cols.len() + 1);
+        let mut t = 0;
+        off.push(0);
+        for &k in cols {
+            t += ix.n_bins(k);
+            off.push(t);
+        }
+        Self { off }
+    }
+
+    fn total(&self) -> usize {
+        self.off.last().copied().unwrap_or(0)
+    }
+}
+
+/// Adds rows `rows` to the histogram `hist` of the sampled features `cols` (bins of `cols[j]`
+/// from `off[j] − off[0]`), in row order: each bin's sum runs over the node's rows in the same
+/// order whatever the chunking, so the sums do not depend on the thread count.
+fn add_rows<B: Copy>(
+    bins: &[B],
+    nf: usize,
+    rows: &[u32],
+    ws: &Workspace,
+    cols: &[usize],
+    off: &[usize],
+    hist: &mut [HBin],
+) where
+    usize: From<B>,
+{
+    let base = off[0];
+    let local: Vec<(usize, usize)> = cols.iter().zip(off).map(|(&k, &o)| (k, o - base)).collect();
+    for &r in rows {
+        let r = r as usize;
+        let g = ws.row[r].g;
+        let row = &bins[r * nf..(r + 1) * nf];
+        for &(k, o) in &local {
+            let h = &mut hist[o + usize::from(row[k])];
+            h.g += g;
+            h.n += 1;
+        }
+    }
+}
+
+/// Histogram of rows `rows` over the sampled features `cols[j0..j1]`.
+fn build_hist(
+    ix: &HistIndex,
+    layout: &Layout,
+    rows: &[u32],
+    ws: &Workspace,
+    cols: &[usize],
+    (j0, j1): (usize, usize),
+) -> Vec<HBin> {
+    let off = &layout.off[j0..=j1];
+    let mut hist = vec![HBin::default(); off[off.len() - 1] - off[0]];
+    match &ix.bins {
+        Bins::U8(b) => add_rows(b, ix.n_feat, rows, ws, &cols[j0..j1], off, &mut hist),
+        Bins::U16(b) => add_rows(b, ix.n_feat, rows, ws, &cols[j0..j1], off, &mut hist),
+    }
+    hist
+}
+
+/// Best split of one node over its histogram: per sampled feature (ascending) the boundary after
+/// every non-empty bin, θ = that bin's upper cut; features reduced in ascending order.
+fn search_hist(
+    hist: &[HBin],
+    layout: &Layout,
+    ix: &HistIndex,
+    cols: &[usize],
+    node: &BNode,
+    p: &BoostParams,
+    inv: &[f64],
+) -> Option<(usize, Cand)> {
+    let parent_score = p.score(node.g, f64::from(node.n));
+    let mut best: Option<(usize, Cand)> = None;
+    for (j, &k) in cols.iter().enumerate() {
+        let h = &hist[layout.off[j]..layout.off[j + 1]];
+        let cuts = &ix.cuts[k];
+        let mut fbest: Option<Cand> = None;
+        let (mut gl, mut nl) = (0.0, 0u32);
+        for (b, bin) in h[..h.len() - 1].iter().enumerate() {
+            gl += bin.g;
+            nl += bin.n;
+            let nr = node.n - nl;
+            if bin.n == 0 || nl == 0 || nr == 0 {
+                continue;
+            }
+            let (hl, hr) = (f64::from(nl), f64::from(nr));
+            if hl >= p.min_child_weight && hr >= p.min_child_weight {
+                let gain = fast_score(gl, nl, inv, p.reg_alpha)
+                    + fast_score(node.g - gl, nr, inv, p.reg_alpha)
+                    - parent_score;
+                if better(gain, fbest.as_ref()) {
+                    fbest = Some(Cand {
+                        gain,
+                        threshold: cuts[b],
+                        gl,
+                        nl,
+                    });
+                }
+            }
+        }
+        if let Some(c) = fbest
+            && better(c.gain, best.as_ref().map(|b| &b.1))
+        {
+            best = Some((j, c));
+        }
+    }
+    best
+}
+
+/// Grows one tree by the hist method: level by level over per-node row lists (each node's
+/// sampled rows are a contiguous run of `part`, in ascending row order), one histogram per node
+/// built from its own rows only, and with `subtract` the larger of two expandable siblings'
+/// histogram taken as parent − smaller sibling. Prunes the tree and adds its output to the
+/// margins of all training rows.
+#[expect(
+    clippy::too_many_lines,
+    reason = "one level loop: batches, histograms, search and partition share its state"
+)]
+fn grow_hist(
+    data: &TrainData<'_>,
+    ix: &HistIndex,
+    p: &BoostParams,
+    ws: &mut Workspace,
+    cols: &[usize],
+    sampled: Option<&[bool]>,
+    threads: usize,
+    subtract: bool,
+) -> Tree {
+    let mut part: Vec<u32> = Vec::with_capacity(data.rows.len());
+    let mut unsampled: Vec<u32> = Vec::new();
+    let (mut g0, mut n0) = (0.0, 0u32);
+    for &r in data.rows {
+        if sampled.is_none_or(|s| s[r as usize]) {
+            part.push(r);
+            g0 += ws.row[r as usize].g;
+            n0 += 1;
+        } else {
+            unsampled.push(r);
+        }
+    }
+    let layout = Layout::new(ix, cols);
+    let node_bytes = layout.total() * std::mem::size_of::<HBin>();
+    let batch_nodes = (HIST_BATCH_BYTES / node_bytes.max(1)).max(2);
+    let mut nodes = vec![BNode {
+        g: g0,
+        n: n0,
+        depth: 0,
+        split: None,
+        left: LEAF,
+        right: LEAF,
+        start: 0,
+        end: part.len(),
+    }];
+    let expandable = |b: &BNode| b.depth < p.max_depth && b.n >= 2;
+    let mut level: Vec<Pending> = if expandable(&nodes[0]) {
+        vec![Pending {
+            id: 0,
+            from: Source::Build,
+        }]
+    } else {
+        Vec::new()
+    };
+    let mut kept: Vec<Vec<HBin>> = Vec::new();
+    let mut tmp: Vec<u32> = Vec::new();
+    while !level.is_empty() {
+        let mut next: Vec<Pending> = Vec::new();
+        let mut next_kept: Vec<Vec<HBin>> = Vec::new();
+        let mut kept_bytes = 0;
+        let mut i0 = 0;
+        while i0 < level.len() {
+            let mut i1 = (i0 + batch_nodes).min(level.len());
+            // Siblings that share a parent histogram stay in one batch.
+            if i1 < level.len()
+                && matches!(level[i1].from, Source::Subtract { sibling, .. } if sibling + 1 == i1)
+            {
+                i1 += 1;
+            }
+            if i1 < level.len()
+                && matches!(level[i1 - 1].from, Source::Subtract { sibling, .. } if sibling == i1)
+            {
+                i1 += 1;
+            }
+            let batch = &level[i0..i1];
+            // Direct builds, split by feature chunks on big nodes.
+            let mut tasks: Vec<(usize, (usize, usize))> = Vec::new();
+            let mut work = 0;
+            for (i, w) in batch.iter().enumerate() {
+                if matches!(w.from, Source::Build) {
+                    let rows = nodes[w.id as usize].n as usize;
+                    work += rows * cols.len();
+                    let chunks = if rows * cols.len() >= HIST_CHUNK_WORK {
+                        threads.clamp(1, cols.len().max(1))
+                    } else {
+                        1
+                    };
+                    for c in 0..chunks {
+                        tasks.push((i, (c * cols.len() / chunks, (c + 1) * cols.len() / chunks)));
+                    }
+                }
+            }
+            let t = if work >= PAR_MIN_WORK { threads } else { 1 };
+            let built = par_map(t, &tasks, |_, &(i, range)| {
+                let b = &nodes[batch[i].id as usize];
+                build_hist(ix, &layout, &part[b.start..b.end], ws, cols, range)
+            });
+            let mut hists: Vec<Vec<HBin>> = vec![Vec::new(); batch.len()];
+            for (&(i, _), h) in tasks.iter().zip(built) {
+                hists[i].extend(h);
+            }
+            for (i, w) in batch.iter().enumerate() {
+                if let Source::Subtract { parent, sibling } = w.from {
+                    let mut h = std::mem::take(&mut kept[parent]);
+                    for (a, b) in h.iter_mut().zip(&hists[sibling - i0]) {
+                        a.g -= b.g;
+                        a.n -= b.n;
+                    }
+                    hists[i] = h;
+                }
+            }
+            let t = if batch.len() > 1 && batch.len() * layout.total() >= PAR_MIN_WORK {
+                threads
+            } else {
+                1
+            };
+            let best = par_map(t, batch, |i, w| {
+                search_hist(
+                    &hists[i],
+                    &layout,
+                    ix,
+                    cols,
+                    &nodes[w.id as usize],
+                    p,
+                    &ws.inv,
+                )
+            });
+            for ((w, c), hist) in batch.iter().zip(best).zip(hists) {
+                let Some((j, c)) = c.filter(|(_, c)| c.gain > KRT_EPS) else {
+                    continue;
+                };
+                let id = w.id as usize;
+                let parent = nodes[id];
+                let k = cols[j];
+                let feature = data.features[k];
+                // Stable partition of the node's rows: x < θ first.
+                let col = data.x.col(feature);
+                tmp.clear();
+                let mut wr = parent.start;
+                for i in parent.start..parent.end {
+                    let r = part[i];
+                    if col[r as usize] < c.threshold {
+                        part[wr] = r;
+                        wr += 1;
+                    } else {
+                        tmp.push(r);
+                    }
+                }
+                part[wr..parent.end].copy_from_slice(&tmp);
+                debug_assert_eq!(wr - parent.start, c.nl as usize);
+                let left = u32::try_from(nodes.len()).unwrap_or(LEAF);
+                let depth = parent.depth + 1;
+                let lnode = BNode {
+                    g: c.gl,
+                    n: c.nl,
+                    depth,
+                    split: None,
+                    left: LEAF,
+                    right: LEAF,
+                    start: parent.start,
+                    end: wr,
+                };
+                let rnode = BNode {
+                    g: parent.g - c.gl,
+                    n: parent.n - c.nl,
+                    start: wr,
+                    end: parent.end,
+                    ..lnode
+                };
+                let (le, re) = (expandable(&lnode), expandable(&rnode));
+                nodes.push(lnode);
+                nodes.push(rnode);
+                let b = &mut nodes[id];
+                b.split = Some(Split {
+                    feature,
+                    threshold: c.threshold,
+                    gain: c.gain,
+                });
+                b.left = left;
+                b.right = left + 1;
+                match (le, re) {
+                    (true, true) if subtract && kept_bytes + node_bytes <= HIST_KEEP_BYTES => {
+                        kept_bytes += node_bytes;
+                        // The smaller child is summed, the larger one subtracted.
+                        let small_left = lnode.n <= rnode.n;
+                        let s = next.len() + usize::from(!small_left);
+                        let from = Source::Subtract {
+                            parent: next_kept.len(),
+                            sibling: s,
+                        };
+                        next_kept.push(hist);
+                        for (child, is_small) in [(left, small_left), (left + 1, !small_left)] {
+                            next.push(Pending {
+                                id: child,
+                                from: if is_small { Source::Build } else { from },
+                            });
+                        }
+                    }
+                    _ => {
+                        for (child, e) in [(left, le), (left + 1, re)] {
+                            if e {
+                                next.push(Pending {
+                                    id: child,
+                                    from: Source::Build,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+            i0 = i1;
+        }
+        level = next;
+        kept = next_kept;
+    }
+    let (tree, leaf_of) = finish_tree(p, nodes.clone());
+    for (i, b) in nodes.iter().enumerate() {
+        if b.left == LEAF {
+            let v = tree.nodes[leaf_of[i] as usize].value;
+            for &r in &part[b.start..b.end] {
+                ws.margin[r as usize] += v;
+            }
+        }
+    }
+    for &r in &unsampled {
+        let r = r as usize;
+        let mut i = 0;
+        loop {
+            let nd = &tree.nodes[i];
+            if nd.is_leaf() {
+                ws.margin[r] += nd.value;
+                break;
+            }
+            i = if data.x.get(r, nd.feature as usize) < nd.threshold {
+                nd.left
+            } else {
+                nd.right
+            } as usize;
+        }
+    }
+    tree
 }
 
 /// A slot's best split over all sampled features.
@@ -617,13 +1075,10 @@ fn search_level(
     let scan = |_: usize, &k: &usize| -> Vec<Option<Cand>> {
         match data.index {
             SplitIndex::Exact(ix) => scan_exact(ix.order(k), ix.vals(k), ws, st, p),
-            SplitIndex::Hist(ix) => scan_hist(ix.bins(k), &ix.cuts[k], data.rows, ws, st, p),
+            SplitIndex::Hist(_) => unreachable!("the hist method grows its trees in grow_hist"),
         }
     };
-    let rows_scanned = match data.index {
-        SplitIndex::Exact(_) => data.x.n_rows(),
-        SplitIndex::Hist(_) => data.rows.len(),
-    };
+    let rows_scanned = data.x.n_rows();
     let per_feature: Vec<Vec<Option<Cand>>> =
         if threads > 1 && cols.len() > 1 && rows_scanned * cols.len() >= PAR_MIN_WORK {
             par_map(threads, cols, scan)
@@ -708,59 +1163,6 @@ fn scan_exact(
     acc.into_iter().map(|a| a.best).collect()
 }
 
-/// Histogram search over one binned column: the boundary after every non-empty bin of each
-/// node, ascending; θ = that bin's upper cut.
-fn scan_hist(
-    bins: &[u16],
-    cuts: &[f64],
-    rows: &[u32],
-    ws: &Workspace,
-    st: &Level,
-    p: &BoostParams,
-) -> Vec<Option<Cand>> {
-    let nslots = st.g.len();
-    let nb = cuts.len() + 1;
-    let mut hist = vec![(0.0f64, 0u32); nslots * nb];
-    let limit = u32::try_from(nslots).unwrap_or(NONE);
-    for &r in rows {
-        let r = r as usize;
-        let RowState { g, pos: s } = ws.row[r];
-        if s >= limit {
-            continue;
-        }
-        let h = &mut hist[s as usize * nb + usize::from(bins[r])];
-        h.0 += g;
-        h.1 += 1;
-    }
-    let mut out = vec![None; nslots];
-    for (s, best) in out.iter_mut().enumerate() {
-        let (mut gl, mut nl) = (0.0, 0u32);
-        for (j, &(gb, nbin)) in hist[s * nb..(s + 1) * nb - 1].iter().enumerate() {
-            gl += gb;
-            nl += nbin;
-            let nr = st.n[s] - nl;
-            if nbin == 0 || nl == 0 || nr == 0 {
-                continue;
-            }
-            let (hl, hr) = (f64::from(nl), f64::from(nr));
-            if hl >= p.min_child_weight && hr >= p.min_child_weight {
-                let gain = fast_score(gl, nl, &ws.inv, p.reg_alpha)
-                    + fast_score(st.g[s] - gl, nr, &ws.inv, p.reg_alpha)
-                    - st.parent_score[s];
-                if better(gain, best.as_ref()) {
-                    *best = Some(Cand {
-                        gain,
-                        threshold: cuts[j],
-                        gl,
-                        nl,
-                    });
-                }
-            }
-        }
-    }
-    out
-}
-
 /// Sends every training row of a split node to its child (`x < θ` → left), as prediction will.
 fn route(
     data: &TrainData<'_>,
@@ -791,13 +1193,9 @@ fn route(
     }
 }
 
-/// Leaf values, γ pruning, compaction to a breadth-first [`Tree`], and the margin update.
-fn finish_tree(
-    data: &TrainData<'_>,
-    p: &BoostParams,
-    ws: &mut Workspace,
-    mut nodes: Vec<BNode>,
-) -> Tree {
+/// Leaf values, γ pruning and compaction to a breadth-first [`Tree`]; with it, for every node
+/// under construction the index of the leaf its rows end in (meaningful for unsplit nodes).
+fn finish_tree(p: &BoostParams, mut nodes: Vec<BNode>) -> (Tree, Vec<u32>) {
     // γ pruning, bottom-up: a split whose children are both leaves and whose (un-halved) loss
     // change is below γ becomes a leaf (XGBoost's TreePruner).
     if p.gamma > 0.0 {
@@ -866,12 +1264,8 @@ fn finish_tree(
             }
         })
         .collect();
-    for &r in data.rows {
-        let r = r as usize;
-        let leaf = new_id[rep[ws.node_of[r] as usize] as usize] as usize;
-        ws.margin[r] += out[leaf].value;
-    }
-    Tree { nodes: out }
+    let leaf_of = rep.iter().map(|&i| new_id[i as usize]).collect();
+    (Tree { nodes: out }, leaf_of)
 }
 
 #[cfg(test)]
@@ -1021,6 +1415,140 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `n` rows of `d` uniform features and a nonlinear target; with `dyadic` the targets are
+    /// multiples of 1/8 (every gradient sum of a first tree with base 0 is exact in f64).
+    fn continuous(n: usize, d: usize, seed: u64, dyadic: bool) -> (Matrix, Vec<f64>) {
+        let mut r = rng::stream(seed, 3);
+        let rows: Vec<Vec<f64>> = (0..n)
+            .map(|_| (0..d).map(|_| rng::uniform(&mut r)).collect())
+            .collect();
+        let y = rows
+            .iter()
+            .map(|v| {
+                let t =
+                    (6.0 * v[0]).sin() + 2.0 * v[1] * v[2] - v[d - 1] + 0.2 * rng::uniform(&mut r);
+                if dyadic { (t * 8.0).round() / 8.0 } else { t }
+            })
+            .collect();
+        (Matrix::from_rows(rows, d), y)
+    }
+
+    fn fit_with(x: &Matrix, y: &[f64], p: &BoostParams, threads: usize, subtract: bool) -> Boosted {
+        let rows = super::super::data::all_rows(x.n_rows());
+        let features: Vec<usize> = (0..x.n_cols()).collect();
+        let index = SplitIndex::build(p.method, x, &rows, &features, threads);
+        let data = TrainData {
+            x,
+            y,
+            rows: &rows,
+            features: &features,
+            index: &index,
+        };
+        boost_with(&data, p, &Budget::unlimited(), threads, subtract)
+    }
+
+    /// Bit patterns of every node field of every tree.
+    fn bits(b: &Boosted) -> Vec<(u32, u32, u32, u64, u64, u64, u64)> {
+        b.trees
+            .iter()
+            .flat_map(|t| t.nodes.iter())
+            .map(|n| {
+                (
+                    n.left,
+                    n.right,
+                    n.feature,
+                    n.threshold.to_bits(),
+                    n.value.to_bits(),
+                    n.cover.to_bits(),
+                    n.loss_change.to_bits(),
+                )
+            })
+            .collect()
+    }
+
+    /// Issue 27: with exactly representable gradients (dyadic targets, base 0, first tree) the
+    /// histogram of a sibling taken as parent − smaller child equals its direct sum bit for bit,
+    /// so the tree is the same to the last bit (u8 bins and u16 bins).
+    #[test]
+    fn hist_subtraction_is_exact_on_representable_gradients() {
+        let (x, y) = continuous(3000, 6, 21, true);
+        for max_bin in [32, 700] {
+            let p = BoostParams {
+                method: Method::Hist { max_bin },
+                base_score: Some(0.0),
+                learning_rate: 0.5,
+                reg_lambda: 0.0,
+                ..BoostParams::xgboost(1, 6)
+            };
+            let sub = fit_with(&x, &y, &p, 2, true);
+            let direct = fit_with(&x, &y, &p, 2, false);
+            assert!(sub.trees[0].n_splits() > 20, "{}", sub.trees[0].n_splits());
+            assert_eq!(bits(&sub), bits(&direct), "max_bin {max_bin}");
+        }
+    }
+
+    /// Issue 27: over many rounds (inexact gradients, row and column sampling) the subtraction
+    /// changes the trees by round-off only: same structure and thresholds, values and loss
+    /// changes within a few ulps of the scale, predictions within 1e-12.
+    #[test]
+    fn hist_subtraction_agrees_to_round_off() {
+        let (x, y) = continuous(4000, 8, 5, false);
+        for max_bin in [64, 1000] {
+            let p = BoostParams {
+                method: Method::Hist { max_bin },
+                colsample_bytree: 0.8,
+                subsample: 0.9,
+                seed: 4,
+                ..BoostParams::xgboost(30, 6)
+            };
+            let sub = fit_with(&x, &y, &p, 2, true);
+            let direct = fit_with(&x, &y, &p, 2, false);
+            assert_eq!(sub.trees.len(), direct.trees.len());
+            for (a, b) in sub.trees.iter().zip(&direct.trees) {
+                assert_eq!(a.nodes.len(), b.nodes.len());
+                for (u, v) in a.nodes.iter().zip(&b.nodes) {
+                    assert_eq!((u.left, u.right, u.feature), (v.left, v.right, v.feature));
+                    assert_eq!(u.threshold.to_bits(), v.threshold.to_bits());
+                    assert_eq!(u.cover.to_bits(), v.cover.to_bits());
+                    assert!(
+                        (u.value - v.value).abs() <= 1e-13,
+                        "{} {}",
+                        u.value,
+                        v.value
+                    );
+                    let tol = 1e-11 * u.loss_change.abs().max(1.0);
+                    assert!((u.loss_change - v.loss_change).abs() <= tol);
+                }
+            }
+            let worst = (0..x.n_rows())
+                .map(|r| {
+                    let row = x.row(r);
+                    let f = |b: &Boosted| b.trees.iter().map(|t| t.predict(&row)).sum::<f64>();
+                    (f(&sub) - f(&direct)).abs()
+                })
+                .fold(0.0f64, f64::max);
+            assert!(worst <= 1e-12, "max_bin {max_bin}: {worst:e}");
+        }
+    }
+
+    /// The hist trees are bit-identical for 1 and 2 threads (feature chunks of one histogram,
+    /// nodes of one level searched in parallel), with the work above the parallel thresholds.
+    #[test]
+    fn hist_is_bit_identical_across_thread_counts() {
+        let (x, y) = continuous(6000, 24, 8, false);
+        let p = BoostParams {
+            method: Method::Hist { max_bin: 256 },
+            colsample_bytree: 0.7,
+            subsample: 0.8,
+            seed: 9,
+            ..BoostParams::xgboost(8, 6)
+        };
+        let one = fit_with(&x, &y, &p, 1, true);
+        let two = fit_with(&x, &y, &p, 2, true);
+        assert!(one.trees.iter().all(|t| t.n_splits() > 10));
+        assert_eq!(bits(&one), bits(&two));
     }
 
     #[test]
