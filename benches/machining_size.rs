@@ -237,8 +237,9 @@ fn sweep_training(paper: &Set, reference: Option<&Value>) {
             let xt = refnum(reference, &format!("{key}/train_ms"));
             let xf = refnum(reference, &format!("{key}/fit_ms"));
             println!(
-                "| paper-sized 850 × 8 | {label}, 400 trees ({} effective) | {threads} | {} | {:.1} | {} | {} | {} |",
+                "| paper-sized 850 × 8 | {label}, 400 trees ({} effective, digest {:016x}) | {threads} | {} | {:.1} | {} | {} | {} |",
                 b.trees.iter().filter(|t| t.n_splits() > 0).count(),
+                digest(&b),
                 ms(&t),
                 tr.median_ms(),
                 opt(xt, 1),
@@ -247,6 +248,21 @@ fn sweep_training(paper: &Set, reference: Option<&Value>) {
             );
         }
     }
+}
+
+/// A digest of every bit of a model's trees (node links, features, thresholds, values, covers,
+/// loss changes): equal digests from two builds of the trainer mean byte-identical models.
+fn digest(b: &Boosted) -> u64 {
+    use std::hash::{DefaultHasher, Hash, Hasher};
+    let mut h = DefaultHasher::new();
+    b.base_score.to_bits().hash(&mut h);
+    for n in b.trees.iter().flat_map(|t| t.nodes.iter()) {
+        (n.left, n.right, n.feature).hash(&mut h);
+        for v in [n.threshold, n.value, n.cover, n.loss_change] {
+            v.to_bits().hash(&mut h);
+        }
+    }
+    h.finish()
 }
 
 /// Training time and test RMSE at 10⁴, 10⁵ and 2·10⁵ rows × 20 continuous features against
@@ -260,9 +276,9 @@ fn sweep_large(sets: &[&Set], reference: Option<&Value>) {
     );
     println!("load average at start: {}", load().trim());
     println!(
-        "| rows × features | method | ours ms (all rows) | ours µs/row | XGBoost `train` ms | XGBoost µs/row | ratio XGBoost/ours | ours test RMSE (fold 0) | XGBoost test RMSE | RMSE ours/XGBoost − 1 |"
+        "| rows × features | method | ours ms (all rows) | ours µs/row | XGBoost `train` ms | XGBoost µs/row | ratio XGBoost/ours | ours test RMSE (fold 0) | XGBoost test RMSE | RMSE ours/XGBoost − 1 | model digest (all rows) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for s in sets {
         let x = s.matrix();
         let all = all_rows(s.n);
@@ -285,7 +301,7 @@ fn sweep_large(sets: &[&Set], reference: Option<&Value>) {
                 ..table2(400, 1.0)
             };
             let runs = if s.n <= 10_000 { 3 } else { 1 };
-            let (t, _) = time_runs(runs, || fit(&x, &s.y, &all, &p, 2));
+            let (t, full) = time_runs(runs, || fit(&x, &s.y, &all, &p, 2));
             let m = fit(&x, &s.y, &train, &p, 2).into_model(s.d, Vec::new());
             let pred: Vec<f64> = test
                 .iter()
@@ -298,7 +314,7 @@ fn sweep_large(sets: &[&Set], reference: Option<&Value>) {
             let xr = refnum(reference, &format!("{k}/rmse"));
             let per_row = |ms: f64| ms * 1e3 / s.n as f64;
             println!(
-                "| {} × {} | {key} | {:.0} | {:.1} | {} | {} | {} | {rmse:.6} | {} | {} |",
+                "| {} × {} | {key} | {:.0} | {:.1} | {} | {} | {} | {rmse:.6} | {} | {} | {:016x} |",
                 s.n,
                 s.d,
                 t.median_ms(),
@@ -311,6 +327,7 @@ fn sweep_large(sets: &[&Set], reference: Option<&Value>) {
                     "{:+.2} %",
                     (rmse / v - 1.0) * 100.0
                 )),
+                digest(&full),
             );
         }
     }

@@ -4,10 +4,25 @@
 //! XGBoost's split threshold 1e-6 (`kRtEps`) and its γ pruning with the un-halved loss change.
 //!
 //! Growing level by level gives the same trees as the spec's depth-first description (a node's
-//! split depends only on its own rows) and numbers the nodes breadth-first as XGBoost does. The
-//! split search of one level runs over the sampled features with [`par_map`] when the level is
-//! large enough to pay for it; the per-feature results are reduced in ascending feature order, so
-//! the trees are bit-identical for any thread count.
+//! split depends only on its own rows) and numbers the nodes breadth-first as XGBoost does.
+//! Every node's sampled rows are one contiguous run of the tree's row list (hist) or of every
+//! working column (exact), partitioned stably when the node splits, so a level touches only the
+//! rows of its open nodes, in ascending row (hist) or value (exact) order.
+//!
+//! * exact: each sampled feature's working column holds (value, gradient, row) in ascending
+//!   value order; a level partitions the runs split by the previous level and scans the open
+//!   runs, one feature per task on the compute threads ([`par_map`]).
+//! * hist: bins are built once per model, row-major (one byte per cell when every feature has
+//!   at most 256 bins). A node's histogram is summed from its own rows only, and of two
+//!   expandable siblings only the smaller one is summed: the other is the parent's histogram
+//!   minus it (counts exact, gradient sums equal to round-off). Histogram builds (split into
+//!   feature chunks) and node searches run on the compute threads.
+//!
+//! Every parallel result is a sum in a fixed order (bins over a node's rows in row order; the
+//! per-feature bests reduced in ascending feature order), so the trees are bit-identical for any
+//! thread count.
+
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use crate::numerics::{Budget, StopReason, par_map};
 
@@ -36,13 +51,6 @@ const HIST_KEEP_BYTES: usize = 128 << 20;
 
 /// Smallest histogram build (node rows × sampled features) split into per-thread feature chunks.
 const HIST_CHUNK_WORK: usize = 32_768;
-
-/// `pos` entry of a row that no node of the current level holds (not a training row of this
-/// model, or its node is finished).
-const NONE: u32 = 0x7FFF_FFFF;
-/// `pos` flag of a training row left out of this tree by row subsampling: it is routed like the
-/// others (its margin must be updated) but never counted in the split search.
-const UNSAMPLED: u32 = 0x8000_0000;
 
 /// Split-search method (spec §2.1 `tree_method`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -397,14 +405,19 @@ fn boost_with(
     let mut ws = Workspace {
         yc: data.y.iter().map(|&y| y - base).collect(),
         margin: vec![0.0; n],
-        row: vec![RowState { g: 0.0, pos: NONE }; n],
-        node_of: vec![0; n],
+        g: vec![0.0; n],
         inv: (0..=m)
             .map(|c| {
                 let h = c as f64 + p.reg_lambda;
                 if h > 0.0 { 1.0 / h } else { 0.0 }
             })
             .collect(),
+        columns: match data.index {
+            SplitIndex::Exact(_) => (0..data.features.len())
+                .map(|_| Mutex::new(Vec::new()))
+                .collect(),
+            SplitIndex::Hist(_) => Vec::new(),
+        },
     };
     let mut rng = rng::stream(p.seed, rng::STREAM_SAMPLING);
     let d = data.features.len();
@@ -434,10 +447,12 @@ fn boost_with(
         });
         for &r in data.rows {
             let r = r as usize;
-            ws.row[r].g = ws.margin[r] - ws.yc[r];
+            ws.g[r] = ws.margin[r] - ws.yc[r];
         }
         let tree = match data.index {
-            SplitIndex::Exact(_) => grow(data, p, &mut ws, &cols, sampled.as_deref(), threads),
+            SplitIndex::Exact(ix) => {
+                grow_exact(data, ix, p, &mut ws, &cols, sampled.as_deref(), threads)
+            }
             SplitIndex::Hist(ix) => grow_hist(
                 data,
                 ix,
@@ -469,24 +484,15 @@ struct Workspace {
     yc: Vec<f64>,
     /// Σ tree outputs so far (margin without base).
     margin: Vec<f64>,
-    /// Gradient and level slot of every row, side by side: the split search reads both for each
-    /// entry of a sorted column, so one cache line serves both.
-    row: Vec<RowState>,
-    /// The row's node in the tree under construction.
-    node_of: Vec<u32>,
+    /// Gradient g = margin − yc of every row (hessians are 1).
+    g: Vec<f64>,
     /// 1/(c + λ) for every row count c: hessians are 1, so H is a count and the split search
     /// multiplies instead of dividing twice per boundary (scores agree with the division to
     /// 1 ulp; the tie tolerance absorbs that).
     inv: Vec<f64>,
-}
-
-/// Gradient (hessian 1) and level slot of one row.
-#[derive(Debug, Clone, Copy)]
-struct RowState {
-    /// g = margin − yc.
-    g: f64,
-    /// Slot of the row's node in the current level (or [`NONE`], with [`UNSAMPLED`]).
-    pos: u32,
+    /// The exact method's working column of every candidate feature (reused tree after tree;
+    /// one lock each so that the compute threads can each own some of them).
+    columns: Vec<Mutex<Vec<Entry>>>,
 }
 
 /// A node under construction.
@@ -502,7 +508,8 @@ struct BNode {
     /// Children ids (valid once split, kept after pruning to map rows).
     left: u32,
     right: u32,
-    /// The node's sampled rows: `start..end` of the tree's row list (hist method).
+    /// The node's sampled rows: `start..end` of the tree's row list (hist) or of every working
+    /// column (exact).
     start: usize,
     end: usize,
 }
@@ -544,35 +551,136 @@ fn midpoint(lo: f64, hi: f64) -> f64 {
     if m > lo { m } else { hi }
 }
 
-/// Sums of the nodes of one level, by slot.
-struct Level {
-    g: Vec<f64>,
-    n: Vec<u32>,
-    parent_score: Vec<f64>,
+/// One entry of a tree's working column (exact method): a sampled training row's value of the
+/// feature and its gradient, stored side by side so the split search reads the column
+/// sequentially, without looking the gradient up by row.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    x: f64,
+    g: f64,
+    r: u32,
 }
 
-/// Grows one tree over the sampled candidate features `cols` (positions in `data.features`)
-/// and the sampled rows (`None`: all training rows), prunes it, and adds its output to the
-/// margins of all training rows.
-fn grow(
+/// Locks a working column (a poisoned lock means another worker panicked; that panic is re-raised
+/// by the parallel map, so the data are never read after it).
+fn lock(c: &Mutex<Vec<Entry>>) -> MutexGuard<'_, Vec<Entry>> {
+    c.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Stable partition of every segment `start..end` of `col` in `splits`: rows with `left[r]`
+/// first, each side in its previous (ascending value) order.
+fn partition(col: &mut [Entry], splits: &[(usize, usize)], left: &[bool], tmp: &mut Vec<Entry>) {
+    for &(start, end) in splits {
+        tmp.clear();
+        let mut w = start;
+        for i in start..end {
+            let e = col[i];
+            if left[e.r as usize] {
+                col[w] = e;
+                w += 1;
+            } else {
+                tmp.push(e);
+            }
+        }
+        col[w..end].copy_from_slice(tmp);
+    }
+}
+
+/// Exact search over one node's run of a working column (ascending values): every boundary
+/// between consecutive distinct values, ascending; the first of tied candidates wins.
+fn scan_exact(
+    seg: &[Entry],
+    node: &BNode,
+    parent_score: f64,
+    p: &BoostParams,
+    inv: &[f64],
+) -> Option<Cand> {
+    let (mut gl, mut nl, mut last) = (0.0, 0u32, 0.0);
+    let mut best: Option<Cand> = None;
+    for e in seg {
+        if nl > 0 && e.x > last {
+            let nr = node.n - nl;
+            let (hl, hr) = (f64::from(nl), f64::from(nr));
+            if hl >= p.min_child_weight && hr >= p.min_child_weight {
+                let gain = fast_score(gl, nl, inv, p.reg_alpha)
+                    + fast_score(node.g - gl, nr, inv, p.reg_alpha)
+                    - parent_score;
+                if better(gain, best.as_ref()) {
+                    best = Some(Cand {
+                        gain,
+                        threshold: midpoint(last, e.x),
+                        gl,
+                        nl,
+                    });
+                }
+            }
+        }
+        gl += e.g;
+        nl += 1;
+        last = e.x;
+    }
+    best
+}
+
+/// Grows one tree by the exact method over the sampled candidate features `cols` (positions in
+/// `data.features`) and the sampled rows (`None`: all training rows), prunes it, and adds its
+/// output to the margins of all training rows.
+///
+/// Each sampled feature has a working column: the tree's sampled rows in ascending order of the
+/// feature (the pre-sorted index filtered once per tree) with their gradients. Every node's rows
+/// are one run `start..end` of every column, and a split partitions its run stably, so a level
+/// scans only the rows of its open nodes, sequentially, and in the order the whole-column scan
+/// visited them (the same sums, the same trees to the bit). The per-feature work (partition of
+/// the last level's splits, then the scan of this level's nodes) runs on the compute threads;
+/// the per-feature bests are reduced in ascending feature order.
+#[expect(
+    clippy::too_many_lines,
+    reason = "one level loop: partition, search and node bookkeeping share its state"
+)]
+fn grow_exact(
     data: &TrainData<'_>,
+    ix: &ExactIndex,
     p: &BoostParams,
     ws: &mut Workspace,
     cols: &[usize],
     sampled: Option<&[bool]>,
     threads: usize,
 ) -> Tree {
+    let n = data.x.n_rows();
+    let mut used = vec![false; n];
+    let mut unsampled: Vec<u32> = Vec::new();
     let (mut g0, mut n0) = (0.0, 0u32);
     for &r in data.rows {
-        let r = r as usize;
-        ws.node_of[r] = 0;
-        if sampled.is_none_or(|s| s[r]) {
-            ws.row[r].pos = 0;
-            g0 += ws.row[r].g;
+        if sampled.is_none_or(|s| s[r as usize]) {
+            used[r as usize] = true;
+            g0 += ws.g[r as usize];
             n0 += 1;
         } else {
-            ws.row[r].pos = UNSAMPLED;
+            unsampled.push(r);
         }
+    }
+    let fill_threads = if n * cols.len() >= PAR_MIN_WORK {
+        threads
+    } else {
+        1
+    };
+    {
+        let (g, used) = (&ws.g, &used);
+        par_map(fill_threads, cols, |_, &k| {
+            let mut c = lock(&ws.columns[k]);
+            c.clear();
+            c.extend(
+                ix.order(k)
+                    .iter()
+                    .zip(ix.vals(k))
+                    .filter(|&(&r, _)| used[r as usize])
+                    .map(|(&r, &x)| Entry {
+                        x,
+                        g: g[r as usize],
+                        r,
+                    }),
+            );
+        });
     }
     let mut nodes = vec![BNode {
         g: g0,
@@ -582,7 +690,7 @@ fn grow(
         left: LEAF,
         right: LEAF,
         start: 0,
-        end: 0,
+        end: n0 as usize,
     }];
     let expandable = |b: &BNode| b.depth < p.max_depth && b.n >= 2;
     let mut level: Vec<u32> = if expandable(&nodes[0]) {
@@ -590,78 +698,143 @@ fn grow(
     } else {
         Vec::new()
     };
+    // Runs split by the previous level (partitioned at the start of the next one) and the side
+    // of each of their rows.
+    let mut splits: Vec<(usize, usize)> = Vec::new();
+    let mut left = vec![false; n];
     while !level.is_empty() {
-        let stats = Level {
-            g: level.iter().map(|&i| nodes[i as usize].g).collect(),
-            n: level.iter().map(|&i| nodes[i as usize].n).collect(),
-            parent_score: level
-                .iter()
-                .map(|&i| {
-                    let b = &nodes[i as usize];
-                    p.score(b.g, f64::from(b.n))
-                })
-                .collect(),
+        let stats: Vec<(BNode, f64)> = level
+            .iter()
+            .map(|&i| {
+                let b = nodes[i as usize];
+                (b, p.score(b.g, f64::from(b.n)))
+            })
+            .collect();
+        let work = (stats.iter().map(|(b, _)| b.n as usize).sum::<usize>()
+            + splits.iter().map(|&(s, e)| e - s).sum::<usize>())
+            * cols.len();
+        let t = if cols.len() > 1 && work >= PAR_MIN_WORK {
+            threads
+        } else {
+            1
         };
-        let best = search_level(data, p, ws, cols, &stats, threads);
-        // Children of each slot: their slot in the next level, or NONE.
+        let per_feature: Vec<Vec<Option<Cand>>> = {
+            let (splits, left, inv) = (&splits, &left, &ws.inv);
+            par_map(t, cols, |_, &k| {
+                let mut c = lock(&ws.columns[k]);
+                let mut tmp = Vec::new();
+                partition(&mut c, splits, left, &mut tmp);
+                stats
+                    .iter()
+                    .map(|(b, ps)| scan_exact(&c[b.start..b.end], b, *ps, p, inv))
+                    .collect()
+            })
+        };
+        let mut best: Vec<Option<(usize, Cand)>> = vec![None; level.len()];
+        for (j, res) in per_feature.iter().enumerate() {
+            for (s, c) in res.iter().enumerate() {
+                if let Some(c) = c
+                    && better(c.gain, best[s].as_ref().map(|b| &b.1))
+                {
+                    best[s] = Some((j, *c));
+                }
+            }
+        }
+        splits.clear();
         let mut next: Vec<u32> = Vec::new();
-        let mut child_slot: Vec<(u32, u32)> = vec![(NONE, NONE); level.len()];
         for (s, c) in best.iter().enumerate() {
-            let Some(c) = c.filter(|c| c.gain > KRT_EPS) else {
+            let Some((j, c)) = c.filter(|(_, c)| c.gain > KRT_EPS) else {
                 continue;
             };
             let id = level[s] as usize;
-            let (k, depth) = (c.feature, nodes[id].depth + 1);
-            let left = u32::try_from(nodes.len()).unwrap_or(LEAF);
-            let (gl, nl) = (c.cand.gl, c.cand.nl);
             let parent = nodes[id];
-            nodes.push(BNode {
-                g: gl,
-                n: nl,
-                depth,
+            let k = cols[j];
+            // The split feature's run is sorted: its first nl rows go left.
+            {
+                let col = lock(&ws.columns[k]);
+                let mid = parent.start + c.nl as usize;
+                for e in &col[parent.start..mid] {
+                    left[e.r as usize] = true;
+                }
+                for e in &col[mid..parent.end] {
+                    left[e.r as usize] = false;
+                }
+            }
+            splits.push((parent.start, parent.end));
+            let lid = u32::try_from(nodes.len()).unwrap_or(LEAF);
+            let mid = parent.start + c.nl as usize;
+            let lnode = BNode {
+                g: c.gl,
+                n: c.nl,
+                depth: parent.depth + 1,
                 split: None,
                 left: LEAF,
                 right: LEAF,
-                start: 0,
-                end: 0,
-            });
-            nodes.push(BNode {
-                g: parent.g - gl,
-                n: parent.n - nl,
-                depth,
-                split: None,
-                left: LEAF,
-                right: LEAF,
-                start: 0,
-                end: 0,
-            });
+                start: parent.start,
+                end: mid,
+            };
+            let rnode = BNode {
+                g: parent.g - c.gl,
+                n: parent.n - c.nl,
+                start: mid,
+                end: parent.end,
+                ..lnode
+            };
+            for (child, b) in [(lid, lnode), (lid + 1, rnode)] {
+                if expandable(&b) {
+                    next.push(child);
+                }
+            }
+            nodes.push(lnode);
+            nodes.push(rnode);
             let b = &mut nodes[id];
             b.split = Some(Split {
                 feature: data.features[k],
-                threshold: c.cand.threshold,
-                gain: c.cand.gain,
+                threshold: c.threshold,
+                gain: c.gain,
             });
-            b.left = left;
-            b.right = left + 1;
-            let mut slot_of = |child: u32| {
-                if expandable(&nodes[child as usize]) {
-                    next.push(child);
-                    u32::try_from(next.len() - 1).unwrap_or(NONE)
-                } else {
-                    NONE
-                }
-            };
-            child_slot[s] = (slot_of(left), slot_of(left + 1));
+            b.left = lid;
+            b.right = lid + 1;
         }
-        route(data, ws, &level, &nodes, &child_slot);
         level = next;
     }
-    let (tree, leaf_of) = finish_tree(p, nodes);
-    for &r in data.rows {
-        let r = r as usize;
-        ws.margin[r] += tree.nodes[leaf_of[ws.node_of[r] as usize] as usize].value;
+    let (tree, leaf_of) = finish_tree(p, nodes.clone());
+    // The margins, from the runs of the unsplit nodes in one column (the last level's splits
+    // partitioned there first).
+    let mut col = lock(&ws.columns[cols[0]]);
+    partition(&mut col, &splits, &left, &mut Vec::new());
+    for (i, b) in nodes.iter().enumerate() {
+        if b.left == LEAF {
+            let v = tree.nodes[leaf_of[i] as usize].value;
+            for e in &col[b.start..b.end] {
+                ws.margin[e.r as usize] += v;
+            }
+        }
     }
+    drop(col);
+    add_by_traversal(data, &tree, &unsampled, &mut ws.margin);
     tree
+}
+
+/// Adds the output of `tree` to the margins of rows `rows` (rows left out by row sampling,
+/// routed as prediction routes them).
+fn add_by_traversal(data: &TrainData<'_>, tree: &Tree, rows: &[u32], margin: &mut [f64]) {
+    for &r in rows {
+        let r = r as usize;
+        let mut i = 0;
+        loop {
+            let nd = &tree.nodes[i];
+            if nd.is_leaf() {
+                margin[r] += nd.value;
+                break;
+            }
+            i = if data.x.get(r, nd.feature as usize) < nd.threshold {
+                nd.left
+            } else {
+                nd.right
+            } as usize;
+        }
+    }
 }
 
 /// One bin of a node's histogram: Σ g and the number of its sampled rows (= Σ h).
@@ -729,7 +902,7 @@ fn add_rows<B: Copy>(
     let local: Vec<(usize, usize)> = cols.iter().zip(off).map(|(&k, &o)| (k, o - base)).collect();
     for &r in rows {
         let r = r as usize;
-        let g = ws.row[r].g;
+        let g = ws.g[r];
         let row = &bins[r * nf..(r + 1) * nf];
         for &(k, o) in &local {
             let h = &mut hist[o + usize::from(row[k])];
@@ -831,7 +1004,7 @@ fn grow_hist(
     for &r in data.rows {
         if sampled.is_none_or(|s| s[r as usize]) {
             part.push(r);
-            g0 += ws.row[r as usize].g;
+            g0 += ws.g[r as usize];
             n0 += 1;
         } else {
             unsampled.push(r);
@@ -1029,168 +1202,8 @@ fn grow_hist(
             }
         }
     }
-    for &r in &unsampled {
-        let r = r as usize;
-        let mut i = 0;
-        loop {
-            let nd = &tree.nodes[i];
-            if nd.is_leaf() {
-                ws.margin[r] += nd.value;
-                break;
-            }
-            i = if data.x.get(r, nd.feature as usize) < nd.threshold {
-                nd.left
-            } else {
-                nd.right
-            } as usize;
-        }
-    }
+    add_by_traversal(data, &tree, &unsampled, &mut ws.margin);
     tree
-}
-
-/// A slot's best split over all sampled features.
-#[derive(Debug, Clone, Copy)]
-struct Best {
-    /// Position in `cols`.
-    feature: usize,
-    cand: Cand,
-}
-
-impl std::ops::Deref for Best {
-    type Target = Cand;
-    fn deref(&self) -> &Cand {
-        &self.cand
-    }
-}
-
-/// Best candidate per slot of the level, over the sampled features in ascending order.
-fn search_level(
-    data: &TrainData<'_>,
-    p: &BoostParams,
-    ws: &Workspace,
-    cols: &[usize],
-    st: &Level,
-    threads: usize,
-) -> Vec<Option<Best>> {
-    let scan = |_: usize, &k: &usize| -> Vec<Option<Cand>> {
-        match data.index {
-            SplitIndex::Exact(ix) => scan_exact(ix.order(k), ix.vals(k), ws, st, p),
-            SplitIndex::Hist(_) => unreachable!("the hist method grows its trees in grow_hist"),
-        }
-    };
-    let rows_scanned = data.x.n_rows();
-    let per_feature: Vec<Vec<Option<Cand>>> =
-        if threads > 1 && cols.len() > 1 && rows_scanned * cols.len() >= PAR_MIN_WORK {
-            par_map(threads, cols, scan)
-        } else {
-            cols.iter().enumerate().map(|(i, k)| scan(i, k)).collect()
-        };
-    let mut best: Vec<Option<Best>> = vec![None; st.g.len()];
-    for (i, res) in per_feature.iter().enumerate() {
-        for (s, c) in res.iter().enumerate() {
-            if let Some(c) = c
-                && better(c.gain, best[s].as_ref().map(|b| &b.cand))
-            {
-                best[s] = Some(Best {
-                    feature: i,
-                    cand: *c,
-                });
-            }
-        }
-    }
-    // Map positions in `cols` back to candidate positions.
-    for b in best.iter_mut().flatten() {
-        b.feature = cols[b.feature];
-    }
-    best
-}
-
-/// Exact search over one pre-sorted column: every boundary between consecutive distinct values of
-/// each node's sampled rows, ascending.
-fn scan_exact(
-    order: &[u32],
-    vals: &[f64],
-    ws: &Workspace,
-    st: &Level,
-    p: &BoostParams,
-) -> Vec<Option<Cand>> {
-    #[derive(Clone, Copy)]
-    struct Acc {
-        gl: f64,
-        nl: u32,
-        last: f64,
-        best: Option<Cand>,
-    }
-    let nslots = st.g.len();
-    let mut acc = vec![
-        Acc {
-            gl: 0.0,
-            nl: 0,
-            last: 0.0,
-            best: None,
-        };
-        nslots
-    ];
-    let limit = u32::try_from(nslots).unwrap_or(NONE);
-    for (&r, &x) in order.iter().zip(vals) {
-        let RowState { g, pos: s } = ws.row[r as usize];
-        if s >= limit {
-            continue;
-        }
-        let s = s as usize;
-        let a = &mut acc[s];
-        if a.nl > 0 && x > a.last {
-            let nr = st.n[s] - a.nl;
-            let (hl, hr) = (f64::from(a.nl), f64::from(nr));
-            if hl >= p.min_child_weight && hr >= p.min_child_weight {
-                let gain = fast_score(a.gl, a.nl, &ws.inv, p.reg_alpha)
-                    + fast_score(st.g[s] - a.gl, nr, &ws.inv, p.reg_alpha)
-                    - st.parent_score[s];
-                if better(gain, a.best.as_ref()) {
-                    a.best = Some(Cand {
-                        gain,
-                        threshold: midpoint(a.last, x),
-                        gl: a.gl,
-                        nl: a.nl,
-                    });
-                }
-            }
-        }
-        a.gl += g;
-        a.nl += 1;
-        a.last = x;
-    }
-    acc.into_iter().map(|a| a.best).collect()
-}
-
-/// Sends every training row of a split node to its child (`x < θ` → left), as prediction will.
-fn route(
-    data: &TrainData<'_>,
-    ws: &mut Workspace,
-    level: &[u32],
-    nodes: &[BNode],
-    child_slot: &[(u32, u32)],
-) {
-    let limit = u32::try_from(level.len()).unwrap_or(NONE);
-    for &r in data.rows {
-        let r = r as usize;
-        let p = ws.row[r].pos;
-        let s = p & !UNSAMPLED;
-        if s >= limit {
-            continue;
-        }
-        let b = &nodes[level[s as usize] as usize];
-        let Some(split) = b.split else {
-            ws.row[r].pos = NONE | (p & UNSAMPLED);
-            continue;
-        };
-        let (left, (ls, rs)) = (
-            data.x.get(r, split.feature) < split.threshold,
-            child_slot[s as usize],
-        );
-        ws.node_of[r] = if left { b.left } else { b.right };
-        ws.row[r].pos = (if left { ls } else { rs }) | (p & UNSAMPLED);
-    }
 }
 
 /// Leaf values, γ pruning and compaction to a breadth-first [`Tree`]; with it, for every node
