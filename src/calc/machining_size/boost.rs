@@ -49,6 +49,9 @@ const HIST_BATCH_BYTES: usize = 64 << 20;
 /// beyond it are both summed directly.
 const HIST_KEEP_BYTES: usize = 128 << 20;
 
+/// Histogram slots per feature with one-byte bins (every bin number indexes them).
+const U8_SLOTS: usize = 256;
+
 /// Smallest histogram build (node rows × sampled features) split into per-thread feature chunks.
 const HIST_CHUNK_WORK: usize = 32_768;
 
@@ -533,15 +536,23 @@ struct Cand {
 }
 
 /// score(G, H) of a child with H = `count` ≥ min_child_weight rows: T_α(G)²·(1/(H + λ)).
+/// Branch-free: |T_α(G)| = max(|G| − α, 0), bit for bit (rounding is symmetric in sign), and
+/// the sign does not matter once squared.
 fn fast_score(g: f64, count: u32, inv: &[f64], alpha: f64) -> f64 {
-    let t = soft_threshold(g, alpha);
+    let t = (g.abs() - alpha).max(0.0);
     t * t * inv[count as usize]
+}
+
+/// The loss change a candidate must exceed to replace a best of loss change `best` (see
+/// [`better`]); the scans keep it beside their best instead of recomputing it per boundary.
+fn bar(best: f64) -> f64 {
+    best + TIE_REL * best.abs().max(1.0)
 }
 
 /// Whether a candidate with loss change `gain` replaces `best` (strictly better beyond the tie
 /// tolerance; the first found keeps a tie).
 fn better(gain: f64, best: Option<&Cand>) -> bool {
-    best.is_none_or(|b| gain > b.gain + TIE_REL * b.gain.abs().max(1.0))
+    best.is_none_or(|b| gain > bar(b.gain))
 }
 
 /// The midpoint of two consecutive distinct values, nudged up to `hi` when rounding put it on
@@ -571,18 +582,27 @@ fn lock(c: &Mutex<Vec<Entry>>) -> MutexGuard<'_, Vec<Entry>> {
 /// first, each side in its previous (ascending value) order.
 fn partition(col: &mut [Entry], splits: &[(usize, usize)], left: &[bool], tmp: &mut Vec<Entry>) {
     for &(start, end) in splits {
+        // Branch-free (the sides are as good as random): both sides are written, the index of
+        // the other side stays.
         tmp.clear();
-        let mut w = start;
+        tmp.resize(
+            end - start,
+            Entry {
+                x: 0.0,
+                g: 0.0,
+                r: 0,
+            },
+        );
+        let (mut w, mut t) = (start, 0);
         for i in start..end {
             let e = col[i];
-            if left[e.r as usize] {
-                col[w] = e;
-                w += 1;
-            } else {
-                tmp.push(e);
-            }
+            let l = left[e.r as usize];
+            col[w] = e;
+            tmp[t] = e;
+            w += usize::from(l);
+            t += usize::from(!l);
         }
-        col[w..end].copy_from_slice(tmp);
+        col[w..end].copy_from_slice(&tmp[..t]);
     }
 }
 
@@ -597,6 +617,7 @@ fn scan_exact(
 ) -> Option<Cand> {
     let (mut gl, mut nl, mut last) = (0.0, 0u32, 0.0);
     let mut best: Option<Cand> = None;
+    let mut need = f64::NEG_INFINITY;
     for e in seg {
         if nl > 0 && e.x > last {
             let nr = node.n - nl;
@@ -605,13 +626,14 @@ fn scan_exact(
                 let gain = fast_score(gl, nl, inv, p.reg_alpha)
                     + fast_score(node.g - gl, nr, inv, p.reg_alpha)
                     - parent_score;
-                if better(gain, best.as_ref()) {
+                if gain > need {
                     best = Some(Cand {
                         gain,
                         threshold: midpoint(last, e.x),
                         gl,
                         nl,
                     });
+                    need = bar(gain);
                 }
             }
         }
@@ -837,11 +859,34 @@ fn add_by_traversal(data: &TrainData<'_>, tree: &Tree, rows: &[u32], margin: &mu
     }
 }
 
-/// One bin of a node's histogram: Σ g and the number of its sampled rows (= Σ h).
+/// One bin of a node's histogram: Σ g and the number of its sampled rows (= Σ h, an integer
+/// held exactly in f64), side by side so that one row's update is one two-lane add.
 #[derive(Debug, Clone, Copy, Default)]
-struct HBin {
-    g: f64,
-    n: u32,
+struct HBin([f64; 2]);
+
+impl HBin {
+    /// Adds one row of gradient `g`.
+    #[inline]
+    fn add(&mut self, g: f64) {
+        let [a, b] = &mut self.0;
+        *a += g;
+        *b += 1.0;
+    }
+
+    /// Σ g.
+    fn g(self) -> f64 {
+        self.0[0]
+    }
+
+    /// The row count (exact: below 2^32).
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        reason = "a count of rows, an exact non-negative integer below 2^32"
+    )]
+    fn n(self) -> u32 {
+        self.0[1] as u32
+    }
 }
 
 /// Where a node of the level gets its histogram from.
@@ -862,13 +907,19 @@ struct Pending {
 }
 
 /// Histogram layout of one tree: the sampled features' bins back to back, `off[j]` the first
-/// bin of `cols[j]`, `off[cols.len()]` the total.
+/// bin of `cols[j]`, `off[cols.len()]` the total; with one-byte bins every feature takes
+/// [`U8_SLOTS`] slots (the unused ones stay empty).
 struct Layout {
     off: Vec<usize>,
 }
 
 impl Layout {
     fn new(ix: &HistIndex, cols: &[usize]) -> Self {
+        if matches!(ix.bins, Bins::U8(_)) {
+            return Self {
+                off: (0..=cols.len()).map(|j| j * U8_SLOTS).collect(),
+            };
+        }
         let mut off = Vec::with_capacity(cols.len() + 1);
         let mut t = 0;
         off.push(0);
@@ -906,8 +957,37 @@ fn add_rows<B: Copy>(
         let row = &bins[r * nf..(r + 1) * nf];
         for &(k, o) in &local {
             let h = &mut hist[o + usize::from(row[k])];
-            h.g += g;
-            h.n += 1;
+            h.add(g);
+        }
+    }
+}
+
+/// [`add_rows`] for one-byte bins: every feature's histogram has 256 slots, so a bin number
+/// indexes it without a bounds check, and a run of consecutive features (no column sampling)
+/// reads the row's bins as one slice. Same order of the sums as [`add_rows`].
+fn add_rows_u8(bins: &[u8], nf: usize, rows: &[u32], g: &[f64], cols: &[usize], hist: &mut [HBin]) {
+    let (slots, _) = hist.as_chunks_mut::<U8_SLOTS>();
+    let Some(&k0) = cols.first() else {
+        return;
+    };
+    let w = cols.len();
+    if cols.iter().enumerate().all(|(i, &k)| k == k0 + i) {
+        for &r in rows {
+            let r = r as usize;
+            let gr = g[r];
+            let row = &bins[r * nf + k0..r * nf + k0 + w];
+            for (h, &bin) in slots.iter_mut().zip(row) {
+                h[usize::from(bin)].add(gr);
+            }
+        }
+    } else {
+        for &r in rows {
+            let r = r as usize;
+            let gr = g[r];
+            let row = &bins[r * nf..(r + 1) * nf];
+            for (h, &k) in slots.iter_mut().zip(cols) {
+                h[usize::from(row[k])].add(gr);
+            }
         }
     }
 }
@@ -924,7 +1004,7 @@ fn build_hist(
     let off = &layout.off[j0..=j1];
     let mut hist = vec![HBin::default(); off[off.len() - 1] - off[0]];
     match &ix.bins {
-        Bins::U8(b) => add_rows(b, ix.n_feat, rows, ws, &cols[j0..j1], off, &mut hist),
+        Bins::U8(b) => add_rows_u8(b, ix.n_feat, rows, &ws.g, &cols[j0..j1], &mut hist),
         Bins::U16(b) => add_rows(b, ix.n_feat, rows, ws, &cols[j0..j1], off, &mut hist),
     }
     hist
@@ -944,15 +1024,17 @@ fn search_hist(
     let parent_score = p.score(node.g, f64::from(node.n));
     let mut best: Option<(usize, Cand)> = None;
     for (j, &k) in cols.iter().enumerate() {
-        let h = &hist[layout.off[j]..layout.off[j + 1]];
+        let h = &hist[layout.off[j]..layout.off[j] + ix.n_bins(k)];
         let cuts = &ix.cuts[k];
         let mut fbest: Option<Cand> = None;
+        let mut need = f64::NEG_INFINITY;
         let (mut gl, mut nl) = (0.0, 0u32);
         for (b, bin) in h[..h.len() - 1].iter().enumerate() {
-            gl += bin.g;
-            nl += bin.n;
+            let nb = bin.n();
+            gl += bin.g();
+            nl += nb;
             let nr = node.n - nl;
-            if bin.n == 0 || nl == 0 || nr == 0 {
+            if nb == 0 || nl == 0 || nr == 0 {
                 continue;
             }
             let (hl, hr) = (f64::from(nl), f64::from(nr));
@@ -960,13 +1042,14 @@ fn search_hist(
                 let gain = fast_score(gl, nl, inv, p.reg_alpha)
                     + fast_score(node.g - gl, nr, inv, p.reg_alpha)
                     - parent_score;
-                if better(gain, fbest.as_ref()) {
+                if gain > need {
                     fbest = Some(Cand {
                         gain,
                         threshold: cuts[b],
                         gl,
                         nl,
                     });
+                    need = bar(gain);
                 }
             }
         }
@@ -986,7 +1069,9 @@ fn search_hist(
 /// margins of all training rows.
 #[expect(
     clippy::too_many_lines,
-    reason = "one level loop: batches, histograms, search and partition share its state"
+    clippy::too_many_arguments,
+    reason = "one level loop: batches, histograms, search and partition share its state; the \
+              arguments are the tree's inputs, as for `grow_exact`, plus the subtraction switch"
 )]
 fn grow_hist(
     data: &TrainData<'_>,
@@ -1083,8 +1168,8 @@ fn grow_hist(
                 if let Source::Subtract { parent, sibling } = w.from {
                     let mut h = std::mem::take(&mut kept[parent]);
                     for (a, b) in h.iter_mut().zip(&hists[sibling - i0]) {
-                        a.g -= b.g;
-                        a.n -= b.n;
+                        a.0[0] -= b.0[0];
+                        a.0[1] -= b.0[1];
                     }
                     hists[i] = h;
                 }
@@ -1114,19 +1199,20 @@ fn grow_hist(
                 let k = cols[j];
                 let feature = data.features[k];
                 // Stable partition of the node's rows: x < θ first.
+                // Branch-free: both sides are written, the index of the other side stays.
                 let col = data.x.col(feature);
                 tmp.clear();
-                let mut wr = parent.start;
+                tmp.resize(parent.end - parent.start, 0);
+                let (mut wr, mut t) = (parent.start, 0);
                 for i in parent.start..parent.end {
                     let r = part[i];
-                    if col[r as usize] < c.threshold {
-                        part[wr] = r;
-                        wr += 1;
-                    } else {
-                        tmp.push(r);
-                    }
+                    let is_left = col[r as usize] < c.threshold;
+                    part[wr] = r;
+                    tmp[t] = r;
+                    wr += usize::from(is_left);
+                    t += usize::from(!is_left);
                 }
-                part[wr..parent.end].copy_from_slice(&tmp);
+                part[wr..parent.end].copy_from_slice(&tmp[..t]);
                 debug_assert_eq!(wr - parent.start, c.nl as usize);
                 let left = u32::try_from(nodes.len()).unwrap_or(LEAF);
                 let depth = parent.depth + 1;
