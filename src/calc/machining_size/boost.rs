@@ -1062,6 +1062,51 @@ fn search_hist(
     best
 }
 
+/// Stable partition (x < θ first, each side in ascending row order) of the row runs `jobs`
+/// (start, end, feature, θ; ascending and disjoint) of `part`: the splits of one batch, on the
+/// compute threads when there are several and enough rows.
+fn partition_rows(
+    part: &mut [u32],
+    jobs: &[(usize, usize, usize, f64)],
+    x: &Matrix,
+    threads: usize,
+) {
+    let mut segs: Vec<Mutex<(&mut [u32], usize, f64)>> = Vec::with_capacity(jobs.len());
+    let mut rest: &mut [u32] = part;
+    let mut at = 0;
+    for &(start, end, f, theta) in jobs {
+        let (_, tail) = std::mem::take(&mut rest).split_at_mut(start - at);
+        let (seg, tail) = tail.split_at_mut(end - start);
+        segs.push(Mutex::new((seg, f, theta)));
+        rest = tail;
+        at = end;
+    }
+    let work: usize = jobs.iter().map(|j| j.1 - j.0).sum();
+    let t = if jobs.len() > 1 && work >= PAR_MIN_WORK {
+        threads
+    } else {
+        1
+    };
+    par_map(t, &segs, |_, m| {
+        let mut guard = m.lock().unwrap_or_else(PoisonError::into_inner);
+        let (seg, f, theta) = &mut *guard;
+        let col = x.col(*f);
+        // Branch-free (the sides are as good as random): both sides are written, the index of
+        // the other side stays.
+        let mut tmp = vec![0u32; seg.len()];
+        let (mut w, mut t) = (0, 0);
+        for i in 0..seg.len() {
+            let r = seg[i];
+            let is_left = col[r as usize] < *theta;
+            seg[w] = r;
+            tmp[t] = r;
+            w += usize::from(is_left);
+            t += usize::from(!is_left);
+        }
+        seg[w..].copy_from_slice(&tmp[..t]);
+    });
+}
+
 /// Grows one tree by the hist method: level by level over per-node row lists (each node's
 /// sampled rows are a contiguous run of `part`, in ascending row order), one histogram per node
 /// built from its own rows only, and with `subtract` the larger of two expandable siblings'
@@ -1118,7 +1163,6 @@ fn grow_hist(
         Vec::new()
     };
     let mut kept: Vec<Vec<HBin>> = Vec::new();
-    let mut tmp: Vec<u32> = Vec::new();
     while !level.is_empty() {
         let mut next: Vec<Pending> = Vec::new();
         let mut next_kept: Vec<Vec<HBin>> = Vec::new();
@@ -1190,6 +1234,7 @@ fn grow_hist(
                     &ws.inv,
                 )
             });
+            let mut jobs: Vec<(usize, usize, usize, f64)> = Vec::new();
             for ((w, c), hist) in batch.iter().zip(best).zip(hists) {
                 let Some((j, c)) = c.filter(|(_, c)| c.gain > KRT_EPS) else {
                     continue;
@@ -1199,21 +1244,8 @@ fn grow_hist(
                 let k = cols[j];
                 let feature = data.features[k];
                 // Stable partition of the node's rows: x < θ first.
-                // Branch-free: both sides are written, the index of the other side stays.
-                let col = data.x.col(feature);
-                tmp.clear();
-                tmp.resize(parent.end - parent.start, 0);
-                let (mut wr, mut t) = (parent.start, 0);
-                for i in parent.start..parent.end {
-                    let r = part[i];
-                    let is_left = col[r as usize] < c.threshold;
-                    part[wr] = r;
-                    tmp[t] = r;
-                    wr += usize::from(is_left);
-                    t += usize::from(!is_left);
-                }
-                part[wr..parent.end].copy_from_slice(&tmp[..t]);
-                debug_assert_eq!(wr - parent.start, c.nl as usize);
+                jobs.push((parent.start, parent.end, feature, c.threshold));
+                let wr = parent.start + c.nl as usize;
                 let left = u32::try_from(nodes.len()).unwrap_or(LEAF);
                 let depth = parent.depth + 1;
                 let lnode = BNode {
@@ -1274,6 +1306,7 @@ fn grow_hist(
                     }
                 }
             }
+            partition_rows(&mut part, &jobs, data.x, threads);
             i0 = i1;
         }
         level = next;
