@@ -745,11 +745,20 @@ fn grow_exact(
             par_map(t, cols, |_, &k| {
                 let mut c = lock(&ws.columns[k]);
                 let mut tmp = Vec::new();
-                partition(&mut c, splits, left, &mut tmp);
-                stats
+                // Each run is partitioned just before its children are scanned, while it is
+                // still in cache (runs and nodes are both in ascending position order).
+                let mut done = 0;
+                let res = stats
                     .iter()
-                    .map(|(b, ps)| scan_exact(&c[b.start..b.end], b, *ps, p, inv))
-                    .collect()
+                    .map(|(b, ps)| {
+                        let upto = done + splits[done..].partition_point(|sp| sp.0 <= b.start);
+                        partition(&mut c, &splits[done..upto], left, &mut tmp);
+                        done = upto;
+                        scan_exact(&c[b.start..b.end], b, *ps, p, inv)
+                    })
+                    .collect();
+                partition(&mut c, &splits[done..], left, &mut tmp);
+                res
             })
         };
         let mut best: Vec<Option<(usize, Cand)>> = vec![None; level.len()];
