@@ -3,7 +3,9 @@
 //! Tables (printed before criterion, only under `cargo bench`; a name filter must contain
 //! `sweep` to run them):
 //! * training time against XGBoost 3.2.0 (same data, same parameters, exact, 2 threads): the
-//!   paper-sized set (850 rows × 8 features, 400 trees) and 100 000 × 20;
+//!   paper-sized set (850 rows × 8 features, 400 trees);
+//! * training at scale (`sweep_large`): 10⁴, 10⁵ and 2·10⁵ rows × 20, exact and hist, time per
+//!   row and test RMSE against XGBoost's (same data, parameters and folds, 2 threads);
 //! * the thread knob of the level search and the CV folds (1 vs 2 threads by size);
 //! * the accuracy-vs-cost grid n_estimators × max_depth with fixed 5 folds: fit time and mean test
 //!   RMSE against XGBoost's on the same folds;
@@ -136,9 +138,10 @@ fn paper_set() -> Set {
     }
 }
 
-/// 100 000 × 20 continuous features, a smooth nonlinear target with noise.
-fn big_set() -> Set {
-    let (n, d) = (100_000, 20);
+/// `n` × 20 continuous features, a smooth nonlinear target with noise (the first rows of a
+/// larger set are the rows of a smaller one).
+fn big_set(name: &'static str, n: usize) -> Set {
+    let d = 20;
     let mut r = rng::stream(77, 7);
     let mut rows = Vec::with_capacity(n);
     let mut y = Vec::with_capacity(n);
@@ -154,7 +157,7 @@ fn big_set() -> Set {
         y.push(v);
     }
     Set {
-        name: "big",
+        name,
         n,
         d,
         rows,
@@ -210,7 +213,7 @@ fn opt(x: Option<f64>, digits: usize) -> String {
     x.map_or("—".to_owned(), |v| format!("{v:.digits$}"))
 }
 
-fn sweep_training(paper: &Set, big: &Set, reference: Option<&Value>) {
+fn sweep_training(paper: &Set, reference: Option<&Value>) {
     println!("\n### Training time against XGBoost 3.2.0 (exact, same data and parameters)\n");
     println!(
         "| data set | parameters | threads | ours: index + boosting, median / worst ms | ours: whole `run_train` ms | XGBoost `train` median ms | XGBoost `fit` incl. DMatrix ms | ratio XGBoost/ours |"
@@ -235,8 +238,9 @@ fn sweep_training(paper: &Set, big: &Set, reference: Option<&Value>) {
             let xt = refnum(reference, &format!("{key}/train_ms"));
             let xf = refnum(reference, &format!("{key}/fit_ms"));
             println!(
-                "| paper-sized 850 × 8 | {label}, 400 trees ({} effective) | {threads} | {} | {:.1} | {} | {} | {} |",
+                "| paper-sized 850 × 8 | {label}, 400 trees ({} effective, digest {:016x}) | {threads} | {} | {:.1} | {} | {} | {} |",
                 b.trees.iter().filter(|t| t.n_splits() > 0).count(),
+                digest(&b),
                 ms(&t),
                 tr.median_ms(),
                 opt(xt, 1),
@@ -245,33 +249,90 @@ fn sweep_training(paper: &Set, big: &Set, reference: Option<&Value>) {
             );
         }
     }
-    let xb = big.matrix();
-    let rows = all_rows(big.n);
-    for (method, label) in [
-        (Method::Exact, "exact"),
-        (Method::Hist { max_bin: 256 }, "hist 256"),
-    ] {
-        let p = BoostParams {
-            method,
-            ..table2(400, 1.0)
-        };
-        let (t, _) = time_runs(1, || fit(&xb, &big.y, &rows, &p, 2));
-        let key = format!(
-            "/big/{}",
-            if method == Method::Exact {
-                "exact"
-            } else {
-                "hist"
-            }
-        );
-        let xt = refnum(reference, &format!("{key}/train_ms"));
-        println!(
-            "| 100 000 × 20 | Table 2, colsample 1.0, {label}, 400 trees | 2 | {} | — | {} | — | {} |",
-            ms(&t),
-            opt(xt, 0),
-            opt(xt.map(|v| v / t.median_ms()), 2)
-        );
+}
+
+/// A digest of every bit of a model's trees (node links, features, thresholds, values, covers,
+/// loss changes): equal digests from two builds of the trainer mean byte-identical models.
+fn digest(b: &Boosted) -> u64 {
+    use std::hash::{DefaultHasher, Hash, Hasher};
+    let mut h = DefaultHasher::new();
+    b.base_score.to_bits().hash(&mut h);
+    for n in b.trees.iter().flat_map(|t| t.nodes.iter()) {
+        (n.left, n.right, n.feature).hash(&mut h);
+        for v in [n.threshold, n.value, n.cover, n.loss_change] {
+            v.to_bits().hash(&mut h);
+        }
     }
+    h.finish()
+}
+
+/// Training time and test RMSE at 10⁴, 10⁵ and 2·10⁵ rows × 20 continuous features against
+/// XGBoost 3.2 (Table 2 with colsample 1.0, 400 trees, 2 threads each; exact not run at 2·10⁵):
+/// index + boosting on all rows (median of 3 runs at 10⁴, one run above), and the test RMSE on
+/// fold 0 of a model trained on folds 1–4. `hist_only` skips the exact rows.
+fn sweep_large(sets: &[&Set], reference: Option<&Value>, hist_only: bool) {
+    let load = || std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    println!(
+        "\n### Training at scale against XGBoost 3.2.0 (Table 2, colsample 1.0, 400 trees, 2 threads)\n"
+    );
+    println!("load average at start: {}", load().trim());
+    println!(
+        "| rows × features | method | ours ms (all rows) | ours µs/row | XGBoost `train` ms | XGBoost µs/row | ratio XGBoost/ours | ours test RMSE (fold 0) | XGBoost test RMSE | RMSE ours/XGBoost − 1 | model digest (all rows) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for s in sets {
+        let x = s.matrix();
+        let all = all_rows(s.n);
+        let split = |test: bool| -> Vec<u32> {
+            all.iter()
+                .copied()
+                .filter(|&r| (s.fold[r as usize] == 0) == test)
+                .collect()
+        };
+        let (train, test) = (split(false), split(true));
+        for (method, key) in [
+            (Method::Exact, "exact"),
+            (Method::Hist { max_bin: 256 }, "hist"),
+        ] {
+            if method == Method::Exact && (s.n > 100_000 || hist_only) {
+                continue;
+            }
+            let p = BoostParams {
+                method,
+                ..table2(400, 1.0)
+            };
+            let runs = if s.n <= 10_000 { 3 } else { 1 };
+            let (t, full) = time_runs(runs, || fit(&x, &s.y, &all, &p, 2));
+            let m = fit(&x, &s.y, &train, &p, 2).into_model(s.d, Vec::new());
+            let pred: Vec<f64> = test
+                .iter()
+                .map(|&r| m.predict_prepared(&x.row(r as usize)))
+                .collect();
+            let yt: Vec<f64> = test.iter().map(|&r| s.y[r as usize]).collect();
+            let rmse = metrics(&pred, &yt).rmse;
+            let k = format!("/large/{}/{key}", s.name);
+            let xt = refnum(reference, &format!("{k}/train_ms"));
+            let xr = refnum(reference, &format!("{k}/rmse"));
+            let per_row = |ms: f64| ms * 1e3 / s.n as f64;
+            println!(
+                "| {} × {} | {key} | {:.0} | {:.1} | {} | {} | {} | {rmse:.6} | {} | {} | {:016x} |",
+                s.n,
+                s.d,
+                t.median_ms(),
+                per_row(t.median_ms()),
+                opt(xt, 0),
+                opt(xt.map(per_row), 1),
+                opt(xt.map(|v| v / t.median_ms()), 2),
+                opt(xr, 6),
+                xr.map_or("—".to_owned(), |v| format!(
+                    "{:+.2} %",
+                    (rmse / v - 1.0) * 100.0
+                )),
+                digest(&full),
+            );
+        }
+    }
+    println!("\nload average at end: {}", load().trim());
 }
 
 fn paper_request(paper: &Set, colsample: f64) -> TrainRequest {
@@ -559,8 +620,11 @@ fn sweeps(_: &mut Criterion) {
     };
     let paper = paper_set();
     paper.dump();
-    let big = big_set();
+    let big = big_set("big", 100_000);
     big.dump();
+    let (big10k, big200k) = (big_set("big10k", 10_000), big_set("big200k", 200_000));
+    big10k.dump();
+    big200k.dump();
     let reference = reference();
     if reference.is_none() {
         println!(
@@ -571,7 +635,12 @@ fn sweeps(_: &mut Criterion) {
     println!("\n## machining_size sweeps (bench profile)");
     let want = |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()));
     if want("sweep_train") {
-        sweep_training(&paper, &big, reference.as_ref());
+        sweep_training(&paper, reference.as_ref());
+    }
+    // `sweep_large_hist` runs the hist rows of `sweep_large` only.
+    let hist_only = filters.iter().any(|f| f.contains("sweep_large_hist"));
+    if want("sweep_large") || hist_only {
+        sweep_large(&[&big10k, &big, &big200k], reference.as_ref(), hist_only);
     }
     if want("sweep_threads") {
         sweep_threads(&paper, &big);

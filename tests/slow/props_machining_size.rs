@@ -377,7 +377,8 @@ proptest! {
 }
 
 /// Training with sampling is bit-identical for 1 and 2 threads (the level search runs in
-/// parallel above its work threshold; CV folds run in parallel).
+/// parallel above its work threshold; CV folds run in parallel), for both split methods (issue
+/// 27: the hist method builds histograms in feature chunks and searches nodes in parallel).
 #[test]
 fn training_is_bit_identical_across_thread_counts() {
     let n = 5000;
@@ -394,23 +395,26 @@ fn training_is_bit_identical_across_thread_counts() {
         .map(|r| r[0] * 3.0 + r[5] - r[9] * r[9] + 0.1 * next())
         .collect();
     let ds = DataSet { rows, y };
-    let req = || {
-        train_request(
-            &ds,
-            json!({"params": {"n_estimators": 6, "max_depth": 5, "learning_rate": 0.3,
-                              "colsample_bytree": 0.7, "subsample": 0.8, "seed": 9},
-                   "validation": {"test_fraction": 0.2, "k_fold": 3}}),
-        )
-    };
-    let one = run_train(req(), &Budget::unlimited().with_threads(1)).unwrap();
-    let two = run_train(req(), &Budget::unlimited().with_threads(2)).unwrap();
-    let a = serde_json::to_string(&one.model).unwrap();
-    let b = serde_json::to_string(&two.model).unwrap();
-    assert_eq!(a, b, "models differ between 1 and 2 threads");
-    let cv = |r: &mechcalc::calc::machining_size::TrainResponse| {
-        serde_json::to_string(&r.metrics.cv.as_ref().unwrap().folds).unwrap()
-    };
-    assert_eq!(cv(&one), cv(&two));
+    for method in ["exact", "hist"] {
+        let req = || {
+            train_request(
+                &ds,
+                json!({"params": {"n_estimators": 6, "max_depth": 5, "learning_rate": 0.3,
+                                  "colsample_bytree": 0.7, "subsample": 0.8, "seed": 9,
+                                  "tree_method": method, "max_bin": 64},
+                       "validation": {"test_fraction": 0.2, "k_fold": 3}}),
+            )
+        };
+        let one = run_train(req(), &Budget::unlimited().with_threads(1)).unwrap();
+        let two = run_train(req(), &Budget::unlimited().with_threads(2)).unwrap();
+        let a = serde_json::to_string(&one.model).unwrap();
+        let b = serde_json::to_string(&two.model).unwrap();
+        assert_eq!(a, b, "{method}: models differ between 1 and 2 threads");
+        let cv = |r: &mechcalc::calc::machining_size::TrainResponse| {
+            serde_json::to_string(&r.metrics.cv.as_ref().unwrap().folds).unwrap()
+        };
+        assert_eq!(cv(&one), cv(&two), "{method}");
+    }
 }
 
 /// Any JSON value: numbers of every kind (integers beyond i64, negative zero, fractions,
