@@ -42,12 +42,21 @@ const TIE_REL: f64 = 1e-12;
 const PAR_MIN_WORK: usize = 60_000;
 
 /// Most histogram bytes of one level alive at once: a level with more nodes is processed in
-/// batches (deep trees over many features and bins would otherwise hold gigabytes).
+/// batches (deep trees over many features and bins would otherwise hold gigabytes). Also at most
+/// [`HIST_BYTES_PER_CELL`] per training cell (at least [`HIST_MIN_BYTES`]), so that the
+/// histograms stay a small multiple of the data: k-fold training runs two models at once.
 const HIST_BATCH_BYTES: usize = 64 << 20;
 
 /// Most bytes of parent histograms kept for the sibling subtraction of the next level; siblings
-/// beyond it are both summed directly.
+/// beyond it are both summed directly. Also at most [`HIST_BYTES_PER_CELL`] per training cell.
 const HIST_KEEP_BYTES: usize = 128 << 20;
+
+/// Histogram bytes per training cell (rows × sampled features) one model may hold in a batch
+/// and in kept parent histograms (each).
+const HIST_BYTES_PER_CELL: usize = 8;
+
+/// Histogram bytes a model may always hold in a batch and in kept parents (small data sets).
+const HIST_MIN_BYTES: usize = 4 << 20;
 
 /// Histogram slots per feature with one-byte bins (every bin number indexes them).
 const U8_SLOTS: usize = 256;
@@ -417,7 +426,7 @@ fn boost_with(
             .collect(),
         columns: match data.index {
             SplitIndex::Exact(_) => (0..data.features.len())
-                .map(|_| Mutex::new(Vec::new()))
+                .map(|_| Mutex::new(Column::default()))
                 .collect(),
             SplitIndex::Hist(_) => Vec::new(),
         },
@@ -495,7 +504,7 @@ struct Workspace {
     inv: Vec<f64>,
     /// The exact method's working column of every candidate feature (reused tree after tree;
     /// one lock each so that the compute threads can each own some of them).
-    columns: Vec<Mutex<Vec<Entry>>>,
+    columns: Vec<Mutex<Column>>,
 }
 
 /// A node under construction.
@@ -562,54 +571,53 @@ fn midpoint(lo: f64, hi: f64) -> f64 {
     if m > lo { m } else { hi }
 }
 
-/// One entry of a tree's working column (exact method): a sampled training row's value of the
-/// feature and its gradient, stored side by side so the split search reads the column
-/// sequentially, without looking the gradient up by row.
-#[derive(Debug, Clone, Copy)]
-struct Entry {
-    x: f64,
-    g: f64,
-    r: u32,
+/// A tree's working column (exact method): the sampled training rows in ascending order of the
+/// feature, as two parallel arrays (value, row): 12 bytes per row, so a model's columns stay a
+/// small multiple of its data (a gradient beside each value ran faster but doubled the memory
+/// of k-fold training, above the 5·B + 32 MiB the service holds a request to).
+#[derive(Debug, Default)]
+struct Column {
+    x: Vec<f64>,
+    r: Vec<u32>,
 }
 
 /// Locks a working column (a poisoned lock means another worker panicked; that panic is re-raised
 /// by the parallel map, so the data are never read after it).
-fn lock(c: &Mutex<Vec<Entry>>) -> MutexGuard<'_, Vec<Entry>> {
+fn lock(c: &Mutex<Column>) -> MutexGuard<'_, Column> {
     c.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// Stable partition of every segment `start..end` of `col` in `splits`: rows with `left[r]`
 /// first, each side in its previous (ascending value) order.
-fn partition(col: &mut [Entry], splits: &[(usize, usize)], left: &[bool], tmp: &mut Vec<Entry>) {
+fn partition(col: &mut Column, splits: &[(usize, usize)], left: &[bool], tmp: &mut Column) {
     for &(start, end) in splits {
         // Branch-free (the sides are as good as random): both sides are written, the index of
         // the other side stays.
-        tmp.clear();
-        tmp.resize(
-            end - start,
-            Entry {
-                x: 0.0,
-                g: 0.0,
-                r: 0,
-            },
-        );
+        tmp.x.clear();
+        tmp.x.resize(end - start, 0.0);
+        tmp.r.clear();
+        tmp.r.resize(end - start, 0);
         let (mut w, mut t) = (start, 0);
         for i in start..end {
-            let e = col[i];
-            let l = left[e.r as usize];
-            col[w] = e;
-            tmp[t] = e;
+            let (x, r) = (col.x[i], col.r[i]);
+            let l = left[r as usize];
+            col.x[w] = x;
+            col.r[w] = r;
+            tmp.x[t] = x;
+            tmp.r[t] = r;
             w += usize::from(l);
             t += usize::from(!l);
         }
-        col[w..end].copy_from_slice(&tmp[..t]);
+        col.x[w..end].copy_from_slice(&tmp.x[..t]);
+        col.r[w..end].copy_from_slice(&tmp.r[..t]);
     }
 }
 
 /// Exact search over one node's run of a working column (ascending values): every boundary
 /// between consecutive distinct values, ascending; the first of tied candidates wins.
 fn scan_exact(
-    seg: &[Entry],
+    (xs, rs): (&[f64], &[u32]),
+    g: &[f64],
     node: &BNode,
     parent_score: f64,
     p: &BoostParams,
@@ -618,8 +626,8 @@ fn scan_exact(
     let (mut gl, mut nl, mut last) = (0.0, 0u32, 0.0);
     let mut best: Option<Cand> = None;
     let mut need = f64::NEG_INFINITY;
-    for e in seg {
-        if nl > 0 && e.x > last {
+    for (&x, &r) in xs.iter().zip(rs) {
+        if nl > 0 && x > last {
             let nr = node.n - nl;
             let (hl, hr) = (f64::from(nl), f64::from(nr));
             if hl >= p.min_child_weight && hr >= p.min_child_weight {
@@ -629,7 +637,7 @@ fn scan_exact(
                 if gain > need {
                     best = Some(Cand {
                         gain,
-                        threshold: midpoint(last, e.x),
+                        threshold: midpoint(last, x),
                         gl,
                         nl,
                     });
@@ -637,9 +645,9 @@ fn scan_exact(
                 }
             }
         }
-        gl += e.g;
+        gl += g[r as usize];
         nl += 1;
-        last = e.x;
+        last = x;
     }
     best
 }
@@ -687,21 +695,18 @@ fn grow_exact(
         1
     };
     {
-        let (g, used) = (&ws.g, &used);
+        let used = &used;
         par_map(fill_threads, cols, |_, &k| {
             let mut c = lock(&ws.columns[k]);
-            c.clear();
-            c.extend(
-                ix.order(k)
-                    .iter()
-                    .zip(ix.vals(k))
-                    .filter(|&(&r, _)| used[r as usize])
-                    .map(|(&r, &x)| Entry {
-                        x,
-                        g: g[r as usize],
-                        r,
-                    }),
-            );
+            let c = &mut *c;
+            c.x.clear();
+            c.r.clear();
+            for (&r, &x) in ix.order(k).iter().zip(ix.vals(k)) {
+                if used[r as usize] {
+                    c.x.push(x);
+                    c.r.push(r);
+                }
+            }
         });
     }
     let mut nodes = vec![BNode {
@@ -741,10 +746,10 @@ fn grow_exact(
             1
         };
         let per_feature: Vec<Vec<Option<Cand>>> = {
-            let (splits, left, inv) = (&splits, &left, &ws.inv);
+            let (splits, left, inv, g) = (&splits, &left, &ws.inv, &ws.g);
             par_map(t, cols, |_, &k| {
                 let mut c = lock(&ws.columns[k]);
-                let mut tmp = Vec::new();
+                let mut tmp = Column::default();
                 // Each run is partitioned just before its children are scanned, while it is
                 // still in cache (runs and nodes are both in ascending position order).
                 let mut done = 0;
@@ -754,7 +759,8 @@ fn grow_exact(
                         let upto = done + splits[done..].partition_point(|sp| sp.0 <= b.start);
                         partition(&mut c, &splits[done..upto], left, &mut tmp);
                         done = upto;
-                        scan_exact(&c[b.start..b.end], b, *ps, p, inv)
+                        let run = (&c.x[b.start..b.end], &c.r[b.start..b.end]);
+                        scan_exact(run, g, b, *ps, p, inv)
                     })
                     .collect();
                 partition(&mut c, &splits[done..], left, &mut tmp);
@@ -784,11 +790,11 @@ fn grow_exact(
             {
                 let col = lock(&ws.columns[k]);
                 let mid = parent.start + c.nl as usize;
-                for e in &col[parent.start..mid] {
-                    left[e.r as usize] = true;
+                for &r in &col.r[parent.start..mid] {
+                    left[r as usize] = true;
                 }
-                for e in &col[mid..parent.end] {
-                    left[e.r as usize] = false;
+                for &r in &col.r[mid..parent.end] {
+                    left[r as usize] = false;
                 }
             }
             splits.push((parent.start, parent.end));
@@ -833,12 +839,12 @@ fn grow_exact(
     // The margins, from the runs of the unsplit nodes in one column (the last level's splits
     // partitioned there first).
     let mut col = lock(&ws.columns[cols[0]]);
-    partition(&mut col, &splits, &left, &mut Vec::new());
+    partition(&mut col, &splits, &left, &mut Column::default());
     for (i, b) in nodes.iter().enumerate() {
         if b.left == LEAF {
             let v = tree.nodes[leaf_of[i] as usize].value;
-            for e in &col[b.start..b.end] {
-                ws.margin[e.r as usize] += v;
+            for &r in &col.r[b.start..b.end] {
+                ws.margin[r as usize] += v;
             }
         }
     }
@@ -1151,7 +1157,9 @@ fn grow_hist(
     }
     let layout = Layout::new(ix, cols);
     let node_bytes = layout.total() * std::mem::size_of::<HBin>();
-    let batch_nodes = (HIST_BATCH_BYTES / node_bytes.max(1)).max(2);
+    let per_data = (part.len() * cols.len() * HIST_BYTES_PER_CELL).max(HIST_MIN_BYTES);
+    let batch_nodes = (HIST_BATCH_BYTES.min(per_data) / node_bytes.max(1)).max(2);
+    let keep_bytes = HIST_KEEP_BYTES.min(per_data);
     let mut nodes = vec![BNode {
         g: g0,
         n: n0,
@@ -1285,8 +1293,12 @@ fn grow_hist(
                 });
                 b.left = left;
                 b.right = left + 1;
+                // Subtraction pays when the larger child has more rows than its histogram has
+                // bins (summing it directly would cost more than subtracting); smaller nodes are
+                // summed directly and keep no parent histogram.
+                let pays = lnode.n.max(rnode.n) as usize * cols.len() > layout.total();
                 match (le, re) {
-                    (true, true) if subtract && kept_bytes + node_bytes <= HIST_KEEP_BYTES => {
+                    (true, true) if subtract && pays && kept_bytes + node_bytes <= keep_bytes => {
                         kept_bytes += node_bytes;
                         // The smaller child is summed, the larger one subtracted.
                         let small_left = lnode.n <= rnode.n;
