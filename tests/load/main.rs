@@ -323,6 +323,16 @@ async fn slow_readers_are_dropped_and_memory_returns() {
 /// A machining-size training body of `rows` × 20 features (one shallow tree: the reading, not
 /// the model, is what the memory follows).
 fn training_body(rows: usize) -> Vec<u8> {
+    training_body_with(
+        rows,
+        &json!({"n_estimators": 1, "max_depth": 2, "tree_method": "hist"}),
+        &json!({"test_fraction": 0.2}),
+    )
+}
+
+/// A machining-size training body of `rows` × 20 features with these params and validation
+/// (values with four decimals, about 8 bytes of JSON per value).
+fn training_body_with(rows: usize, params: &Value, validation: &Value) -> Vec<u8> {
     let mut rng = 7_u64;
     let mut next = || {
         // xorshift: a fixed, dependency-free stream of numbers in [0, 100).
@@ -341,8 +351,7 @@ fn training_body(rows: usize) -> Vec<u8> {
     serde_json::to_vec(&json!({
         "feature_names": (0..20).map(|j| format!("f{j}")).collect::<Vec<_>>(),
         "rows": x, "target": y,
-        "params": {"n_estimators": 1, "max_depth": 2, "tree_method": "hist"},
-        "validation": {"test_fraction": 0.2}, "time_limit_ms": 60_000
+        "params": params, "validation": validation, "time_limit_ms": 60_000
     }))
     .expect("serializes")
 }
@@ -385,6 +394,50 @@ async fn memory_follows_a_large_body_and_goes_back() {
         after <= idle + 16 * 1024,
         "RSS {after} KiB 4 s after a {b_mib} MiB body; idle was {idle} KiB"
     );
+    server.stop().await;
+}
+
+/// The trainers' own memory stays within the limit too: k-fold training runs two models at
+/// once, each with its working columns (exact) or histograms (hist, deep trees). The values
+/// carry ten significant digits (about 13 bytes of JSON each, as measured data written by a
+/// program); with fewer digits the body is smaller than the data in memory (8 bytes per f64 plus
+/// the models' columns), and the model work alone is above 5·B.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn memory_of_k_fold_training_stays_within_the_limit() {
+    let _serial = SERIAL.lock().await;
+    let server = Server::start(&[("MECHCALC_MAX_BODY_BYTES", "33554432")]).await;
+    let pid = server.pid();
+    for params in [
+        json!({"n_estimators": 3, "max_depth": 6, "tree_method": "exact"}),
+        json!({"n_estimators": 3, "max_depth": 12, "tree_method": "hist"}),
+    ] {
+        let mut body: Value =
+            serde_json::from_slice(&training_body_with(40_000, &params, &json!({"k_fold": 5})))
+                .expect("json");
+        let mut k = 0u64;
+        for row in body["rows"].as_array_mut().expect("rows") {
+            for v in row.as_array_mut().expect("row") {
+                k = k.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+                *v = json!(v.as_f64().unwrap_or(0.0) + (k >> 44) as f64 * 1e-10);
+            }
+        }
+        let body = serde_json::to_vec(&body).expect("json");
+        let b_mib = body.len() / (1 << 20);
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        let hwm0 = status_field(pid, "VmHWM:").max(rss_kib(pid));
+        let r = client::send(
+            server.addr,
+            client::request_bytes_raw("POST", "/v1/machining-size/train", &body),
+        )
+        .await
+        .expect("answers");
+        assert_eq!(r.status, 200, "{}", r.text());
+        let rise_mib = (status_field(pid, "VmHWM:") - hwm0) / 1024;
+        assert!(
+            rise_mib as usize <= 5 * b_mib + 32,
+            "{params}: peak RSS rose {rise_mib} MiB for a {b_mib} MiB body (limit 5·B + 32 MiB)"
+        );
+    }
     server.stop().await;
 }
 
