@@ -9,14 +9,16 @@
 //! working column (exact), partitioned stably when the node splits, so a level touches only the
 //! rows of its open nodes, in ascending row (hist) or value (exact) order.
 //!
-//! * exact: each sampled feature's working column holds (value, gradient, row) in ascending
-//!   value order; a level partitions the runs split by the previous level and scans the open
-//!   runs, one feature per task on the compute threads ([`par_map`]).
+//! * exact: each sampled feature's working column holds (value, row) in ascending value order
+//!   (the gradient is read by row); a level partitions the runs split by the previous level and
+//!   scans the open runs, one feature per task on the compute threads ([`par_map`]).
 //! * hist: bins are built once per model, row-major (one byte per cell when every feature has
 //!   at most 256 bins). A node's histogram is summed from its own rows only, and of two
 //!   expandable siblings only the smaller one is summed: the other is the parent's histogram
-//!   minus it (counts exact, gradient sums equal to round-off). Histogram builds (split into
-//!   feature chunks) and node searches run on the compute threads.
+//!   minus it (counts exact, gradient sums equal to round-off) where that pays: when the larger
+//!   child has more rows than its histogram has bins. Histograms are capped per model (bytes per
+//!   training cell and an absolute ceiling). Histogram builds (split into feature chunks) and
+//!   node searches run on the compute threads.
 //!
 //! Every parallel result is a sum in a fixed order (bins over a node's rows in row order; the
 //! per-feature bests reduced in ascending feature order), so the trees are bit-identical for any
@@ -657,7 +659,7 @@ fn scan_exact(
 /// output to the margins of all training rows.
 ///
 /// Each sampled feature has a working column: the tree's sampled rows in ascending order of the
-/// feature (the pre-sorted index filtered once per tree) with their gradients. Every node's rows
+/// feature (the pre-sorted index filtered once per tree), gradients read by row. Every node's rows
 /// are one run `start..end` of every column, and a split partitions its run stably, so a level
 /// scans only the rows of its open nodes, sequentially, and in the order the whole-column scan
 /// visited them (the same sums, the same trees to the bit). The per-feature work (partition of
