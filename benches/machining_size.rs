@@ -277,9 +277,9 @@ fn sweep_large(sets: &[&Set], reference: Option<&Value>, hist_only: bool) {
     );
     println!("load average at start: {}", load().trim());
     println!(
-        "| rows × features | method | ours ms (all rows) | ours µs/row | XGBoost `train` ms | XGBoost µs/row | ratio XGBoost/ours | ours test RMSE (fold 0) | XGBoost test RMSE | RMSE ours/XGBoost − 1 | model digest (all rows) |"
+        "| rows × features | method | ours ms (all rows) | ours µs/row | XGBoost `train` ms | XGBoost µs/row | ratio XGBoost/ours | ours test RMSE (fold 0) | XGBoost test RMSE | RMSE ours/XGBoost − 1 | model digest (all rows) | trees built | ours µs per row and tree |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for s in sets {
         let x = s.matrix();
         let all = all_rows(s.n);
@@ -315,7 +315,7 @@ fn sweep_large(sets: &[&Set], reference: Option<&Value>, hist_only: bool) {
             let xr = refnum(reference, &format!("{k}/rmse"));
             let per_row = |ms: f64| ms * 1e3 / s.n as f64;
             println!(
-                "| {} × {} | {key} | {:.0} | {:.1} | {} | {} | {} | {rmse:.6} | {} | {} | {:016x} |",
+                "| {} × {} | {key} | {:.0} | {:.1} | {} | {} | {} | {rmse:.6} | {} | {} | {:016x} | {} | {:.3} |",
                 s.n,
                 s.d,
                 t.median_ms(),
@@ -329,6 +329,8 @@ fn sweep_large(sets: &[&Set], reference: Option<&Value>, hist_only: bool) {
                     (rmse / v - 1.0) * 100.0
                 )),
                 digest(&full),
+                full.trees.len(),
+                per_row(t.median_ms()) / full.trees.len().max(1) as f64,
             );
         }
     }
