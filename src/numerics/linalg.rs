@@ -9,7 +9,7 @@ use nalgebra::{Complex, DMatrix, DVector, Dim, Matrix, Matrix4, StorageMut};
 ///
 /// Balancing lowers the norm of badly unit-scaled matrices (a coil row with `K_p/L_c ≈ 1e6` next to
 /// unit entries), which saves squarings and the rounding they amplify. nalgebra solves the Padé
-/// denominator with `lu().solve(..).unwrap()`, which panics if that denominator is singular; the
+/// denominator by LU and unwraps the solution inside nalgebra, which panics if that denominator is singular; the
 /// call is isolated with `catch_unwind` so such a matrix is a typed failure for the caller, never
 /// a crashed job. Finite inputs were never observed to reach it.
 #[must_use]

@@ -406,7 +406,6 @@ async fn memory_follows_a_large_body_and_goes_back() {
 async fn memory_of_k_fold_training_stays_within_the_limit() {
     let _serial = SERIAL.lock().await;
     let server = Server::start(&[("MECHCALC_MAX_BODY_BYTES", "33554432")]).await;
-    let pid = server.pid();
     for params in [
         json!({"n_estimators": 3, "max_depth": 6, "tree_method": "exact"}),
         json!({"n_estimators": 3, "max_depth": 12, "tree_method": "hist"}),
@@ -422,23 +421,33 @@ async fn memory_of_k_fold_training_stays_within_the_limit() {
             }
         }
         let body = serde_json::to_vec(&body).expect("json");
-        let b_mib = body.len() / (1 << 20);
-        tokio::time::sleep(Duration::from_millis(300)).await;
-        let hwm0 = status_field(pid, "VmHWM:").max(rss_kib(pid));
-        let r = client::send(
-            server.addr,
-            client::request_bytes_raw("POST", "/v1/machining-size/train", &body),
+        within_memory_limit(
+            &server,
+            "/v1/machining-size/train",
+            &body,
+            &params.to_string(),
         )
-        .await
-        .expect("answers");
-        assert_eq!(r.status, 200, "{}", r.text());
-        let rise_mib = (status_field(pid, "VmHWM:") - hwm0) / 1024;
-        assert!(
-            rise_mib as usize <= 5 * b_mib + 32,
-            "{params}: peak RSS rose {rise_mib} MiB for a {b_mib} MiB body (limit 5·B + 32 MiB)"
-        );
+        .await;
     }
     server.stop().await;
+}
+
+/// Posts `body` to `path` on a running `server`, expects 200, and asserts that the peak RSS
+/// rose by at most 5·B + 32 MiB for the body's B MiB.
+async fn within_memory_limit(server: &Server, path: &str, body: &[u8], what: &str) {
+    let pid = server.pid();
+    let b_mib = body.len() / (1 << 20);
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let hwm0 = status_field(pid, "VmHWM:").max(rss_kib(pid));
+    let r = client::send(server.addr, client::request_bytes_raw("POST", path, body))
+        .await
+        .expect("answers");
+    assert_eq!(r.status, 200, "{}", r.text());
+    let rise_mib = (status_field(pid, "VmHWM:") - hwm0) / 1024;
+    assert!(
+        rise_mib as usize <= 5 * b_mib + 32,
+        "{what}: peak RSS rose {rise_mib} MiB for a {b_mib} MiB body (limit 5·B + 32 MiB)"
+    );
 }
 
 /// A `/predict` body whose XGBoost model has `trees` complete trees of depth 8 (511 nodes) over
@@ -484,24 +493,15 @@ fn model_body(trees: usize) -> Vec<u8> {
 async fn memory_follows_a_large_model() {
     let _serial = SERIAL.lock().await;
     let server = Server::start(&[("MECHCALC_MAX_BODY_BYTES", "33554432")]).await;
-    let pid = server.pid();
     let body = model_body(300);
-    let b_mib = body.len() / (1 << 20);
-    assert!(b_mib >= 6, "{b_mib} MiB");
-    tokio::time::sleep(Duration::from_millis(300)).await;
-    let hwm0 = status_field(pid, "VmHWM:").max(rss_kib(pid));
-    let r = client::send(
-        server.addr,
-        client::request_bytes_raw("POST", "/v1/machining-size/predict", &body),
+    assert!(body.len() >= 6 << 20, "{} bytes", body.len());
+    within_memory_limit(
+        &server,
+        "/v1/machining-size/predict",
+        &body,
+        "300-tree model",
     )
-    .await
-    .expect("answers");
-    assert_eq!(r.status, 200, "{}", r.text());
-    let rise_mib = (status_field(pid, "VmHWM:") - hwm0) / 1024;
-    assert!(
-        rise_mib as usize <= 5 * b_mib + 32,
-        "peak RSS rose {rise_mib} MiB for a {b_mib} MiB model (limit 5·B + 32 MiB)"
-    );
+    .await;
     server.stop().await;
 }
 

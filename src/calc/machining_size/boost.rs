@@ -568,6 +568,30 @@ fn better(gain: f64, best: Option<&Cand>) -> bool {
 
 /// The midpoint of two consecutive distinct values, nudged up to `hi` when rounding put it on
 /// `lo` (adjacent floats), so that `x < θ` sends exactly the values ≤ `lo` left.
+/// The two children of `parent` split by candidate `c`: the first `c.nl` rows of its run go
+/// left, the rest right.
+fn children(parent: &BNode, c: &Cand) -> (BNode, BNode) {
+    let mid = parent.start + c.nl as usize;
+    let left = BNode {
+        g: c.gl,
+        n: c.nl,
+        depth: parent.depth + 1,
+        split: None,
+        left: LEAF,
+        right: LEAF,
+        start: parent.start,
+        end: mid,
+    };
+    let right = BNode {
+        g: parent.g - c.gl,
+        n: parent.n - c.nl,
+        start: mid,
+        end: parent.end,
+        ..left
+    };
+    (left, right)
+}
+
 fn midpoint(lo: f64, hi: f64) -> f64 {
     let m = lo * 0.5 + hi * 0.5;
     if m > lo { m } else { hi }
@@ -801,24 +825,7 @@ fn grow_exact(
             }
             splits.push((parent.start, parent.end));
             let lid = u32::try_from(nodes.len()).unwrap_or(LEAF);
-            let mid = parent.start + c.nl as usize;
-            let lnode = BNode {
-                g: c.gl,
-                n: c.nl,
-                depth: parent.depth + 1,
-                split: None,
-                left: LEAF,
-                right: LEAF,
-                start: parent.start,
-                end: mid,
-            };
-            let rnode = BNode {
-                g: parent.g - c.gl,
-                n: parent.n - c.nl,
-                start: mid,
-                end: parent.end,
-                ..lnode
-            };
+            let (lnode, rnode) = children(&parent, &c);
             for (child, b) in [(lid, lnode), (lid + 1, rnode)] {
                 if expandable(&b) {
                     next.push(child);
@@ -1264,26 +1271,8 @@ fn grow_hist(
                 let feature = data.features[k];
                 // Stable partition of the node's rows: x < θ first.
                 jobs.push((parent.start, parent.end, feature, c.threshold));
-                let wr = parent.start + c.nl as usize;
                 let left = u32::try_from(nodes.len()).unwrap_or(LEAF);
-                let depth = parent.depth + 1;
-                let lnode = BNode {
-                    g: c.gl,
-                    n: c.nl,
-                    depth,
-                    split: None,
-                    left: LEAF,
-                    right: LEAF,
-                    start: parent.start,
-                    end: wr,
-                };
-                let rnode = BNode {
-                    g: parent.g - c.gl,
-                    n: parent.n - c.nl,
-                    start: wr,
-                    end: parent.end,
-                    ..lnode
-                };
+                let (lnode, rnode) = children(&parent, &c);
                 let (le, re) = (expandable(&lnode), expandable(&rnode));
                 nodes.push(lnode);
                 nodes.push(rnode);
