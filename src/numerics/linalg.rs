@@ -9,8 +9,8 @@ use nalgebra::{Complex, DMatrix, DVector, Dim, Matrix, Matrix4, StorageMut};
 ///
 /// Balancing lowers the norm of badly unit-scaled matrices (a coil row with `K_p/L_c ≈ 1e6` next to
 /// unit entries), which saves squarings and the rounding they amplify. nalgebra solves the Padé
-/// denominator by LU and unwraps the solution inside nalgebra, which panics if that denominator is singular; the
-/// call is isolated with `catch_unwind` so such a matrix is a typed failure for the caller, never
+/// denominator by LU and unwraps the solution internally, which panics if that denominator is
+/// singular; the call is isolated with `catch_unwind` so such a matrix is a typed failure for the caller, never
 /// a crashed job. Finite inputs were never observed to reach it.
 #[must_use]
 pub fn expm(a: &DMatrix<f64>) -> Option<DMatrix<f64>> {
