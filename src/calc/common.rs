@@ -15,6 +15,7 @@
 //!   ([`ResponseSize`]); an estimate above the service's `--max-response-bytes` is a 422
 //!   `RESPONSE_TOO_LARGE` naming the option to change.
 
+use crate::calc::rules::ensure_rule;
 use std::ops::Range as Span;
 use std::time::Duration;
 
@@ -240,17 +241,8 @@ pub const SHARD_INDEX_BELOW_COUNT: CrossRule = CrossRule::invalid(
 /// The rule between the two fields of a top-level `shard` (their ranges are checked at the door).
 pub fn shard_rule(v: &mut Validator, shard: Option<Shard>) -> Option<Shard> {
     let s = shard?;
-    v.ensure_rule(
-        s.index < s.count,
-        &SHARD_INDEX_BELOW_COUNT,
-        "/shard/index",
-        || {
-            format!(
-                "shard.index must be below shard.count = {}, got {}",
-                s.count, s.index
-            )
-        },
-    )
+    ensure_rule!(v, s.index < s.count, SHARD_INDEX_BELOW_COUNT, "/shard/index";
+        "shard.index must be below shard.count = {}, got {}", s.count, s.index)
     .then_some(s)
 }
 

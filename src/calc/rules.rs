@@ -827,6 +827,33 @@ macro_rules! cross_rules {
 }
 pub(crate) use cross_rules;
 
+/// Records a failure of a rule between fields ([`CrossRule`]) at a pointer:
+/// `rule!(v, RULE, pointer; "message {x}", args…)`. The message takes `format!` arguments, so a
+/// check reads as one line: the rule, where, and what is wrong with which value and limit.
+macro_rules! rule {
+    ($v:expr, $rule:expr, $ptr:expr; $fmt:literal) => {
+        $v.rule(&$rule, $ptr, ::std::fmt::format(format_args!($fmt)))
+    };
+    ($v:expr, $rule:expr, $ptr:expr; $fmt:literal, $($arg:expr),+ $(,)?) => {
+        $v.rule(&$rule, $ptr, format!($fmt, $($arg),+))
+    };
+}
+pub(crate) use rule;
+
+/// Checks a rule between fields: `ensure_rule!(v, ok, RULE, pointer; "message {x}", args…)`
+/// records a failure of `RULE` at the pointer unless `ok`, and is `ok`. The pointer and the
+/// message are formatted only when the rule fails.
+macro_rules! ensure_rule {
+    ($v:expr, $ok:expr, $rule:expr, $ptr:expr; $($msg:tt)+) => {{
+        let ok: bool = $ok;
+        if !ok {
+            $crate::calc::rules::rule!($v, $rule, $ptr; $($msg)+);
+        }
+        ok
+    }};
+}
+pub(crate) use ensure_rule;
+
 #[cfg(test)]
 mod tests {
     use super::*;

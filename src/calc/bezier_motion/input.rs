@@ -16,6 +16,7 @@ use super::wire::{
     self, BezierMotionRequest, FREE_P, GAMMA_OVER_PHI_MAX, MAX_ACCEL_DEGREE, ORDER_M, ObjectiveIn,
 };
 use crate::calc::rules::door_skipped;
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, Validator};
 
 crate::calc::rules::cross_rules! {
@@ -95,18 +96,15 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
         let j_eq = match (&sys.inertias_kgm2, sys.j_eq_kgm2) {
             (Some(list), None) => {
                 let sum: f64 = list.iter().sum();
-                v.ensure_rule(sum > 0.0, &INERTIA_SUM, "/system/inertias_kgm2", || {
-                    "the inertias must sum to > 0 kg m², got 0".to_owned()
-                });
+                ensure_rule!(v, sum > 0.0, INERTIA_SUM, "/system/inertias_kgm2";
+                    "the inertias must sum to > 0 kg m², got 0");
                 sum
             }
             (None, Some(j)) => j,
             _ => return Err(door_skipped("/system/J_eq_kgm2")),
         };
         let (k, c, z) = (sys.k_nm_per_rad, sys.c_nms_per_rad, sys.z);
-        v.ensure_rule(z != 0.0, &RATIO_NONZERO, "/system/z", || {
-            "z must be ≠ 0, got 0".to_owned()
-        });
+        ensure_rule!(v, z != 0.0, RATIO_NONZERO, "/system/z"; "z must be ≠ 0, got 0");
 
         // Motion.
         let mo = &req.motion;
@@ -115,45 +113,27 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
             (None, Some(x)) => (x * std::f64::consts::TAU, "/motion/Phi_rev", "Phi_rev"),
             _ => return Err(door_skipped("/motion/Phi_rad")),
         };
-        let ok_phi = v.ensure_rule(phi != 0.0, &ROTATION_NONZERO, phi_pointer, || {
-            format!("{phi_name} must be ≠ 0, got 0")
-        });
+        let ok_phi = ensure_rule!(v, phi != 0.0, ROTATION_NONZERO, phi_pointer;
+            "{phi_name} must be ≠ 0, got 0");
         if !(ORDER_M.contains(mo.m as f64) && FREE_P.contains(mo.p as f64)) {
             return Err(door_skipped("/motion/m"));
         }
         let (m, p) = (small(mo.m), small(mo.p));
-        v.ensure_rule(
-            2 * m + p - 1 <= MAX_ACCEL_DEGREE,
-            &DEGREE,
-            "/motion/p",
-            || {
-                format!(
-                    "N = 2m + p − 1 must be ≤ {MAX_ACCEL_DEGREE} (Bernstein conditioning), got {} \
+        ensure_rule!(v, 2 * m + p - 1 <= MAX_ACCEL_DEGREE, DEGREE, "/motion/p";
+            "N = 2m + p − 1 must be ≤ {MAX_ACCEL_DEGREE} (Bernstein conditioning), got {} \
                  (m = {m}, p = {p})",
-                    2 * m + p - 1
-                )
-            },
-        );
+            2 * m + p - 1);
         let gamma = match &mo.gamma_rad {
             Some(g) if g.len() != p => {
-                v.rule(
-                    &GAMMA_LENGTH,
-                    "/motion/gamma_rad",
-                    format!("must hold p = {p} ordinates, got {}", g.len()),
-                );
+                rule!(v, GAMMA_LENGTH, "/motion/gamma_rad";
+                    "must hold p = {p} ordinates, got {}", g.len());
                 Vec::new()
             }
             Some(g) => {
                 let lim = GAMMA_OVER_PHI_MAX * phi.abs();
                 if ok_phi && let Some(i) = g.iter().position(|x| x.abs() > lim) {
-                    v.rule(
-                        &GAMMA_SCALE,
-                        format!("/motion/gamma_rad/{i}"),
-                        format!(
-                            "|gamma_rad[{i}]| [rad] must be ≤ 1e3·|Phi| = {lim}, got {}",
-                            g[i]
-                        ),
-                    );
+                    rule!(v, GAMMA_SCALE, format!("/motion/gamma_rad/{i}");
+                        "|gamma_rad[{i}]| [rad] must be ≤ 1e3·|Phi| = {lim}, got {}", g[i]);
                 }
                 g.clone()
             }
@@ -221,11 +201,8 @@ impl TryFrom<BezierMotionRequest> for BezierInput {
 fn shaper_spec(sc: &wire::ShaperComparisonIn, v: &mut Validator) -> ShaperSpec {
     for (i, s) in sc.shapers.iter().enumerate() {
         if sc.shapers[..i].contains(s) {
-            v.rule(
-                &SHAPER_REPEATED,
-                format!("/outputs/shaper_comparison/shapers/{i}"),
-                format!("shapers[{i}] repeats an earlier entry; list each shaper once"),
-            );
+            rule!(v, SHAPER_REPEATED, format!("/outputs/shaper_comparison/shapers/{i}");
+                "shapers[{i}] repeats an earlier entry; list each shaper once");
         }
     }
     ShaperSpec {

@@ -21,6 +21,7 @@ use super::wire::{
 };
 pub use super::wire::{MAX_CYCLE_SAMPLES, MAX_CYCLES, MAX_MOTORS};
 use crate::calc::common::{RESPONSE_TOO_LARGE_RULE, SHARD_INDEX_BELOW_COUNT};
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, CrossRule, Validator};
 
 crate::calc::rules::cross_rules! {
@@ -180,23 +181,15 @@ fn axis(v: &mut Validator, ptr: &str, xs: &[f64]) -> bool {
     let Some(i) = (1..xs.len()).find(|&i| xs[i] <= xs[i - 1]) else {
         return true;
     };
-    v.rule(
-        &AXIS_ORDER,
-        format!("{ptr}/{i}"),
-        format!(
-            "axis must be strictly increasing: {} after {}",
-            xs[i],
-            xs[i - 1]
-        ),
-    );
+    rule!(v, AXIS_ORDER, format!("{ptr}/{i}");
+        "axis must be strictly increasing: {} after {}", xs[i], xs[i - 1]);
     false
 }
 
 /// A list `ys` at `ptr` has the length of its axis `xs` (named `axis`).
 fn same_length(v: &mut Validator, ptr: &str, ys: &[f64], n: usize, axis: &str) -> bool {
-    v.ensure_rule(ys.len() == n, &LENGTH_MISMATCH, ptr, || {
-        format!("must have {n} values like {axis}, got {}", ys.len())
-    })
+    ensure_rule!(v, ys.len() == n, LENGTH_MISMATCH, ptr;
+        "must have {n} values like {axis}, got {}", ys.len())
 }
 
 /// An axis `{base}/{x}` (strictly increasing) and the list `{base}/{y}` paired with it.
@@ -208,23 +201,13 @@ fn paired(v: &mut Validator, base: &str, (x, xs): (&str, &[f64]), (y, ys): (&str
 /// A table `[rows][cols]` (its values are checked at the door).
 fn table(v: &mut Validator, ptr: &str, t: &[Vec<f64>], (rows, cols): (usize, usize)) -> bool {
     if t.len() != rows {
-        v.rule(
-            &LENGTH_MISMATCH,
-            ptr,
-            format!("must have {rows} rows (one per speed), got {}", t.len()),
-        );
+        rule!(v, LENGTH_MISMATCH, ptr; "must have {rows} rows (one per speed), got {}", t.len());
         return false;
     }
     for (i, row) in t.iter().enumerate() {
         if row.len() != cols {
-            v.rule(
-                &LENGTH_MISMATCH,
-                format!("{ptr}/{i}"),
-                format!(
-                    "must have {cols} values (one per torque), got {}",
-                    row.len()
-                ),
-            );
+            rule!(v, LENGTH_MISMATCH, format!("{ptr}/{i}");
+                "must have {cols} values (one per torque), got {}", row.len());
             return false;
         }
     }
@@ -264,11 +247,8 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
         BatteryModel::Constant => {
             for (name, present) in ecm_fields {
                 if present {
-                    v.rule(
-                        &BATTERY_MODEL_FIELDS,
-                        format!("/battery/{name}"),
-                        "is an ecm_2rc field; not allowed with model \"constant\"".to_owned(),
-                    );
+                    rule!(v, BATTERY_MODEL_FIELDS, format!("/battery/{name}");
+                        "is an ecm_2rc field; not allowed with model \"constant\"");
                 }
             }
             Battery::Constant {
@@ -277,20 +257,14 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
         }
         BatteryModel::Ecm2rc => {
             if b.efficiency.is_some() {
-                v.rule(
-                    &BATTERY_MODEL_FIELDS,
-                    "/battery/efficiency",
-                    "is a constant-model field; not allowed with model \"ecm_2rc\"".to_owned(),
-                );
+                rule!(v, BATTERY_MODEL_FIELDS, "/battery/efficiency";
+                    "is a constant-model field; not allowed with model \"ecm_2rc\"");
             }
             // A required field (its range is checked at the door); NaN placeholder when missing.
             let mut need = |name: &str, x: Option<f64>| -> f64 {
                 x.unwrap_or_else(|| {
-                    v.rule(
-                        &BATTERY_ECM_REQUIRED,
-                        format!("/battery/{name}"),
-                        "is required for model \"ecm_2rc\"".to_owned(),
-                    );
+                    rule!(v, BATTERY_ECM_REQUIRED, format!("/battery/{name}");
+                        "is required for model \"ecm_2rc\"");
                     f64::NAN
                 })
             };
@@ -313,11 +287,8 @@ fn battery(v: &mut Validator, b: &BatterySpec) -> Battery {
                         ("ocv_v", b.ocv_v.is_some()),
                     ] {
                         if !given {
-                            v.rule(
-                                &BATTERY_ECM_REQUIRED,
-                                format!("/battery/{name}"),
-                                "is required for model \"ecm_2rc\"".to_owned(),
-                            );
+                            rule!(v, BATTERY_ECM_REQUIRED, format!("/battery/{name}");
+                                "is required for model \"ecm_2rc\"");
                         }
                     }
                     (Vec::new(), Vec::new())
@@ -344,11 +315,8 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
         CycleSpec::Builtin(name) => {
             let cy = cycles::builtin(name);
             if cy.is_none() {
-                v.rule(
-                    &UNKNOWN_CYCLE,
-                    &base,
-                    format!("unknown built-in cycle '{name}' (known: manhattan, hwfet, hdudds)"),
-                );
+                rule!(v, UNKNOWN_CYCLE, &base;
+                    "unknown built-in cycle '{name}' (known: manhattan, hwfet, hdudds)");
             }
             cy
         }
@@ -368,14 +336,9 @@ fn cycle(v: &mut Validator, j: usize, c: &CycleSpec) -> Option<Cycle> {
                     // 1e-6 relative slack: 10.001 − 10.0 is 0.000999999… in binary.
                     !(MIN_TIME_STEP_S * (1.0 - 1e-6)..=MAX_TIME_STEP_S).contains(&dt)
                 }) {
-                    v.rule(
-                        &TIME_STEP,
-                        format!("{tp}/{i}"),
-                        format!(
-                            "time step must be in [{MIN_TIME_STEP_S}, {MAX_TIME_STEP_S}] s, got {} s",
-                            cc.time_s[i] - cc.time_s[i - 1]
-                        ),
-                    );
+                    rule!(v, TIME_STEP, format!("{tp}/{i}");
+                        "time step must be in [{MIN_TIME_STEP_S}, {MAX_TIME_STEP_S}] s, got {} s",
+                        cc.time_s[i] - cc.time_s[i - 1]);
                     ok = false;
                 }
             } else {
@@ -409,12 +372,8 @@ fn envelope(
     let env = match table {
         Some(t) => {
             let p = format!("{base}/envelope");
-            v.ensure_rule(
-                t_peak.is_none() && p_peak.is_none(),
-                &ENVELOPE_CONFLICT,
-                &p,
-                || "give either envelope or t_peak_nm/p_peak_w, not both".to_owned(),
-            );
+            ensure_rule!(v, t_peak.is_none() && p_peak.is_none(), ENVELOPE_CONFLICT, &p;
+                "give either envelope or t_peak_nm/p_peak_w, not both");
             paired(
                 v,
                 &p,
@@ -441,12 +400,8 @@ fn psi_m(v: &mut Validator, p: &str, m: &IpmsmMotor, pp: f64) -> f64 {
         (Some(psi), None) => psi,
         (None, Some(b)) => {
             let psi = psi_from_back_emf(b.v_peak_phase, b.at_rpm, pp);
-            v.ensure_rule(
-                w::PSI_M_WB.contains(psi),
-                &BACK_EMF_PSI,
-                format!("{p}back_emf"),
-                || format!("implies ψ_m = {psi} Wb, outside {}", w::PSI_M_WB),
-            );
+            ensure_rule!(v, w::PSI_M_WB.contains(psi), BACK_EMF_PSI, format!("{p}back_emf");
+                "implies ψ_m = {psi} Wb, outside {}", w::PSI_M_WB);
             psi
         }
         _ => f64::NAN,
@@ -479,24 +434,15 @@ fn ipmsm(v: &mut Validator, base: &str, m: &IpmsmMotor) -> Ipmsm {
     let p = format!("{base}/");
     let pp = f64::from(m.pole_pairs);
     let psi = psi_m(v, &p, m, pp);
-    v.ensure_rule(m.lq_h >= m.ld_h, &LQ_BELOW_LD, format!("{p}lq_h"), || {
-        format!(
-            "must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}",
-            m.ld_h, m.lq_h
-        )
-    });
+    ensure_rule!(v, m.lq_h >= m.ld_h, LQ_BELOW_LD, format!("{p}lq_h");
+        "must be ≥ ld_h ({}) for an IPMSM with reluctance torque (MTPA assumes L_q ≥ L_d), got {}",
+        m.ld_h, m.lq_h);
     let ac = ac_factor(v, &p, m.ac_factor.as_ref());
     let iron = m.iron.clone().unwrap_or_default();
     let mech = m.mech.clone().unwrap_or_default();
-    v.ensure_rule(
-        m.stack_scale.is_none() || matches!(ac, AcFactor::Dowell(_)),
-        &STACK_SCALE_DOWELL,
-        format!("{p}stack_scale"),
-        || {
-            "needs ac_factor model \"dowell\" (its stack/end lengths split the resistance)"
-                .to_owned()
-        },
-    );
+    ensure_rule!(v, m.stack_scale.is_none() || matches!(ac, AcFactor::Dowell(_)),
+        STACK_SCALE_DOWELL, format!("{p}stack_scale");
+        "needs ac_factor model \"dowell\" (its stack/end lengths split the resistance)");
     Ipmsm::new(&IpmsmParams {
         pole_pairs: pp,
         psi_m_wb: psi,
@@ -588,11 +534,7 @@ fn loss_map(
 ) -> Grid2 {
     let (ok_s, ok_t) = map_axes(v, base, (&m.speed_rpm, &m.torque_nm));
     if ok_t && !m.torque_nm.iter().any(|&t| t.abs() <= 0.0) {
-        v.rule(
-            &LOSS_AXIS_ZERO,
-            format!("{base}/torque_nm"),
-            "signed torque axis must contain 0".to_owned(),
-        );
+        rule!(v, LOSS_AXIS_ZERO, format!("{base}/torque_nm"); "signed torque axis must contain 0");
     }
     let (ns, nt) = (m.speed_rpm.len(), m.torque_nm.len());
     let ok = ok_s && ok_t && table(v, &format!("{base}/loss_w"), &m.loss_w, (ns, nt));
@@ -721,20 +663,11 @@ fn cycles(v: &mut Validator, specs: &[CycleSpec]) -> Vec<(usize, Cycle)> {
     for (j, c) in specs.iter().enumerate().take(MAX_CYCLES) {
         if let Some(cy) = cycle(v, j, c) {
             if cy.distance_m() <= 0.0 {
-                v.rule(
-                    &ZERO_DISTANCE,
-                    format!("/cycles/{j}"),
-                    format!(
-                        "cycle '{}' has zero distance (fuel economy undefined)",
-                        cy.name
-                    ),
-                );
+                rule!(v, ZERO_DISTANCE, format!("/cycles/{j}");
+                    "cycle '{}' has zero distance (fuel economy undefined)", cy.name);
             } else if let Some((k, _)) = cycles_ok.iter().find(|(_, o)| o.name == cy.name) {
-                v.rule(
-                    &DUPLICATE_NAME,
-                    format!("/cycles/{j}"),
-                    format!("duplicate cycle name '{}' (also /cycles/{k})", cy.name),
-                );
+                rule!(v, DUPLICATE_NAME, format!("/cycles/{j}");
+                    "duplicate cycle name '{}' (also /cycles/{k})", cy.name);
             }
             cycles_ok.push((j, cy));
         }
@@ -747,11 +680,8 @@ fn motors(v: &mut Validator, specs: &[MotorSpec]) -> Vec<MotorInput> {
     let mut motors = Vec::new();
     for (i, m) in specs.iter().enumerate().take(MAX_MOTORS) {
         if let Some(k) = specs[..i].iter().position(|o| o.id() == m.id()) {
-            v.rule(
-                &DUPLICATE_NAME,
-                format!("/motors/{i}/id"),
-                format!("duplicate motor id '{}' (also /motors/{k})", m.id()),
-            );
+            rule!(v, DUPLICATE_NAME, format!("/motors/{i}/id");
+                "duplicate motor id '{}' (also /motors/{k})", m.id());
         }
         motors.push(motor(v, i, m));
     }
@@ -767,23 +697,16 @@ fn desirability(v: &mut Validator, weights: Option<&[f64]>, n_cycles: usize) -> 
         return equal;
     };
     let p = "/options/desirability_weights";
-    if !v.ensure_rule(w.len() == n_cycles, &LENGTH_MISMATCH, p, || {
-        format!(
-            "must have one weight per cycle ({n_cycles}), got {}",
-            w.len()
-        )
-    }) {
+    if !ensure_rule!(v, w.len() == n_cycles, LENGTH_MISMATCH, p;
+        "must have one weight per cycle ({n_cycles}), got {}", w.len())
+    {
         return equal;
     }
     let s: f64 = w.iter().sum();
     if s > 0.0 {
         w.iter().map(|x| x / s).collect()
     } else {
-        v.rule(
-            &DESIRABILITY_ZERO,
-            p,
-            "weights must not all be 0".to_owned(),
-        );
+        rule!(v, DESIRABILITY_ZERO, p; "weights must not all be 0");
         equal
     }
 }
@@ -805,17 +728,10 @@ fn speed_limits(
                     }
                     _ => "n_max_rpm",
                 };
-                v.rule(
-                    &CYCLE_ABOVE_MOTOR_SPEED,
-                    format!("/motors/{i}/n_max_rpm"),
-                    format!(
-                        "cycle '{}' (/cycles/{j}) needs {:.1} rpm at its top speed {:.3} km/h, above the motor's {field} {:.1} rpm",
-                        c.name,
-                        super::ipmsm::rad_s_to_rpm(w_need),
-                        c.max_speed_mps() * 3.6,
-                        super::ipmsm::rad_s_to_rpm(m.omega_max)
-                    ),
-                );
+                rule!(v, CYCLE_ABOVE_MOTOR_SPEED, format!("/motors/{i}/n_max_rpm");
+                    "cycle '{}' (/cycles/{j}) needs {:.1} rpm at its top speed {:.3} km/h, above the motor's {field} {:.1} rpm",
+                    c.name, super::ipmsm::rad_s_to_rpm(w_need), c.max_speed_mps() * 3.6,
+                    super::ipmsm::rad_s_to_rpm(m.omega_max));
             }
         }
     }

@@ -9,6 +9,7 @@ use super::law::{
     normalize_coefficients,
 };
 use super::wire::{AbscissaIn, ConstraintsIn, EvaluateRequest, Units};
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, Validator};
 
 crate::calc::rules::cross_rules! {
@@ -112,26 +113,17 @@ fn check_abscissa(v: &mut Validator, a: Option<AbscissaIn>) -> Option<Abscissa> 
     let a = a?;
     if let Some(values) = a.values {
         if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
-            v.rule(
-                &ABSCISSA_ORDER,
-                format!("/abscissa/values/{}", i + 1),
-                format!(
-                    "abscissae must be strictly increasing, got {} after {} at index {i}",
-                    values[i + 1],
-                    values[i]
-                ),
-            );
+            rule!(v, ABSCISSA_ORDER, format!("/abscissa/values/{}", i + 1);
+                "abscissae must be strictly increasing, got {} after {} at index {i}",
+                values[i + 1], values[i]);
             return None;
         }
         return Some(Abscissa::Values(values));
     }
     let g = a.grid?;
     if g.end <= g.start {
-        v.rule(
-            &ABSCISSA_ORDER,
-            "/abscissa/grid/end",
-            format!("must be > start = {}, got {}", g.start, g.end),
-        );
+        rule!(v, ABSCISSA_ORDER, "/abscissa/grid/end";
+            "must be > start = {}, got {}", g.start, g.end);
         return None;
     }
     // count ≤ MAX_POINTS (checked at the door): the conversion is exact.
@@ -149,33 +141,24 @@ fn check_coefficients(v: &mut Validator, c: &[f64], normalize: bool) -> Option<(
     let arr = <[f64; 7]>::try_from(c).ok()?;
     let sum: f64 = arr.iter().sum();
     if !normalize && (sum - 1.0).abs() > SUM_TOL {
-        v.rule(
-            &COEFFICIENT_SUM,
-            "/coefficients",
-            format!("coefficients must sum to 1 within {SUM_TOL} (or set normalize: true), got sum {sum}"),
-        );
+        rule!(v, COEFFICIENT_SUM, "/coefficients";
+            "coefficients must sum to 1 within {SUM_TOL} (or set normalize: true), got sum {sum}");
         return None;
     }
     match normalize_coefficients(&arr) {
         Ok(_) => Some((arr, (sum - 1.0).abs() > SUM_SILENT_TOL)),
         Err(LawError::EmptyFirstPulse { area }) => {
-            v.rule(
-                &EMPTY_PULSE,
-                "/coefficients",
-                format!("the first acceleration pulse (c0, c1, c2) is empty: normalized area {area:e} < 1e-9"),
-            );
+            rule!(v, EMPTY_PULSE, "/coefficients";
+                "the first acceleration pulse (c0, c1, c2) is empty: normalized area {area:e} < 1e-9");
             None
         }
         Err(LawError::EmptySecondPulse { area }) => {
-            v.rule(
-                &EMPTY_PULSE,
-                "/coefficients",
-                format!("the second acceleration pulse (c4, c5, c6) is empty: normalized area {area:e} < 1e-9"),
-            );
+            rule!(v, EMPTY_PULSE, "/coefficients";
+                "the second acceleration pulse (c4, c5, c6) is empty: normalized area {area:e} < 1e-9");
             None
         }
         Err(e) => {
-            v.rule(&EMPTY_PULSE, "/coefficients", e.to_string());
+            rule!(v, EMPTY_PULSE, "/coefficients"; "{}", e.to_string());
             None
         }
     }
@@ -238,27 +221,14 @@ fn boundary(
         }
     };
     if bc.t_b <= bc.t_a {
-        v.rule(
-            &SEGMENT_INTERVAL,
-            "/constraints/t_b",
-            format!(
-                "t_b must be > t_a = {}{}, got {}{}",
-                bc.t_a,
-                defaulted(c.t_a, "first abscissa"),
-                bc.t_b,
-                defaulted(c.t_b, "last abscissa")
-            ),
-        );
+        rule!(v, SEGMENT_INTERVAL, "/constraints/t_b";
+            "t_b must be > t_a = {}{}, got {}{}", bc.t_a, defaulted(c.t_a, "first abscissa"),
+            bc.t_b, defaulted(c.t_b, "last abscissa"));
         bc_ok = false;
     } else if bc.t_b - bc.t_a <= MIN_RELATIVE_INTERVAL * bc.t_a.abs().max(bc.t_b.abs()) {
-        v.rule(
-            &SEGMENT_INTERVAL,
-            "/constraints/t_b",
-            format!(
-                "t_b - t_a = {:e} is too short to resolve knots at this offset (must exceed {MIN_RELATIVE_INTERVAL:e}·max(|t_a|, |t_b|))",
-                bc.t_b - bc.t_a
-            ),
-        );
+        rule!(v, SEGMENT_INTERVAL, "/constraints/t_b";
+            "t_b - t_a = {:e} is too short to resolve knots at this offset (must exceed {MIN_RELATIVE_INTERVAL:e}·max(|t_a|, |t_b|))",
+            bc.t_b - bc.t_a);
         bc_ok = false;
     }
     (bc, bc_ok)
@@ -275,17 +245,10 @@ fn closed_form_rates(v: &mut Validator, law: Option<&LawChoice>, bc: &BoundaryCo
         ("a_a", bc.a_a),
         ("a_b", bc.a_b),
     ] {
-        v.ensure_rule(
-            value == 0.0 || !value.is_finite(),
-            &CLOSED_FORM_RATES,
-            format!("/constraints/{name}"),
-            || {
-                format!(
-                    "must be 0 for the named law `{}`, which is outside the 7-segment class (only zero end rates), got {value}",
-                    named.wire_name()
-                )
-            },
-        );
+        ensure_rule!(v, value == 0.0 || !value.is_finite(),
+            CLOSED_FORM_RATES, format!("/constraints/{name}");
+            "must be 0 for the named law `{}`, which is outside the 7-segment class (only zero end rates), got {value}",
+            named.wire_name());
     }
 }
 
@@ -307,23 +270,15 @@ fn abscissa_within(v: &mut Validator, a: &Abscissa, bc: &BoundaryConditions) {
                 } else {
                     String::new()
                 };
-                v.rule(
-                    &ABSCISSA_OUTSIDE,
-                    format!("/abscissa/values/{i}"),
-                    format!("abscissa {x} lies outside {}{tail}", range()),
-                );
+                rule!(v, ABSCISSA_OUTSIDE, format!("/abscissa/values/{i}");
+                    "abscissa {x} lies outside {}{tail}", range());
             }
         }
         Abscissa::Grid { start, end, .. } => {
-            v.ensure_rule(
-                *start >= lo,
-                &ABSCISSA_OUTSIDE,
-                "/abscissa/grid/start",
-                || format!("grid start {start} lies outside {}", range()),
-            );
-            v.ensure_rule(*end <= hi, &ABSCISSA_OUTSIDE, "/abscissa/grid/end", || {
-                format!("grid end {end} lies outside {}", range())
-            });
+            ensure_rule!(v, *start >= lo, ABSCISSA_OUTSIDE, "/abscissa/grid/start";
+                "grid start {start} lies outside {}", range());
+            ensure_rule!(v, *end <= hi, ABSCISSA_OUTSIDE, "/abscissa/grid/end";
+                "grid end {end} lies outside {}", range());
         }
     }
 }

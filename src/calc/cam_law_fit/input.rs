@@ -7,6 +7,7 @@ use crate::calc::cam_law::law::{
     BoundaryConditions, K1, LawError, LawNotice, Quantity, SevenSegmentLaw,
 };
 use crate::calc::cam_law::wire::Units;
+use crate::calc::rules::rule;
 use crate::calc::{CalcFailure, Validator};
 
 use super::optim::ga::GaParams;
@@ -211,40 +212,26 @@ fn abscissa(req: &FitCamLawRequest, v: &mut Validator) -> Option<Vec<f64>> {
         (Some(_), Some(_)) | (None, None) => None,
         (Some(values), None) => {
             if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
-                v.rule(
-                    &ABSCISSA_ORDER,
-                    format!("/abscissa/values/{}", i + 1),
-                    format!(
-                        "abscissae must be strictly increasing, got {} after {}",
-                        values[i + 1],
-                        values[i]
-                    ),
-                );
+                rule!(v, ABSCISSA_ORDER, format!("/abscissa/values/{}", i + 1);
+                    "abscissae must be strictly increasing, got {} after {}", values[i + 1],
+                    values[i]);
                 return None;
             }
             Some(values.clone())
         }
         (None, Some(g)) => {
             if g.end <= g.start {
-                v.rule(
-                    &ABSCISSA_ORDER,
-                    "/abscissa/grid/end",
-                    format!("must be > start = {}, got {}", g.start, g.end),
-                );
+                rule!(v, ABSCISSA_ORDER, "/abscissa/grid/end";
+                    "must be > start = {}, got {}", g.start, g.end);
                 return None;
             }
             // count ≤ 200 000 (checked at the door): the conversion cannot fail.
             let count = usize::try_from(g.count).ok()?;
             let xs = grid::linspace(g.start, g.end, count);
             if xs.windows(2).any(|w| w[1] <= w[0]) {
-                v.rule(
-                    &ABSCISSA_ORDER,
-                    "/abscissa/grid",
-                    format!(
-                        "the grid [{}, {}] with {count} points is too fine to be strictly increasing in f64",
-                        g.start, g.end
-                    ),
-                );
+                rule!(v, ABSCISSA_ORDER, "/abscissa/grid";
+                    "the grid [{}, {}] with {count} points is too fine to be strictly increasing in f64",
+                    g.start, g.end);
                 return None;
             }
             Some(xs)
@@ -267,11 +254,8 @@ fn supplied(req: &FitCamLawRequest) -> [Option<&Vec<f64>>; 3] {
 fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -> (bool, Channel) {
     let supplied = supplied(req);
     if supplied.iter().all(Option::is_none) {
-        v.rule(
-            &NO_CHANNEL,
-            "/channels",
-            "supply at least one of displacement, velocity, acceleration",
-        );
+        rule!(v, NO_CHANNEL, "/channels";
+            "supply at least one of displacement, velocity, acceleration");
     }
     let mut channels_ok = true;
     for (q, ch) in Channel::ALL.iter().zip(supplied) {
@@ -280,14 +264,8 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
             if let Some(n) = n
                 && values.len() != n
             {
-                v.rule(
-                    &CHANNEL_LENGTH,
-                    &p,
-                    format!(
-                        "must have one value per abscissa ({n}), got {}",
-                        values.len()
-                    ),
-                );
+                rule!(v, CHANNEL_LENGTH, &p;
+                    "must have one value per abscissa ({n}), got {}", values.len());
                 channels_ok = false;
             }
         }
@@ -296,23 +274,13 @@ fn check_channels(req: &FitCamLawRequest, n: Option<usize>, v: &mut Validator) -
     let fit_idx = fit_on.index();
     if supplied[fit_idx].is_none() && !supplied.iter().all(Option::is_none) {
         if !req.derive_missing {
-            v.rule(
-                &FIT_CHANNEL,
-                "/fit_on",
-                format!(
-                    "the {} channel is not supplied: supply it, fit on a supplied channel, or set derive_missing: true",
-                    fit_on.name()
-                ),
-            );
+            rule!(v, FIT_CHANNEL, "/fit_on";
+                "the {} channel is not supplied: supply it, fit on a supplied channel, or set derive_missing: true",
+                fit_on.name());
         } else if supplied[..fit_idx].iter().all(Option::is_none) {
-            v.rule(
-                &FIT_CHANNEL,
-                "/fit_on",
-                format!(
-                    "cannot derive {} from the supplied channels: only differentiation s → v → a is offered (no integration); fit on a supplied channel",
-                    fit_on.name()
-                ),
-            );
+            rule!(v, FIT_CHANNEL, "/fit_on";
+                "cannot derive {} from the supplied channels: only differentiation s → v → a is offered (no integration); fit on a supplied channel",
+                fit_on.name());
         }
     }
 
@@ -339,13 +307,8 @@ fn check_constraints(
     let any_channel = supplied.iter().any(Option::is_some);
     for (name, given, end) in [("s_a", s_a, "start"), ("s_b", s_b, "end")] {
         if given.is_none() && s_data.is_none() && any_channel {
-            v.rule(
-                &END_DISPLACEMENT,
-                format!("/constraints/{name}"),
-                format!(
-                    "required when no displacement channel is supplied (the {end} displacement)"
-                ),
-            );
+            rule!(v, END_DISPLACEMENT, format!("/constraints/{name}");
+                "required when no displacement channel is supplied (the {end} displacement)");
         }
     }
     let mut bc = None;
@@ -365,17 +328,16 @@ fn check_constraints(
         };
         match cand.check() {
             Ok(()) => bc = Some(cand),
-            Err(LawError::IntervalNotIncreasing { .. }) => v.rule(
-                &SEGMENT_INTERVAL,
-                "/constraints/t_b",
-                format!("t_b must be greater than t_a = {t_a}, got {t_b}"),
-            ),
+            Err(LawError::IntervalNotIncreasing { .. }) => {
+                rule!(v, SEGMENT_INTERVAL, "/constraints/t_b";
+                "t_b must be greater than t_a = {t_a}, got {t_b}")
+            }
             Err(e @ LawError::IntervalTooShort { .. }) => {
-                v.rule(&SEGMENT_INTERVAL, "/constraints/t_b", e.to_string());
+                rule!(v, SEGMENT_INTERVAL, "/constraints/t_b"; "{}", e.to_string());
             }
             // Every given value and every sample is within DATA_VALUE (the door), so the
             // magnitude cap cannot be broken; should it be, it is the segment's rule.
-            Err(e) => v.rule(&SEGMENT_INTERVAL, "/constraints", e.to_string()),
+            Err(e) => rule!(v, SEGMENT_INTERVAL, "/constraints"; "{}", e.to_string()),
         }
     }
     // Samples inside [t_a, t_b] up to the tolerance.
@@ -396,14 +358,9 @@ fn check_constraints(
             } else {
                 pointer_base.to_owned()
             };
-            v.rule(
-                &ABSCISSA_OUTSIDE,
-                p,
-                format!(
-                    "sample x = {x} lies outside the segment [t_a, t_b] = [{}, {}]: set constraints t_a/t_b to cover every sample, or drop the samples outside",
-                    bc.t_a, bc.t_b
-                ),
-            );
+            rule!(v, ABSCISSA_OUTSIDE, p;
+                "sample x = {x} lies outside the segment [t_a, t_b] = [{}, {}]: set constraints t_a/t_b to cover every sample, or drop the samples outside",
+                bc.t_a, bc.t_b);
         }
     }
 
@@ -448,22 +405,16 @@ fn check_initial(
             (4..7, "c4, c5, c6", "second"),
         ] {
             if fixed_zero[pulse].iter().all(|z| *z) {
-                v.rule(
-                    &EMPTY_PULSE,
-                    "/fixed_zero",
-                    format!("fixes all of {cs}: the {which} acceleration pulse would be empty; free at least one of them"),
-                );
+                rule!(v, EMPTY_PULSE, "/fixed_zero";
+                    "fixes all of {cs}: the {which} acceleration pulse would be empty; free at least one of them");
             }
         }
     }
     let mut initial = [1.0 / 7.0; 7];
     let mut initial_pointer = None;
     match (&req.initial_coefficients, req.initial_law) {
-        (Some(_), Some(_)) => v.rule(
-            &INITIAL_EXCLUSIVE,
-            "/initial_law",
-            "give at most one of initial_coefficients and initial_law",
-        ),
+        (Some(_), Some(_)) => rule!(v, INITIAL_EXCLUSIVE, "/initial_law";
+            "give at most one of initial_coefficients and initial_law"),
         (Some(ic), None) => {
             initial_pointer = Some("/initial_coefficients");
             // 7 numbers ≥ 0: checked at the door.
@@ -475,14 +426,9 @@ fn check_initial(
             initial_pointer = Some("/initial_law");
             match law.seven_segment_coefficients() {
                 Some(cv) => initial = cv,
-                None => v.rule(
-                    &INITIAL_LAW_CLASS,
-                    "/initial_law",
-                    format!(
-                        "{} is not a 7-segment law: use constant_acceleration, simple_harmonic, cycloidal, modified_trapezoid or modified_sine, or give initial_coefficients",
-                        law.wire_name()
-                    ),
-                ),
+                None => rule!(v, INITIAL_LAW_CLASS, "/initial_law";
+                    "{} is not a 7-segment law: use constant_acceleration, simple_harmonic, cycloidal, modified_trapezoid or modified_sine, or give initial_coefficients",
+                    law.wire_name()),
             }
         }
         (None, None) => {}
@@ -503,19 +449,13 @@ fn check_initial(
             (pulse2, "c4, c5, c6", "second"),
         ] {
             if pulse <= 0.0 {
-                v.rule(
-                    &EMPTY_PULSE,
-                    p,
-                    format!("{cs} (after fixed_zero) are all zero: the {which} acceleration pulse is empty; give at least one of them a positive value"),
-                );
+                rule!(v, EMPTY_PULSE, p;
+                    "{cs} (after fixed_zero) are all zero: the {which} acceleration pulse is empty; give at least one of them a positive value");
             }
         }
     } else if sum.is_finite() {
-        v.rule(
-            &EMPTY_PULSE,
-            p,
-            "the coefficients (after fixed_zero) are all zero: both acceleration pulses are empty",
-        );
+        rule!(v, EMPTY_PULSE, p;
+            "the coefficients (after fixed_zero) are all zero: both acceleration pulses are empty");
     }
 
     (initial, fixed_zero, initial_pointer)
@@ -635,14 +575,8 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
         match (usize::try_from(w), n) {
             (Ok(wu), Some(max)) if wu <= max => dtw_window = wu,
             (Ok(_), None) => {}
-            _ => v.rule(
-                &DTW_WINDOW_SAMPLES,
-                "/objective/dtw_window",
-                format!(
-                    "must be in [0, N = {}] samples, got {w}",
-                    n.unwrap_or_default()
-                ),
-            ),
+            _ => rule!(v, DTW_WINDOW_SAMPLES, "/objective/dtw_window";
+                "must be in [0, N = {}] samples, got {w}", n.unwrap_or_default()),
         }
     }
 
@@ -650,11 +584,8 @@ pub fn validate(req: FitCamLawRequest) -> Result<FitInput, CalcFailure> {
     let o = req.optimizer;
     let method = o.method;
     if metric == MetricName::Dtw && method == Method::Lsq {
-        v.rule(
-            &METHOD_METRIC,
-            "/optimizer/method",
-            "`lsq` minimizes a sum of squares and cannot fit the DTW metric: use `auto`, `cmaes`, `de` or `ga`",
-        );
+        rule!(v, METHOD_METRIC, "/optimizer/method";
+            "`lsq` minimizes a sum of squares and cannot fit the DTW metric: use `auto`, `cmaes`, `de` or `ga`");
     }
     let max_evaluations = o.max_evaluations.unwrap_or(DEFAULT_MAX_EVALUATIONS);
     let ga = ga_params(o.ga);

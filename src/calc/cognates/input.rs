@@ -10,6 +10,7 @@
 //! no square can overflow or underflow whatever the caller's unit.
 
 use crate::calc::common;
+use crate::calc::rules::rule;
 use crate::calc::{CalcFailure, Validator};
 
 use super::geometry::{C64, FourBar, Sign, cis, cross};
@@ -194,11 +195,8 @@ fn joints_mode(
 ) -> Result<CognatesInput, CalcFailure> {
     for (ptr, present) in conflicts_with_joints(req) {
         if present {
-            v.rule(
-                &JOINTS_EXCLUSIVE,
-                ptr,
-                "must be omitted with `joints` (read from the drawn configuration)",
-            );
+            rule!(v, JOINTS_EXCLUSIVE, ptr;
+                "must be omitted with `joints` (read from the drawn configuration)");
         }
     }
     // Every coordinate is within ±1e100 (the door).
@@ -215,15 +213,12 @@ fn joints_mode(
         .max((p - d).norm())
         .max((p - e).norm());
     if !(big_l.is_finite() && big_l > 0.0) {
-        v.rule(&LENGTH_FLOOR, "/joints", "all joints coincide");
+        rule!(v, LENGTH_FLOOR, "/joints"; "all joints coincide");
         v.checkpoint()?;
     }
     if l <= COINCIDENT_REL * big_l {
-        v.rule(
-            &COINCIDENT_PIVOTS,
-            "/joints/B",
-            format!("B coincides with A: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"),
-        );
+        rule!(v, COINCIDENT_PIVOTS, "/joints/B";
+            "B coincides with A: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})");
     }
     length_floor(
         &mut v,
@@ -280,11 +275,8 @@ fn length_floor(
     let floor = LENGTH_FLOOR_REL * big_l;
     for (ptr, name, len) in links {
         if too_short(len, floor) {
-            v.rule(
-                &LENGTH_FLOOR,
-                ptr,
-                format!("{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)"),
-            );
+            rule!(v, LENGTH_FLOOR, ptr;
+                "{name} = {len:e} is zero next to L = {big_l:e} (limit 1e-12·L)");
         }
     }
 }
@@ -294,23 +286,11 @@ fn length_floor(
 fn check_at_joint(v: &mut Validator, ptr: &str, k: C64) {
     let one = C64::new(1.0, 0.0);
     if k.norm() <= AT_JOINT_TOL {
-        v.rule(
-            &COUPLER_POINT_AT_JOINT,
-            ptr,
-            format!(
-                "P coincides with the crank joint D: |k| = {:e} ≤ 1e-9",
-                k.norm()
-            ),
-        );
+        rule!(v, COUPLER_POINT_AT_JOINT, ptr;
+            "P coincides with the crank joint D: |k| = {:e} ≤ 1e-9", k.norm());
     } else if (one - k).norm() <= AT_JOINT_TOL {
-        v.rule(
-            &COUPLER_POINT_AT_JOINT,
-            ptr,
-            format!(
-                "P coincides with the rocker joint E: |1 − k| = {:e} ≤ 1e-9",
-                (one - k).norm()
-            ),
-        );
+        rule!(v, COUPLER_POINT_AT_JOINT, ptr;
+            "P coincides with the rocker joint E: |1 − k| = {:e} ≤ 1e-9", (one - k).norm());
     }
 }
 
@@ -318,38 +298,23 @@ fn check_at_joint(v: &mut Validator, ptr: &str, k: C64) {
 /// coordinate caps and l > 0 are checked at the door).
 fn check_ground(v: &mut Validator, ground: Option<&GroundSpec>) -> Option<([f64; 2], [f64; 2])> {
     let Some(g) = ground else {
-        v.rule(
-            &DIMENSIONS_REQUIRED,
-            "/ground",
-            "ground is required (or give `joints`)",
-        );
+        rule!(v, DIMENSIONS_REQUIRED, "/ground"; "ground is required (or give `joints`)");
         return None;
     };
     let a_raw = g.a.unwrap_or([0.0, 0.0]);
     match (g.b, g.length) {
         (Some(_), Some(_)) => {
-            v.rule(
-                &GROUND_B_OR_LENGTH,
-                "/ground/length",
-                "give either B or length, not both",
-            );
+            rule!(v, GROUND_B_OR_LENGTH, "/ground/length"; "give either B or length, not both");
             None
         }
         (None, None) => {
-            v.rule(
-                &GROUND_B_OR_LENGTH,
-                "/ground/B",
-                "B (or length) is required",
-            );
+            rule!(v, GROUND_B_OR_LENGTH, "/ground/B"; "B (or length) is required");
             None
         }
         (Some(b), None) => {
             if g.angle_deg.is_some() {
-                v.rule(
-                    &GROUND_ANGLE_WITH_LENGTH,
-                    "/ground/angle_deg",
-                    "angle_deg goes with length, not with B",
-                );
+                rule!(v, GROUND_ANGLE_WITH_LENGTH, "/ground/angle_deg";
+                    "angle_deg goes with length, not with B");
             }
             Some((a_raw, b))
         }
@@ -372,11 +337,7 @@ fn check_links(v: &mut Validator, req: &CognatesRequest) -> Option<[f64; 3]> {
     ]) {
         match given {
             None => {
-                v.rule(
-                    &DIMENSIONS_REQUIRED,
-                    ptr,
-                    format!("{name} is required (or give `joints`)"),
-                );
+                rule!(v, DIMENSIONS_REQUIRED, ptr; "{name} is required (or give `joints`)");
                 ok = false;
             }
             Some(x) => *slot = x,
@@ -388,11 +349,8 @@ fn check_links(v: &mut Validator, req: &CognatesRequest) -> Option<[f64; 3]> {
 /// The coupler point in any of its three forms (its ranges are checked at the door).
 fn check_coupler_point(v: &mut Validator, cp: Option<CouplerPoint>) -> Option<CouplerPoint> {
     if cp.is_none() {
-        v.rule(
-            &DIMENSIONS_REQUIRED,
-            "/coupler_point",
-            "coupler_point is required (or give `joints`)",
-        );
+        rule!(v, DIMENSIONS_REQUIRED, "/coupler_point";
+            "coupler_point is required (or give `joints`)");
     }
     cp
 }
@@ -411,11 +369,8 @@ fn coupler_data(v: &mut Validator, cp: CouplerPoint, coupler: f64) -> Option<Cou
             .into_iter()
             .find(|(x, s, _)| *x > *s + slack);
             if let Some((_, _, what)) = violated {
-                v.rule(
-                    &COUPLER_TRIANGLE_INVALID,
-                    "/coupler_point",
-                    format!("coupler triangle (b, d, e) = ({coupler}, {d}, {e}) violates the triangle inequality: {what}"),
-                );
+                rule!(v, COUPLER_TRIANGLE_INVALID, "/coupler_point";
+                    "coupler triangle (b, d, e) = ({coupler}, {d}, {e}) violates the triangle inequality: {what}");
                 return None;
             }
             // Work with lengths scaled by max(b, d, e) so the squares cannot overflow.
@@ -470,15 +425,8 @@ fn dimension_mode(
     let (d_len, e_len) = ratio.as_ref().map_or((0.0, 0.0), |c| (c.d, c.e));
     let big_l = l.max(crank).max(coupler).max(rocker).max(d_len).max(e_len);
     if l <= COINCIDENT_REL * big_l {
-        v.rule(
-            &COINCIDENT_PIVOTS,
-            if req.ground.as_ref().is_some_and(|g| g.length.is_some()) {
-                "/ground/length"
-            } else {
-                "/ground/B"
-            },
-            format!("ground pivots coincide: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})"),
-        );
+        rule!(v, COINCIDENT_PIVOTS, if req.ground.as_ref().is_some_and(|g| g.length.is_some()) { "/ground/length" } else { "/ground/B" };
+            "ground pivots coincide: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})");
     }
     length_floor(
         &mut v,

@@ -18,6 +18,7 @@ use super::wire::{
     DEFAULT_O_OUT, DEFAULT_PATH_CAP, DEFAULT_Q_IN, FailureMode, Options, Outputs,
 };
 pub use super::wire::{MAX_COMPONENTS, MAX_ID_CHARS, MAX_TIMES, MIN_COMPONENTS};
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, Validator};
 
 crate::calc::rules::cross_rules! {
@@ -178,12 +179,8 @@ fn times_match(a: f64, b: f64) -> bool {
 /// The pair's sum (each weight positive and the count 2: checked at the door).
 fn weight_pair(v: &mut Validator, pointer: &str, w: &[f64]) -> Option<[f64; 2]> {
     let &[a, b] = w else { return None };
-    v.ensure_rule((a + b - 1.0).abs() <= SUM_TOL, &WEIGHT_SUM, pointer, || {
-        format!(
-            "weights must sum to 1 (±{SUM_TOL:e}), got {a} + {b} = {}",
-            a + b
-        )
-    })
+    ensure_rule!(v, (a + b - 1.0).abs() <= SUM_TOL, WEIGHT_SUM, pointer;
+        "weights must sum to 1 (±{SUM_TOL:e}), got {a} + {b} = {}", a + b)
     .then_some([a, b])
 }
 
@@ -221,11 +218,8 @@ fn ids<'a>(v: &mut Validator, components: &'a [ComponentSpec]) -> HashMap<&'a st
     let mut index_of: HashMap<&str, usize> = HashMap::with_capacity(components.len());
     for (i, c) in components.iter().enumerate() {
         if let Some(&j) = index_of.get(c.id.as_str()) {
-            v.rule(
-                &DUPLICATE_ID,
-                format!("/components/{i}/id"),
-                format!("duplicate id \"{}\" (first at /components/{j}/id)", c.id),
-            );
+            rule!(v, DUPLICATE_ID, format!("/components/{i}/id");
+                "duplicate id \"{}\" (first at /components/{j}/id)", c.id);
         } else {
             index_of.insert(c.id.as_str(), i);
         }
@@ -245,11 +239,8 @@ fn override_values(
     let mut out = vec![None; n];
     for (id, &x) in values {
         match index_of.get(id.as_str()) {
-            None => v.rule(
-                &UNKNOWN_ID,
-                format!("{ptr}/{}", pointer_token(id)),
-                format!("unknown component id \"{id}\""),
-            ),
+            None => rule!(v, UNKNOWN_ID, format!("{ptr}/{}", pointer_token(id));
+                "unknown component id \"{id}\""),
             Some(&i) => out[i] = Some(x),
         }
     }
@@ -270,22 +261,12 @@ fn overrides(
         let pt = format!("/overrides/{k}/time_h");
         let ts = find_time(&req.times_h, o.time_h);
         if ts.is_empty() {
-            v.rule(
-                &OVERRIDE_TIME,
-                &pt,
-                format!("override time {} h is not one of times_h", o.time_h),
-            );
+            rule!(v, OVERRIDE_TIME, &pt; "override time {} h is not one of times_h", o.time_h);
             continue;
         }
         if let Some(prev) = override_of_time[ts[0]] {
-            v.rule(
-                &OVERRIDE_TIME,
-                &pt,
-                format!(
-                    "second override for time {} h (first at /overrides/{prev})",
-                    o.time_h
-                ),
-            );
+            rule!(v, OVERRIDE_TIME, &pt;
+                "second override for time {} h (first at /overrides/{prev})", o.time_h);
             continue;
         }
         let fo = override_values(v, &format!("/overrides/{k}/F"), &o.f, index_of, n);
@@ -305,18 +286,10 @@ fn weibull(v: &mut Validator, base: &str, c: &ComponentSpec, covered: bool) -> O
     if let Some(w) = c.weibull {
         return Some((w.eta_h, w.beta));
     }
-    v.ensure_rule(
-        covered,
-        &WEIBULL_REQUIRED,
-        format!("{base}/weibull"),
-        || {
-            format!(
-                "component \"{}\" needs Weibull data (eta_h, beta) unless overrides give \
+    ensure_rule!(v, covered, WEIBULL_REQUIRED, format!("{base}/weibull");
+        "component \"{}\" needs Weibull data (eta_h, beta) unless overrides give \
              both F and RI at every time",
-                c.id
-            )
-        },
-    );
+        c.id);
     None
 }
 
@@ -332,11 +305,7 @@ fn failure_modes(
     let sum_alpha: f64 = modes.iter().map(|m| m.alpha).sum();
     let s: f64 = modes.iter().map(|m| m.alpha * m.impact).sum();
     if !s.is_finite() {
-        v.rule(
-            &MODE_SUM_OVERFLOW,
-            &p,
-            "sum of alpha·impact exceeds the f64 range".to_owned(),
-        );
+        rule!(v, MODE_SUM_OVERFLOW, &p; "sum of alpha·impact exceeds the f64 range");
         return None;
     }
     if (sum_alpha - 1.0).abs() > ALPHA_SUM_WARN_TOL {
@@ -360,11 +329,8 @@ fn mode_sum(
 ) -> Option<f64> {
     match (&c.failure_modes, c.mode_sum) {
         (Some(_), Some(_)) => {
-            v.rule(
-                &MODE_DATA_CONFLICT,
-                format!("{base}/mode_sum"),
-                "give either failure_modes or mode_sum, not both".to_owned(),
-            );
+            rule!(v, MODE_DATA_CONFLICT, format!("{base}/mode_sum");
+                "give either failure_modes or mode_sum, not both");
             None
         }
         (None, Some(s)) => Some(s),
@@ -372,18 +338,10 @@ fn mode_sum(
             failure_modes(v, format!("{base}/failure_modes"), modes, &c.id, warnings)
         }
         (None, None) => {
-            v.ensure_rule(
-                ri_all,
-                &MODE_DATA_REQUIRED,
-                format!("{base}/failure_modes"),
-                || {
-                    format!(
-                        "component \"{}\" needs failure_modes or mode_sum (RI = λ·Σα·impact) \
+            ensure_rule!(v, ri_all, MODE_DATA_REQUIRED, format!("{base}/failure_modes");
+                "component \"{}\" needs failure_modes or mode_sum (RI = λ·Σα·impact) \
                          unless overrides give RI at every time",
-                        c.id
-                    )
-                },
-            );
+                c.id);
             None
         }
     }
@@ -428,11 +386,7 @@ fn edges(
         let ib = index_of.get(b.as_str()).copied();
         for (end, id, index) in [(0, a, ia), (1, b, ib)] {
             if index.is_none() {
-                v.rule(
-                    &UNKNOWN_ID,
-                    format!("/edges/{k}/{end}"),
-                    format!("unknown component id \"{id}\""),
-                );
+                rule!(v, UNKNOWN_ID, format!("/edges/{k}/{end}"); "unknown component id \"{id}\"");
             }
         }
         let (Some(ia), Some(ib)) = (ia, ib) else {
@@ -440,20 +394,14 @@ fn edges(
             continue;
         };
         if ia == ib {
-            v.rule(
-                &SELF_LOOP,
-                format!("/edges/{k}"),
-                format!("self-loop \"{a}\" -> \"{a}\": a component cannot propagate to itself"),
-            );
+            rule!(v, SELF_LOOP, format!("/edges/{k}");
+                "self-loop \"{a}\" -> \"{a}\": a component cannot propagate to itself");
             edges_ok = false;
             continue;
         }
         if let Some(&first) = seen.get(&(ia, ib)) {
-            v.rule(
-                &DUPLICATE_EDGE,
-                format!("/edges/{k}"),
-                format!("duplicate edge \"{a}\" -> \"{b}\" (first at /edges/{first})"),
-            );
+            rule!(v, DUPLICATE_EDGE, format!("/edges/{k}");
+                "duplicate edge \"{a}\" -> \"{b}\" (first at /edges/{first})");
             edges_ok = false;
             continue;
         }
@@ -473,11 +421,8 @@ fn weights(v: &mut Validator, w: &ConstantWeights, times_h: &[f64]) -> Option<We
             let s = weight_pair(v, "/options/constant_weights/subjective", &e.subjective);
             let t = find_time(times_h, e.entropy_at_h).first().copied();
             if t.is_none() {
-                v.rule(
-                    &ENTROPY_TIME,
-                    "/options/constant_weights/entropy_at_h",
-                    format!("entropy time {} h is not one of times_h", e.entropy_at_h),
-                );
+                rule!(v, ENTROPY_TIME, "/options/constant_weights/entropy_at_h";
+                    "entropy time {} h is not one of times_h", e.entropy_at_h);
             }
             s.zip(t)
                 .map(|(subjective, time_index)| WeightSpec::Entropy {
@@ -493,17 +438,8 @@ fn weights(v: &mut Validator, w: &ConstantWeights, times_h: &[f64]) -> Option<We
 fn options(v: &mut Validator, o: &Options, times_h: &[f64]) -> Option<WeightSpec> {
     let q = o.q_in.unwrap_or(DEFAULT_Q_IN);
     let out = o.o_out.unwrap_or(DEFAULT_O_OUT);
-    v.ensure_rule(
-        (q + out - 1.0).abs() <= SUM_TOL,
-        &Q_PLUS_O,
-        "/options/o_out",
-        || {
-            format!(
-                "Q + O must equal 1 (±{SUM_TOL:e}), got {q} + {out} = {}",
-                q + out
-            )
-        },
-    );
+    ensure_rule!(v, (q + out - 1.0).abs() <= SUM_TOL, Q_PLUS_O, "/options/o_out";
+        "Q + O must equal 1 (±{SUM_TOL:e}), got {q} + {out} = {}", q + out);
     weights(v, &o.constant_weights, times_h)
 }
 

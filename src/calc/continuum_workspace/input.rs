@@ -17,6 +17,7 @@ use super::wire::{
     StartRequest, WorkspaceRequest,
 };
 use crate::calc::common::{self, Shard};
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, Validator};
 
 crate::calc::rules::cross_rules! {
@@ -217,11 +218,8 @@ fn preset_design(v: &mut Validator, d: &DesignRequest, p: PresetName) -> (Design
         (d.home_inputs_m.is_some(), "home_inputs_m"),
     ] {
         if present {
-            v.rule(
-                &DESIGN_SOURCE,
-                format!("/design/{name}"),
-                "must be absent when design.preset is given (presets fix the geometry)",
-            );
+            rule!(v, DESIGN_SOURCE, format!("/design/{name}");
+                "must be absent when design.preset is given (presets fix the geometry)");
         }
     }
     let preset = preset_of(p);
@@ -235,25 +233,13 @@ fn actuator(v: &mut Validator, j: usize, a: &ActuatorRequest) -> Actuator {
     let p = format!("/design/actuators/{j}");
     let mut dir = [1.0, 0.0];
     let nrm = a.direction[0].hypot(a.direction[1]);
-    if v.ensure_rule(
-        nrm > MIN_DIRECTION_NORM,
-        &DIRECTION_NORM,
-        format!("{p}/direction"),
-        || format!("norm must be > {MIN_DIRECTION_NORM}, got {nrm}"),
-    ) {
+    if ensure_rule!(v, nrm > MIN_DIRECTION_NORM, DIRECTION_NORM, format!("{p}/direction");
+        "norm must be > {MIN_DIRECTION_NORM}, got {nrm}")
+    {
         dir = [a.direction[0] / nrm, a.direction[1] / nrm];
     }
-    v.ensure_rule(
-        a.stroke_m[0] < a.stroke_m[1],
-        &STROKE_ORDER,
-        format!("{p}/stroke_m"),
-        || {
-            format!(
-                "min must be < max, got [{}, {}]",
-                a.stroke_m[0], a.stroke_m[1]
-            )
-        },
-    );
+    ensure_rule!(v, a.stroke_m[0] < a.stroke_m[1], STROKE_ORDER, format!("{p}/stroke_m");
+        "min must be < max, got [{}, {}]", a.stroke_m[0], a.stroke_m[1]);
     Actuator {
         origin: a.origin_m,
         dir,
@@ -264,11 +250,7 @@ fn actuator(v: &mut Validator, j: usize, a: &ActuatorRequest) -> Actuator {
 /// The actuators of an explicit design (1..4 of them: checked at the door).
 fn actuators(v: &mut Validator, acts: Option<&[ActuatorRequest]>) -> Vec<Actuator> {
     let Some(acts) = acts else {
-        v.rule(
-            &DESIGN_SOURCE,
-            "/design/actuators",
-            "required (or give design.preset)",
-        );
+        rule!(v, DESIGN_SOURCE, "/design/actuators"; "required (or give design.preset)");
         return Vec::new();
     };
     acts.iter()
@@ -287,13 +269,8 @@ fn rod_diameter(
     let dm = r.diameter_m?;
     let slender = r.length_m / dm;
     if slender < MIN_SLENDERNESS {
-        v.rule(
-            &SLENDERNESS,
-            format!("{p}/diameter_m"),
-            format!(
-                "slenderness L/d = {slender:.3} is below {MIN_SLENDERNESS}: the rod model does not apply"
-            ),
-        );
+        rule!(v, SLENDERNESS, format!("{p}/diameter_m");
+            "slenderness L/d = {slender:.3} is below {MIN_SLENDERNESS}: the rod model does not apply");
     } else if slender < WARN_SLENDERNESS {
         warnings.push(format!(
             "slender_rod {i}: L/d = {slender:.2} < {WARN_SLENDERNESS}, slender-rod (Kirchhoff) theory is inaccurate"
@@ -311,26 +288,13 @@ fn rod(
     warnings: &mut Vec<String>,
 ) -> Rod {
     let p = format!("/design/rods/{i}");
-    v.ensure_rule(
-        r.actuator < n_act,
-        &UNKNOWN_ACTUATOR,
-        format!("{p}/actuator"),
-        || {
-            format!(
-                "unknown actuator index {} (design has {n_act} actuators)",
-                r.actuator
-            )
-        },
-    );
+    ensure_rule!(v, r.actuator < n_act, UNKNOWN_ACTUATOR, format!("{p}/actuator");
+        "unknown actuator index {} (design has {n_act} actuators)", r.actuator);
     let offset = r.offset_m.unwrap_or([0.0, 0.0]);
     let e = r.youngs_modulus_pa.unwrap_or(DEFAULT_E);
     let diameter = rod_diameter(v, (i, &p), r, warnings);
-    v.ensure_rule(
-        r.diameter_m.is_some() || r.ei_nm2.is_some(),
-        &ROD_STIFFNESS,
-        format!("{p}/diameter_m"),
-        || "required unless ei_nm2 is given".to_owned(),
-    );
+    ensure_rule!(v, r.diameter_m.is_some() || r.ei_nm2.is_some(),
+        ROD_STIFFNESS, format!("{p}/diameter_m"); "required unless ei_nm2 is given");
     let ei = match (r.ei_nm2, diameter) {
         (Some(ei), _) => ei,
         (None, Some(dm)) => e * std::f64::consts::PI * dm.powi(4) / 64.0,
@@ -359,11 +323,7 @@ fn rods(
     warnings: &mut Vec<String>,
 ) -> Vec<Rod> {
     let Some(rs) = rs else {
-        v.rule(
-            &DESIGN_SOURCE,
-            "/design/rods",
-            "required (or give design.preset)",
-        );
+        rule!(v, DESIGN_SOURCE, "/design/rods"; "required (or give design.preset)");
         return Vec::new();
     };
     let rods: Vec<Rod> = rs
@@ -372,12 +332,9 @@ fn rods(
         .map(|(i, r)| rod(v, i, r, n_act, warnings))
         .collect();
     for j in 0..n_act {
-        v.ensure_rule(
-            rs.iter().any(|r| r.actuator == j),
-            &ACTUATOR_WITHOUT_ROD,
-            format!("/design/actuators/{j}"),
-            || "carries no rod: its input would be undetermined".to_owned(),
-        );
+        ensure_rule!(v, rs.iter().any(|r| r.actuator == j),
+            ACTUATOR_WITHOUT_ROD, format!("/design/actuators/{j}");
+            "carries no rod: its input would be undetermined");
     }
     if rods.len() >= 2 && v.is_clean() {
         let l_ref = rods.iter().map(|r| r.length).sum::<f64>() / rods.len() as f64;
@@ -385,15 +342,8 @@ fn rods(
         let spread = rods.iter().fold(0.0f64, |m, r| {
             m.max((r.attach[0] - r0[0]).hypot(r.attach[1] - r0[1]))
         });
-        v.ensure_rule(
-            spread > COINCIDENT_REL * l_ref,
-            &COINCIDENT_ATTACHMENTS,
-            "/design/rods",
-            || {
-                "all attachment points attach_m coincide: the platform rotation is undetermined"
-                    .to_owned()
-            },
-        );
+        ensure_rule!(v, spread > COINCIDENT_REL * l_ref, COINCIDENT_ATTACHMENTS, "/design/rods";
+            "all attachment points attach_m coincide: the platform rotation is undetermined");
     }
     rods
 }
@@ -412,17 +362,8 @@ fn design_of(
     let n_act = actuators.len();
     let rods = rods(v, d.rods.as_deref(), n_act, warnings);
     if let Some(h) = &d.home_inputs_m {
-        v.ensure_rule(
-            h.len() == n_act,
-            &HOME_INPUTS_COUNT,
-            "/design/home_inputs_m",
-            || {
-                format!(
-                    "must have {n_act} entries (one per actuator), got {}",
-                    h.len()
-                )
-            },
-        );
+        ensure_rule!(v, h.len() == n_act, HOME_INPUTS_COUNT, "/design/home_inputs_m";
+            "must have {n_act} entries (one per actuator), got {}", h.len());
     }
     let design = Design {
         actuators,
@@ -444,12 +385,9 @@ fn solver(
     let tol = solver.tol.unwrap_or(1e-10);
     let max_iter = solver.max_iter.unwrap_or(50);
     let extensible = solver.axial_extensibility.unwrap_or(false);
-    v.ensure_rule(
-        !(extensible && design.rods.iter().any(|r| r.ea.is_none())),
-        &EXTENSIBILITY_NEEDS_DIAMETER,
-        "/solver/axial_extensibility",
-        || "needs diameter_m (and youngs_modulus_pa) on every rod to compute EA".to_owned(),
-    );
+    ensure_rule!(v, !(extensible && design.rods.iter().any(|r| r.ea.is_none())),
+        EXTENSIBILITY_NEEDS_DIAMETER, "/solver/axial_extensibility";
+        "needs diameter_m (and youngs_modulus_pa) on every rod to compute EA");
     (base_steps, tol, max_iter, extensible)
 }
 
@@ -460,14 +398,9 @@ fn home(v: &mut Validator, model: &Model, preset: Option<Preset>) {
     };
     let fit = fk::home_fit(model, Some(h));
     if fit.residual.is_nan() || fit.residual > HOME_REL_TOL * model.l_ref {
-        v.rule(
-            &HOME_NOT_STRESS_FREE,
-            "/design/home_inputs_m",
-            format!(
-                "rods are not straight and unloaded with theta_EE = 0 at these inputs (closure residual {:.3e} m > {:.1e} L_ref)",
-                fit.residual, HOME_REL_TOL
-            ),
-        );
+        rule!(v, HOME_NOT_STRESS_FREE, "/design/home_inputs_m";
+            "rods are not straight and unloaded with theta_EE = 0 at these inputs (closure residual {:.3e} m > {:.1e} L_ref)",
+            fit.residual, HOME_REL_TOL);
     }
 }
 
@@ -478,16 +411,11 @@ fn load(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> ([
     let moment = load.moment_nm.unwrap_or(0.0);
     let fmax = MAX_LOAD_REL * model.f_ref;
     let fnorm = force[0].hypot(force[1]);
-    v.ensure_rule(fnorm <= fmax, &LOAD_LIMIT, "/load/force_n", || {
-        format!("|F| = {fnorm} N exceeds 1e4 EI_ref/L_ref^2 = {fmax} N")
-    });
+    ensure_rule!(v, fnorm <= fmax, LOAD_LIMIT, "/load/force_n";
+        "|F| = {fnorm} N exceeds 1e4 EI_ref/L_ref^2 = {fmax} N");
     let mmax = MAX_LOAD_REL * model.f_ref * model.l_ref;
-    v.ensure_rule(moment.abs() <= mmax, &LOAD_LIMIT, "/load/moment_nm", || {
-        format!(
-            "|M| = {} N m exceeds 1e4 EI_ref/L_ref = {mmax} N m",
-            moment.abs()
-        )
-    });
+    ensure_rule!(v, moment.abs() <= mmax, LOAD_LIMIT, "/load/moment_nm";
+        "|M| = {} N m exceeds 1e4 EI_ref/L_ref = {mmax} N m", moment.abs());
     (force, moment)
 }
 
@@ -500,30 +428,17 @@ fn inputs(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> 
         return lambda;
     }
     match &req.inputs_m {
-        None => v.rule(
-            &INPUTS_REQUIRED,
-            "/inputs_m",
-            "required for mode fk and assembly_modes",
-        ),
+        None => rule!(v, INPUTS_REQUIRED, "/inputs_m"; "required for mode fk and assembly_modes"),
         Some(l) if l.len() != n_act => {
-            v.rule(
-                &INPUTS_COUNT,
-                "/inputs_m",
-                format!(
-                    "must have {n_act} entries (one per actuator), got {}",
-                    l.len()
-                ),
-            );
+            rule!(v, INPUTS_COUNT, "/inputs_m";
+                "must have {n_act} entries (one per actuator), got {}", l.len());
         }
         Some(l) => {
             for (j, (&x, a)) in l.iter().zip(&model.design.actuators).enumerate() {
                 let [lo, hi] = a.stroke;
-                v.ensure_rule(
-                    (lo..=hi).contains(&x),
-                    &INPUT_OUTSIDE_STROKE,
-                    format!("/inputs_m/{j}"),
-                    || format!("inputs_m[{j}] [m] must be in [{lo}, {hi}] (the stroke of actuator {j}), got {x}"),
-                );
+                ensure_rule!(v, (lo..=hi).contains(&x),
+                    INPUT_OUTSIDE_STROKE, format!("/inputs_m/{j}");
+                    "inputs_m[{j}] [m] must be in [{lo}, {hi}] (the stroke of actuator {j}), got {x}");
             }
             lambda.clone_from(l);
         }
@@ -533,13 +448,8 @@ fn inputs(v: &mut Validator, req: &ContinuumWorkspaceRequest, model: &Model) -> 
 
 /// A solver state `st` at `ptr` (`…/state/v`): 3N+3 numbers for `nr` rods.
 fn state(v: &mut Validator, ptr: &str, st: &SolverState, nr: usize) -> Vec<f64> {
-    v.ensure_rule(st.v.len() == 3 * nr + 3, &STATE_LENGTH, ptr, || {
-        format!(
-            "must have 3N+3 = {} entries, got {}",
-            3 * nr + 3,
-            st.v.len()
-        )
-    });
+    ensure_rule!(v, st.v.len() == 3 * nr + 3, STATE_LENGTH, ptr;
+        "must have 3N+3 = {} entries, got {}", 3 * nr + 3, st.v.len());
     st.v.clone()
 }
 
@@ -556,11 +466,7 @@ fn start(
             StartKind::AssemblyMode => Start::AssemblyMode(s.index.unwrap_or(0)),
             StartKind::Guess => match &s.state {
                 None => {
-                    v.rule(
-                        &STATE_REQUIRED,
-                        "/start/state",
-                        "required when start.kind = guess",
-                    );
+                    rule!(v, STATE_REQUIRED, "/start/state"; "required when start.kind = guess");
                     Start::Home
                 }
                 Some(st) => Start::Guess(state(v, "/start/state/v", st, nr)),
@@ -645,12 +551,8 @@ fn ranges(v: &mut Validator, ranges: Option<[[f64; 2]; 2]>, model: &Model) -> [[
     };
     let ranges = ranges.unwrap_or(strokes);
     for (k, r) in ranges.iter().enumerate() {
-        v.ensure_rule(
-            r[0] < r[1],
-            &RANGE_ORDER,
-            format!("/workspace/ranges_m/{k}"),
-            || format!("min must be < max, got [{}, {}]", r[0], r[1]),
-        );
+        ensure_rule!(v, r[0] < r[1], RANGE_ORDER, format!("/workspace/ranges_m/{k}");
+            "min must be < max, got [{}, {}]", r[0], r[1]);
     }
     ranges
 }
@@ -719,11 +621,7 @@ fn seed(v: &mut Validator, seed: Option<&SeedRequest>, nr: usize) -> SeedInput {
     let kind = s.kind;
     let state = match (kind, &s.state) {
         (SeedKind::Guess, None) => {
-            v.rule(
-                &STATE_REQUIRED,
-                "/workspace/seed/state",
-                "required when seed.kind = guess",
-            );
+            rule!(v, STATE_REQUIRED, "/workspace/seed/state"; "required when seed.kind = guess");
             None
         }
         (SeedKind::Guess, Some(st)) => Some(state(v, "/workspace/seed/state/v", st, nr)),
@@ -747,12 +645,8 @@ fn workspace(
         return (None, None);
     }
     let n_act = model.n_act();
-    v.ensure_rule(
-        n_act == 2,
-        &WORKSPACE_ACTUATORS,
-        "/design/actuators",
-        || format!("mode workspace needs exactly 2 actuators (2-D grid), got {n_act}"),
-    );
+    ensure_rule!(v, n_act == 2, WORKSPACE_ACTUATORS, "/design/actuators";
+        "mode workspace needs exactly 2 actuators (2-D grid), got {n_act}");
     let w = req.workspace.clone().unwrap_or_default();
     let (grid, too_large) = grid(w.grid);
     let ranges = ranges(v, w.ranges_m, model);
@@ -779,11 +673,8 @@ fn shard(v: &mut Validator, req: &ContinuumWorkspaceRequest) -> Option<Shard> {
         wire::Mode::AssemblyModes => Some("assembly_modes"),
     };
     if let (Some(mode), Some(_)) = (one_job, req.shard) {
-        v.rule(
-            &SHARD_NOT_APPLICABLE,
-            "/shard",
-            format!("shard splits the waves of a workspace sweep; mode \"{mode}\" has no sweep"),
-        );
+        rule!(v, SHARD_NOT_APPLICABLE, "/shard";
+            "shard splits the waves of a workspace sweep; mode \"{mode}\" has no sweep");
     }
     shard
 }

@@ -8,6 +8,7 @@
 //! with its own code.
 
 use super::error::{BAD_RANGE, MISSING_FIELD, class_of};
+use crate::calc::rules::rule;
 use crate::calc::{CrossRule, Validator};
 
 /// A validator with the IREFC codes (`BAD_RANGE` by default, classes from [`class_of`]).
@@ -34,7 +35,7 @@ crate::calc::rules::cross_rules! {
 /// Record a missing required field (`MISSING_FIELD`, a rule of `rule`).
 pub fn missing(v: &mut Validator, rule: &CrossRule, pointer: &str, what: &str) {
     debug_assert_eq!(rule.code, MISSING_FIELD);
-    v.rule(rule, pointer, format!("{what} is required"));
+    rule!(v, rule, pointer; "{what} is required");
 }
 
 /// Z2 as a count (its range 3..=1000 is checked at the door, so the conversion is exact).

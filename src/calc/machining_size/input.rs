@@ -9,6 +9,7 @@
 use std::collections::HashSet;
 
 use crate::calc::common::{self, RESPONSE_TOO_LARGE_RULE, SHARD_INDEX_BELOW_COUNT};
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, CrossRule, Validator};
 
 use super::boost::{BoostParams, Method};
@@ -211,17 +212,10 @@ fn check_names(v: &mut Validator, names: &[String]) {
     let mut seen = HashSet::new();
     for (i, n) in names.iter().enumerate() {
         if n.trim().is_empty() {
-            v.rule(
-                &FEATURE_NAME_EMPTY,
-                format!("/feature_names/{i}"),
-                "must not be empty",
-            );
+            rule!(v, FEATURE_NAME_EMPTY, format!("/feature_names/{i}"); "must not be empty");
         } else if !seen.insert(n.as_str()) {
-            v.rule(
-                &FEATURE_NAME_DUPLICATE,
-                format!("/feature_names/{i}"),
-                format!("duplicate feature name \"{n}\""),
-            );
+            rule!(v, FEATURE_NAME_DUPLICATE, format!("/feature_names/{i}");
+                "duplicate feature name \"{n}\"");
         }
     }
 }
@@ -237,14 +231,8 @@ fn check_widths(v: &mut Validator, rule: &CrossRule, at: &str, rows: &[Vec<f64>]
         } else {
             String::new()
         };
-        v.rule(
-            rule,
-            format!("{at}/{i}"),
-            format!(
-                "must have {d} values (one per feature), got {}{tail}",
-                r.len()
-            ),
-        );
+        rule!(v, rule, format!("{at}/{i}");
+            "must have {d} values (one per feature), got {}{tail}", r.len());
     }
 }
 
@@ -252,18 +240,8 @@ fn check_widths(v: &mut Validator, rule: &CrossRule, at: &str, rows: &[Vec<f64>]
 fn check_data(v: &mut Validator, names: &[String], rows: &[Vec<f64>], target: &[f64]) {
     check_names(v, names);
     check_widths(v, &ROW_WIDTH, "/rows", rows, names.len());
-    v.ensure_rule(
-        target.len() == rows.len(),
-        &TARGET_LENGTH,
-        "/target",
-        || {
-            format!(
-                "must have one value per row ({}), got {}",
-                rows.len(),
-                target.len()
-            )
-        },
-    );
+    ensure_rule!(v, target.len() == rows.len(), TARGET_LENGTH, "/target";
+        "must have one value per row ({}), got {}", rows.len(), target.len());
 }
 
 /// SMOGN's parameters (ranges and the count of control points: checked at the door); the
@@ -276,22 +254,12 @@ fn smogn_params(
     (threshold, k, perturbation, seed): (f64, u32, f64, u64),
 ) -> SmognParams {
     for (i, p) in relevance.iter().enumerate() {
-        v.ensure_rule(
-            RELEVANCE_PHI.contains(p[1]),
-            phi_rule,
-            format!("{at}/relevance/{i}/1"),
-            || format!("φ must be {RELEVANCE_PHI}, got {}", p[1]),
-        );
+        ensure_rule!(v, RELEVANCE_PHI.contains(p[1]), phi_rule, format!("{at}/relevance/{i}/1");
+            "φ must be {RELEVANCE_PHI}, got {}", p[1]);
         if i > 0 && p[0] <= relevance[i - 1][0] {
-            v.rule(
-                order_rule,
-                format!("{at}/relevance/{i}/0"),
-                format!(
-                    "control points must be strictly increasing in y: {} after {}",
-                    p[0],
-                    relevance[i - 1][0]
-                ),
-            );
+            rule!(v, order_rule, format!("{at}/relevance/{i}/0");
+                "control points must be strictly increasing in y: {} after {}", p[0],
+                relevance[i - 1][0]);
         }
     }
     SmognParams {
@@ -318,33 +286,18 @@ fn constant_columns(x: &Matrix) -> Vec<usize> {
 impl TryFrom<TrainRequest> for TrainInput {
     type Error = CalcFailure;
 
-    #[expect(
-        clippy::too_many_lines,
-        reason = "one flat list of the spec's §2.5 rejections, each with its pointer; splitting it \
-                  would scatter the cross-field rules"
-    )]
     fn try_from(req: TrainRequest) -> Result<Self, CalcFailure> {
         let mut v = Validator::new();
         check_data(&mut v, &req.feature_names, &req.rows, &req.target);
         let p = &req.params;
-        v.ensure_rule(
-            !(p.reg_lambda == 0.0 && p.min_child_weight == 0.0),
-            &REG_LAMBDA_ZERO,
-            "/params/reg_lambda",
-            || {
-                "reg_lambda must be > 0 when min_child_weight is 0 (an empty child would divide \
-                 by zero, spec §8 hazard 4)"
-                    .to_owned()
-            },
-        );
+        ensure_rule!(v, !(p.reg_lambda == 0.0 && p.min_child_weight == 0.0),
+            REG_LAMBDA_ZERO, "/params/reg_lambda";
+            "reg_lambda must be > 0 when min_child_weight is 0 (an empty child would divide \
+                 by zero, spec §8 hazard 4)");
         let val = &req.validation;
         let shard = common::shard_rule(&mut v, req.shard);
-        v.ensure_rule(
-            req.shard.is_none() || val.k_fold.is_some(),
-            &SHARD_NOT_APPLICABLE,
-            "/shard",
-            || "shard splits the k-fold cross-validation: set validation.k_fold".to_owned(),
-        );
+        ensure_rule!(v, req.shard.is_none() || val.k_fold.is_some(), SHARD_NOT_APPLICABLE, "/shard";
+            "shard splits the k-fold cross-validation: set validation.k_fold");
         let smogn = req.preprocessing.smogn.as_ref().map(|s| {
             smogn_params(
                 &mut v,
@@ -362,38 +315,25 @@ impl TryFrom<TrainRequest> for TrainInput {
         let min_rows = 2.0 * p.min_child_weight.max(1.0);
         let n_train = n_train_rows(n, val.test_fraction);
         if (n_train as f64) < min_rows {
-            v.rule(
-                &TRAINING_ROWS,
-                "/params/min_child_weight",
-                format!(
-                    "the training split has {n_train} rows but needs at least \
-                     2·max(1, min_child_weight) = {min_rows} (spec §2.5)"
-                ),
-            );
+            rule!(v, TRAINING_ROWS, "/params/min_child_weight";
+                "the training split has {n_train} rows but needs at least \
+                     2·max(1, min_child_weight) = {min_rows} (spec §2.5)");
         }
         if let Some(k) = val.k_fold {
             let k = k as usize;
             let smallest = n - n.div_ceil(k);
             if (smallest as f64) < min_rows {
-                v.rule(
-                    &FOLD_ROWS,
-                    "/validation/k_fold",
-                    format!(
-                        "{k} folds of {n} rows leave {smallest} training rows in a fold, fewer than \
-                         2·max(1, min_child_weight) = {min_rows}"
-                    ),
-                );
+                rule!(v, FOLD_ROWS, "/validation/k_fold";
+                    "{k} folds of {n} rows leave {smallest} training rows in a fold, fewer than \
+                         2·max(1, min_child_weight) = {min_rows}");
             }
         }
         let d = req.feature_names.len();
         let x = Matrix::from_rows(req.rows, d);
         let y = req.target;
         if y.iter().all(|&t| (t - y[0]) == 0.0) {
-            v.rule(
-                &CONSTANT_TARGET,
-                "/target",
-                "all targets are equal: there is nothing to learn (spec §2.5)",
-            );
+            rule!(v, CONSTANT_TARGET, "/target";
+                "all targets are equal: there is nothing to learn (spec §2.5)");
         }
         let dropped = if req.preprocessing.drop_constant {
             constant_columns(&x)
@@ -402,23 +342,14 @@ impl TryFrom<TrainRequest> for TrainInput {
         };
         let features: Vec<usize> = (0..d).filter(|f| !dropped.contains(f)).collect();
         if features.is_empty() {
-            v.rule(
-                &ALL_FEATURES_CONSTANT,
-                "/rows",
+            rule!(v, ALL_FEATURES_CONSTANT, "/rows";
                 "every feature is constant: there is nothing to split on (set \
-                 preprocessing.drop_constant to false to fit the mean only)",
-            );
+                 preprocessing.drop_constant to false to fit the mean only)");
         } else if (p.colsample_bytree * features.len() as f64).floor() < 1.0 {
-            v.rule(
-                &COLSAMPLE_NO_FEATURE,
-                "/params/colsample_bytree",
-                format!(
-                    "colsample_bytree {} leaves 0 of {} features per tree (⌊colsample·d⌋ must be \
+            rule!(v, COLSAMPLE_NO_FEATURE, "/params/colsample_bytree";
+                "colsample_bytree {} leaves 0 of {} features per tree (⌊colsample·d⌋ must be \
                      ≥ 1, as XGBoost requires)",
-                    p.colsample_bytree,
-                    features.len()
-                ),
-            );
+                p.colsample_bytree, features.len());
         }
         v.finish()?;
         Ok(Self {
@@ -490,15 +421,8 @@ fn read_model(v: &mut Validator, doc: &Doc) -> Option<Model> {
                 // code.
                 v.push(e.pointer, e.detail);
             } else {
-                v.rule(
-                    if unsupported {
-                        &MODEL_SUPPORTED
-                    } else {
-                        &MODEL_DOCUMENT
-                    },
-                    e.pointer,
-                    e.detail,
-                );
+                rule!(v, if unsupported { MODEL_SUPPORTED } else { MODEL_DOCUMENT }, e.pointer;
+                    "{}", e.detail);
             }
             None
         }
@@ -520,71 +444,45 @@ impl TryFrom<PredictRequest> for PredictInput {
         check_widths(&mut v, &PREDICT_ROW_WIDTH, "/rows", &req.rows, d);
         if let Some(names) = &req.feature_names {
             if names.len() != d {
-                v.rule(
-                    &FEATURE_NAMES_MISMATCH,
-                    "/feature_names",
-                    format!("the model has {d} features, got {} names", names.len()),
-                );
+                rule!(v, FEATURE_NAMES_MISMATCH, "/feature_names";
+                    "the model has {d} features, got {} names", names.len());
             } else if !model.feature_names.is_empty()
                 && let Some(i) = (0..d).find(|&i| names[i] != model.feature_names[i])
             {
-                v.rule(
-                    &FEATURE_NAMES_MISMATCH,
-                    format!("/feature_names/{i}"),
-                    format!(
-                        "must be the model's feature \"{}\", got \"{}\"",
-                        model.feature_names[i], names[i]
-                    ),
-                );
+                rule!(v, FEATURE_NAMES_MISMATCH, format!("/feature_names/{i}");
+                    "must be the model's feature \"{}\", got \"{}\"", model.feature_names[i],
+                    names[i]);
             }
         }
         let n = req.rows.len();
         let shap = req.shap;
         if shap != ShapKind::None && n * d > MAX_SHAP_CELLS {
-            v.rule(
-                &PREDICT_WORK,
-                "/rows",
-                format!(
-                    "SHAP values for {n} rows × {d} features exceed {MAX_SHAP_CELLS} numbers; \
-                     send fewer rows per request"
-                ),
-            );
+            rule!(v, PREDICT_WORK, "/rows";
+                "SHAP values for {n} rows × {d} features exceed {MAX_SHAP_CELLS} numbers; \
+                     send fewer rows per request");
         }
         let background_ignored = req.background.is_some() && shap != ShapKind::Interventional;
         let mut background = Vec::new();
         if shap == ShapKind::Interventional {
             match &req.background {
-                None => v.rule(
-                    &BACKGROUND_REQUIRED,
-                    "/background",
-                    "interventional SHAP needs background rows (spec §2.5)",
-                ),
+                None => rule!(v, BACKGROUND_REQUIRED, "/background";
+                    "interventional SHAP needs background rows (spec §2.5)"),
                 Some(b) => {
                     check_widths(&mut v, &PREDICT_ROW_WIDTH, "/background", b, d);
                     if n * b.len() > MAX_INTERVENTIONAL_PAIRS {
-                        v.rule(
-                            &PREDICT_WORK,
-                            "/background",
-                            format!(
-                                "{n} rows × {} background rows exceed {MAX_INTERVENTIONAL_PAIRS} \
+                        rule!(v, PREDICT_WORK, "/background";
+                            "{n} rows × {} background rows exceed {MAX_INTERVENTIONAL_PAIRS} \
                                  pairs",
-                                b.len()
-                            ),
-                        );
+                            b.len());
                     }
                     background = b.iter().map(|r| model.prepare_row(r)).collect();
                 }
             }
         }
         if req.interactions && (n > MAX_INTERACTION_ROWS || n * d * d > MAX_INTERACTION_CELLS) {
-            v.rule(
-                &PREDICT_WORK,
-                "/interactions",
-                format!(
-                    "interaction values need rows ≤ {MAX_INTERACTION_ROWS} and rows·d² ≤ \
-                     {MAX_INTERACTION_CELLS}, got {n} rows and d = {d}"
-                ),
-            );
+            rule!(v, PREDICT_WORK, "/interactions";
+                "interaction values need rows ≤ {MAX_INTERACTION_ROWS} and rows·d² ≤ \
+                     {MAX_INTERACTION_CELLS}, got {n} rows and d = {d}");
         }
         v.finish()?;
         let rows = req
@@ -614,14 +512,9 @@ impl TryFrom<AnalyzeRequest> for AnalyzeInput {
             if p.scores {
                 let k = p.components.map_or(req.feature_names.len(), |k| k as usize);
                 if req.rows.len() * k > MAX_SCORE_CELLS {
-                    v.rule(
-                        &ANALYZE_WORK,
-                        "/pca/scores",
-                        format!(
-                            "scores of {} rows × {k} components exceed {MAX_SCORE_CELLS} numbers",
-                            req.rows.len()
-                        ),
-                    );
+                    rule!(v, ANALYZE_WORK, "/pca/scores";
+                        "scores of {} rows × {k} components exceed {MAX_SCORE_CELLS} numbers",
+                        req.rows.len());
                 }
             }
             (p.components.map(|k| k as usize), p.scores)

@@ -7,6 +7,7 @@
 use std::time::Duration;
 
 use crate::calc::common::Sign;
+use crate::calc::rules::ensure_rule;
 use crate::calc::{CalcFailure, Validator};
 use crate::numerics::angles::sin_cos_deg;
 
@@ -119,19 +120,11 @@ impl TryFrom<SpatialCouplingRequest> for SpatialCouplingInput {
         let mut v = Validator::new();
         let alpha_deg = req.alpha_deg.unwrap_or(DEFAULT_ALPHA_DEG);
         let c2a = sin_cos_deg(2.0 * alpha_deg).1;
-        v.ensure_rule(
-            c2a.abs() >= MIN_ABS_COS_2ALPHA,
-            &PERPENDICULAR_SHAFTS,
-            "/alpha_deg",
-            || {
-                format!(
-                    "|cos 2α| must be ≥ {MIN_ABS_COS_2ALPHA:e} (α = ±45° makes the shafts \
+        ensure_rule!(v, c2a.abs() >= MIN_ABS_COS_2ALPHA, PERPENDICULAR_SHAFTS, "/alpha_deg";
+            "|cos 2α| must be ≥ {MIN_ABS_COS_2ALPHA:e} (α = ±45° makes the shafts \
                      perpendicular: dead points, i12 = 0/0), got |cos 2α| = {:e} at α = \
                      {alpha_deg}°",
-                    c2a.abs()
-                )
-            },
-        );
+            c2a.abs());
         let a = req.a_m.unwrap_or(1.0);
         // β defaults to α.
         let beta_deg = req.beta_deg.unwrap_or(alpha_deg);

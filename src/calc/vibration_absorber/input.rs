@@ -4,6 +4,7 @@
 use std::time::Duration;
 
 use crate::calc::common::{RESPONSE_TOO_LARGE_RULE, TimeLimited};
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, Validator};
 
 use super::error::{DEADLINE_RULE, EIGEN_NOT_CONVERGED_RULE, NON_FINITE_RULE};
@@ -260,9 +261,8 @@ impl TimeLimited for VibrationAbsorberRequest {
 
 /// A mode reference `k` (already in `MODE_INDEX` at the door) against `beam.n_modes`.
 fn mode_ref(v: &mut Validator, pointer: &str, name: &str, k: u32, n_modes: usize) -> usize {
-    v.ensure_rule(k as usize <= n_modes, &MODE_OUT_OF_RANGE, pointer, || {
-        format!("{name} must be ≤ beam.n_modes = {n_modes}, got {k}")
-    });
+    ensure_rule!(v, k as usize <= n_modes, MODE_OUT_OF_RANGE, pointer;
+        "{name} must be ≤ beam.n_modes = {n_modes}, got {k}");
     (k as usize).clamp(1, n_modes.max(1))
 }
 
@@ -284,9 +284,8 @@ fn freq_or_mode(
 /// A position in (0, L] (the lower end and `LENGTH` are checked at the door).
 fn position(v: &mut Validator, pointer: &str, x: Option<f64>, length: f64) -> f64 {
     let p = x.unwrap_or(length);
-    v.ensure_rule(p <= length, &POSITION_OUT_OF_BEAM, pointer, || {
-        format!("must be ≤ beam.length_m = {length} m, got {p}")
-    });
+    ensure_rule!(v, p <= length, POSITION_OUT_OF_BEAM, pointer;
+        "must be ≤ beam.length_m = {length} m, got {p}");
     p
 }
 
@@ -296,12 +295,8 @@ fn abscissae(v: &mut Validator, pointer: &str, xs: Option<&Vec<f64>>, length: f6
         return vec![length];
     };
     for (i, x) in xs.iter().enumerate() {
-        v.ensure_rule(
-            *x <= length,
-            &POSITION_OUT_OF_BEAM,
-            format!("{pointer}/{i}"),
-            || format!("points_m[{i}] [m] must be ≤ beam.length_m = {length} m, got {x}"),
-        );
+        ensure_rule!(v, *x <= length, POSITION_OUT_OF_BEAM, format!("{pointer}/{i}");
+            "points_m[{i}] [m] must be ≤ beam.length_m = {length} m, got {x}");
     }
     xs.clone()
 }
@@ -309,31 +304,17 @@ fn abscissae(v: &mut Validator, pointer: &str, xs: Option<&Vec<f64>>, length: f6
 /// A frequency grid: `f_min < f_max` (equal only with one point).
 fn grid(v: &mut Validator, base: &str, g: &GridIn) -> Grid {
     let ok = g.f_max_hz > g.f_min_hz || (g.n_points == 1 && g.f_max_hz >= g.f_min_hz);
-    v.ensure_rule(ok, &GRID_ORDER, format!("{base}/f_max_hz"), || {
-        format!(
-            "f_max_hz [Hz] must be > f_min_hz = {} Hz, got {}",
-            g.f_min_hz, g.f_max_hz
-        )
-    });
+    ensure_rule!(v, ok, GRID_ORDER, format!("{base}/f_max_hz");
+        "f_max_hz [Hz] must be > f_min_hz = {} Hz, got {}", g.f_min_hz, g.f_max_hz);
     g.clone()
 }
 
 fn time(v: &mut Validator, t: &TimeResponseIn, length: f64) -> TimeRequest {
     let base = "/outputs/time_response";
     let ratio = t.t_end_s / t.dt_s;
-    v.ensure_rule(
-        ratio <= wire::MAX_SAMPLES,
-        &TOO_MANY_SAMPLES,
-        format!("{base}/dt_s"),
-        || {
-            format!(
-                "t_end_s / dt_s must be ≤ {:e} samples, got {ratio:.6e} (t_end_s = {} s, dt_s = {} s)",
-                wire::MAX_SAMPLES,
-                t.t_end_s,
-                t.dt_s
-            )
-        },
-    );
+    ensure_rule!(v, ratio <= wire::MAX_SAMPLES, TOO_MANY_SAMPLES, format!("{base}/dt_s");
+        "t_end_s / dt_s must be ≤ {:e} samples, got {ratio:.6e} (t_end_s = {} s, dt_s = {} s)",
+        wire::MAX_SAMPLES, t.t_end_s, t.dt_s);
     let decimate = t.decimate.unwrap_or(1);
     // Steps: t_end/dt rounded (a ratio within 1e-9 of an integer is that integer).
     let steps = if ratio.is_finite() && ratio > 0.0 {
@@ -384,23 +365,11 @@ fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, 
             ("phase_rad", e.phase_rad.is_some()),
         ];
         for (name, given) in single {
-            v.ensure_rule(
-                !given,
-                &HARMONICS_CONFLICT,
-                format!("/excitation/{name}"),
-                || {
-                    format!(
-                        "give either excitation.harmonics or the single harmonic's {name}, not both"
-                    )
-                },
-            );
+            ensure_rule!(v, !given, HARMONICS_CONFLICT, format!("/excitation/{name}");
+                "give either excitation.harmonics or the single harmonic's {name}, not both");
         }
-        v.ensure_rule(
-            e.kind == ExcitationType::Harmonic,
-            &HARMONICS_TYPE,
-            "/excitation/harmonics",
-            || "harmonics needs excitation.type = harmonic".to_owned(),
-        );
+        ensure_rule!(v, e.kind == ExcitationType::Harmonic, HARMONICS_TYPE, "/excitation/harmonics";
+            "harmonics needs excitation.type = harmonic");
         let components = harmonics(v, list, n_modes);
         return (
             Forcing::Harmonic {
@@ -410,12 +379,9 @@ fn excitation(v: &mut Validator, e: &ExcitationIn, n_modes: usize) -> (Forcing, 
             amplitude,
         );
     }
-    v.ensure_rule(
-        e.frequency_hz.is_none() || e.resonance_of_mode.is_none(),
-        &FREQUENCY_CONFLICT,
-        "/excitation/resonance_of_mode",
-        || "give at most one of frequency_hz and resonance_of_mode".to_owned(),
-    );
+    ensure_rule!(v, e.frequency_hz.is_none() || e.resonance_of_mode.is_none(),
+        FREQUENCY_CONFLICT, "/excitation/resonance_of_mode";
+        "give at most one of frequency_hz and resonance_of_mode");
     let freq = freq_or_mode(
         v,
         e.frequency_hz,
@@ -468,11 +434,8 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
             (None, Some(a), Some(i)) => (a, i),
             (None, None, None) => (0.05 * 0.005, 0.05 * 0.005_f64.powi(3) / 12.0),
             (Some(_), _, _) => {
-                v.rule(
-                    &SECTION_CONFLICT,
-                    "/beam/section",
-                    "give either section or area_m2 + second_moment_m4, not both",
-                );
+                rule!(v, SECTION_CONFLICT, "/beam/section";
+                    "give either section or area_m2 + second_moment_m4, not both");
                 (1.0, 1.0)
             }
             (None, a, _) => {
@@ -481,11 +444,7 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
                 } else {
                     "/beam/area_m2"
                 };
-                v.rule(
-                    &SECTION_PAIR,
-                    missing,
-                    "area_m2 and second_moment_m4 go together",
-                );
+                rule!(v, SECTION_PAIR, missing; "area_m2 and second_moment_m4 go together");
                 (1.0, 1.0)
             }
         };
@@ -499,15 +458,9 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
             a.passive_tuning_hz.is_some(),
             a.passive_tuning_mode.is_some(),
         ];
-        v.ensure_rule(
-            given.iter().filter(|g| **g).count() <= 1,
-            &STIFFNESS_CONFLICT,
-            "/absorber/stiffness_n_m",
-            || {
-                "give at most one of stiffness_n_m, passive_tuning_hz, passive_tuning_mode"
-                    .to_owned()
-            },
-        );
+        ensure_rule!(v, given.iter().filter(|g| **g).count() <= 1,
+            STIFFNESS_CONFLICT, "/absorber/stiffness_n_m";
+            "give at most one of stiffness_n_m, passive_tuning_hz, passive_tuning_mode");
         let stiffness = a.stiffness_n_m;
         let passive_tuning = freq_or_mode(
             &mut v,
@@ -534,29 +487,15 @@ impl TryFrom<VibrationAbsorberRequest> for VibrationAbsorberInput {
         let c = &req.control;
         let config = c.mode;
         if config == Config::Active {
-            v.ensure_rule(
-                actuator.kc != 0.0,
-                &ZERO_FORCE_CONSTANT,
-                "/actuator/force_constant_n_a",
-                || {
-                    "force_constant_n_a [N/A] must be ≠ 0 with control.mode = active (the gains \
-                     divide by K_c)"
-                        .to_owned()
-                },
-            );
+            ensure_rule!(v, actuator.kc != 0.0, ZERO_FORCE_CONSTANT, "/actuator/force_constant_n_a";
+                "force_constant_n_a [N/A] must be ≠ 0 with control.mode = active (the gains \
+                     divide by K_c)");
         }
-        v.ensure_rule(
-            c.tuning_hz.is_none() || c.tuning_mode.is_none(),
-            &TUNING_CONFLICT,
-            "/control/tuning_mode",
-            || "give at most one of tuning_hz and tuning_mode".to_owned(),
-        );
-        v.ensure_rule(
-            c.kp_v_m.is_some() == c.kd_v_s_m.is_some(),
-            &GAIN_PAIR,
-            "/control/kd_v_s_m",
-            || "kp_v_m and kd_v_s_m go together".to_owned(),
-        );
+        ensure_rule!(v, c.tuning_hz.is_none() || c.tuning_mode.is_none(),
+            TUNING_CONFLICT, "/control/tuning_mode";
+            "give at most one of tuning_hz and tuning_mode");
+        ensure_rule!(v, c.kp_v_m.is_some() == c.kd_v_s_m.is_some(), GAIN_PAIR, "/control/kd_v_s_m";
+            "kp_v_m and kd_v_s_m go together");
         let gains = match (c.kp_v_m, c.kd_v_s_m) {
             (Some(kp), Some(kd)) => GainSource::Explicit { kp, kd },
             _ => GainSource::Tuning(freq_or_mode(

@@ -8,6 +8,7 @@ use crate::calc::irefc::error::{self, IrefcError};
 use crate::calc::irefc::geometry::Geometry;
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::MM;
+use crate::calc::rules::{ensure_rule, rule};
 
 crate::calc::rules::cross_rules! {
     /// The rules between fields of `POST /v1/irefc-efficiency`, as the document lists them.
@@ -71,11 +72,8 @@ impl EfficiencyInput {
         // Every range is checked at the door (`BAD_RANGE`).
         let mut v = design::validator();
         match (req.power_w, req.input_torque_nm) {
-            (Some(_), Some(_)) => v.rule(
-                &AMBIGUOUS_LOAD,
-                "/input_torque_Nm",
-                "give either power_W or input_torque_Nm, not both",
-            ),
+            (Some(_), Some(_)) => rule!(v, AMBIGUOUS_LOAD, "/input_torque_Nm";
+                "give either power_W or input_torque_Nm, not both"),
             (None, None) => design::missing(
                 &mut v,
                 &LOAD_MISSING,
@@ -92,12 +90,9 @@ impl EfficiencyInput {
         let mut phase_fraction = 0.0;
         if let Some(z) = z2 {
             let range = phase_deg_range(z);
-            if v.ensure_rule(
-                range.contains(phase_deg),
-                &PHASE_BELOW_PITCH,
-                "/phase_deg",
-                || format!("cage phase phase_deg [deg] must be {range}, got {phase_deg}"),
-            ) {
+            if ensure_rule!(v, range.contains(phase_deg), PHASE_BELOW_PITCH, "/phase_deg";
+                "cage phase phase_deg [deg] must be {range}, got {phase_deg}")
+            {
                 phase_fraction = (phase_deg / range.hi).clamp(0.0, 1.0 - f64::EPSILON);
             }
         }

@@ -11,6 +11,7 @@ use crate::calc::common::{self, Shard};
 use crate::calc::irefc::error::{BAD_RANGE, GRID_TOO_FINE, MISSING_FIELD, SWEEP_TOO_LARGE};
 use crate::calc::irefc::input as design;
 use crate::calc::irefc::wire::{MM, PROFILE_POINTS_DEFAULT, Warning};
+use crate::calc::rules::{ensure_rule, rule};
 use crate::calc::{CalcFailure, Range, Validator};
 
 crate::calc::rules::cross_rules! {
@@ -204,11 +205,7 @@ impl StressInput {
         let mut v = design::validator();
         let mode = mode_of(req);
         if mode == StressMode::Single && req.sweep.is_some() {
-            v.rule(
-                &SWEEP_NEEDS_MODE,
-                "/sweep",
-                "sweep is only allowed with mode \"sweep\"",
-            );
+            rule!(v, SWEEP_NEEDS_MODE, "/sweep"; "sweep is only allowed with mode \"sweep\"");
         }
         let include = req.include.unwrap_or_default();
         let checked = Checked {
@@ -251,11 +248,8 @@ impl TryFrom<IrefcStressRequest> for StressJob {
         let mut v = Validator::new();
         let shard = common::shard_rule(&mut v, req.shard);
         if req.shard.is_some() && mode_of(&req) == StressMode::Single {
-            v.rule(
-                &SHARD_NEEDS_SWEEP,
-                "/shard",
-                "shard splits a sweep; mode \"single\" has one design",
-            );
+            rule!(v, SHARD_NEEDS_SWEEP, "/shard";
+                "shard splits a sweep; mode \"single\" has one design");
         }
         let input = common::with_issues(v, StressInput::try_from_request(&req))?;
         Ok(Self { input, shard })
@@ -302,14 +296,9 @@ fn check_params(
 /// [`STEP_DEG`].
 fn grid_intervals(v: &mut Validator, step_deg: f64) -> Option<usize> {
     if !STEP_DEG.contains(step_deg) {
-        v.rule(
-            &GRID_TOO_FINE_RULE,
-            "/step_deg",
-            format!(
-                "grid step {step_deg} deg gives 180/step = {} intervals > {GRID_INTERVALS_MAX}",
-                180.0 / step_deg
-            ),
-        );
+        rule!(v, GRID_TOO_FINE_RULE, "/step_deg";
+            "grid step {step_deg} deg gives 180/step = {} intervals > {GRID_INTERVALS_MAX}",
+            180.0 / step_deg);
         return None;
     }
     // 18 ≤ N ≤ 2e6 here: the conversion is exact.
@@ -442,11 +431,7 @@ fn z2_values(v: &mut Validator, r: &IntRange) -> Vec<u32> {
     let to = design::z2(r.to);
     match (from, to) {
         (Some(a), Some(b)) if a > b => {
-            v.rule(
-                &SWEEP_RANGE_ORDER,
-                "/sweep/Z2/to",
-                format!("Z2.to = {b} must be >= Z2.from = {a}"),
-            );
+            rule!(v, SWEEP_RANGE_ORDER, "/sweep/Z2/to"; "Z2.to = {b} must be >= Z2.from = {a}");
             Vec::new()
         }
         (Some(a), Some(b)) => (a..=b).collect(),
@@ -459,11 +444,7 @@ fn z2_values(v: &mut Validator, r: &IntRange) -> Vec<u32> {
 fn chi_sweep(v: &mut Validator, r: &StepRange) -> Option<Vec<f64>> {
     let (a, b) = (r.from, r.to);
     if a > b {
-        v.rule(
-            &SWEEP_RANGE_ORDER,
-            "/sweep/chi/to",
-            format!("chi.to = {b} must be >= chi.from = {a}"),
-        );
+        rule!(v, SWEEP_RANGE_ORDER, "/sweep/chi/to"; "chi.to = {b} must be >= chi.from = {a}");
         return Some(Vec::new());
     }
     chi_values(a, b, r.step, SWEEP_COMBINATIONS_MAX)
@@ -496,35 +477,24 @@ fn check_size(
     n_intervals: usize,
 ) {
     let Some(chis) = chis else {
-        v.rule(
-            &SWEEP_TOO_LARGE_RULE,
-            "/sweep",
-            format!("the sweep has more than 100000 combinations > {SWEEP_COMBINATIONS_MAX}"),
-        );
+        rule!(v, SWEEP_TOO_LARGE_RULE, "/sweep";
+            "the sweep has more than 100000 combinations > {SWEEP_COMBINATIONS_MAX}");
         return;
     };
     let combos = (z2s.len() as u64)
         .saturating_mul(chis.len() as u64)
         .saturating_mul(n_lists as u64);
     if combos > SWEEP_COMBINATIONS_MAX {
-        v.rule(
-            &SWEEP_TOO_LARGE_RULE,
-            "/sweep",
-            format!("the sweep has {combos} combinations > {SWEEP_COMBINATIONS_MAX}"),
-        );
+        rule!(v, SWEEP_TOO_LARGE_RULE, "/sweep";
+            "the sweep has {combos} combinations > {SWEEP_COMBINATIONS_MAX}");
         return;
     }
     // combos ≤ 1e5, n_intervals ≤ 2e6: both exact in f64.
     let work = combos as f64 * (n_intervals as f64 + 1.0);
     if work > SWEEP_WORK_MAX {
-        v.rule(
-            &SWEEP_TOO_LARGE_RULE,
-            "/sweep",
-            format!(
-                "combinations x grid points = {combos} x {} = {work} > {SWEEP_WORK_MAX}; use a coarser step_deg",
-                n_intervals + 1
-            ),
-        );
+        rule!(v, SWEEP_TOO_LARGE_RULE, "/sweep";
+            "combinations x grid points = {combos} x {} = {work} > {SWEEP_WORK_MAX}; use a coarser step_deg",
+            n_intervals + 1);
     }
 }
 
@@ -538,8 +508,7 @@ fn check_lb(v: &mut Validator, lb: Option<f64>, r2s_mm: &[f64]) -> Option<f64> {
     } else {
         LB_MM
     };
-    v.ensure_rule(range.contains(x), &LB_BELOW_R2, "/lb_mm", || {
-        format!("contact length lb_mm [mm] must be {range}, got {x}")
-    })
+    ensure_rule!(v, range.contains(x), LB_BELOW_R2, "/lb_mm";
+        "contact length lb_mm [mm] must be {range}, got {x}")
     .then_some(x)
 }
