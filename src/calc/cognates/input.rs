@@ -425,7 +425,13 @@ fn dimension_mode(
     let (d_len, e_len) = ratio.as_ref().map_or((0.0, 0.0), |c| (c.d, c.e));
     let big_l = l.max(crank).max(coupler).max(rocker).max(d_len).max(e_len);
     if l <= COINCIDENT_REL * big_l {
-        rule!(v, COINCIDENT_PIVOTS, if req.ground.as_ref().is_some_and(|g| g.length.is_some()) { "/ground/length" } else { "/ground/B" };
+        let by_length = req.ground.as_ref().is_some_and(|g| g.length.is_some());
+        let at = if by_length {
+            "/ground/length"
+        } else {
+            "/ground/B"
+        };
+        rule!(v, COINCIDENT_PIVOTS, at;
             "ground pivots coincide: |B − A| = {l:e} ≤ 1e-12·L (L = {big_l:e})");
     }
     length_floor(
