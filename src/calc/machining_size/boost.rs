@@ -9,9 +9,11 @@
 //! working column (exact), partitioned stably when the node splits, so a level touches only the
 //! rows of its open nodes, in ascending row (hist) or value (exact) order.
 //!
-//! * exact: each sampled feature's working column holds (value, row) in ascending value order
-//!   (the gradient is read by row); a level partitions the runs split by the previous level and
-//!   scans the open runs, one feature per task on the compute threads ([`par_map`]).
+//! * exact: each sampled feature's working column holds 4-byte cells in ascending value order:
+//!   the row, and a flag for "greater than the previous cell's value" that stays true through
+//!   the partitions (the gradient and, for a chosen split only, the values are read by row); a
+//!   level partitions the runs split by the previous level and scans the open runs, one feature
+//!   per task on the compute threads ([`par_map`]).
 //! * hist: bins are built once per model, row-major (one byte per cell when every feature has
 //!   at most 256 bins). A node's histogram is summed from its own rows only, and of two
 //!   expandable siblings only the smaller one is summed: the other is the parent's histogram
@@ -176,14 +178,24 @@ impl BoostParams {
     }
 }
 
+/// The flag bit of a column cell ([`ExactIndex`], [`Column`]): the cell's value is greater than
+/// the value of the cell before it in its run (meaningless on a run's first cell: no scan reads
+/// it there).
+const NEW_VALUE: u32 = 1 << 31;
+
+/// The row bits of a column cell. Rows are below 2³¹ (the service takes at most 100 000).
+const ROW: u32 = NEW_VALUE - 1;
+
 /// Pre-sorted columns for the exact method: for each candidate feature, every row of the matrix
-/// in ascending order of its value, and the values in that order (12 bytes per cell): the split
-/// search reads both sequentially.
+/// in ascending order of its value, one 4-byte cell per row: the row, and in [`NEW_VALUE`]
+/// whether its value is greater than the previous cell's. The split search never reads the
+/// values themselves: a boundary is wherever the flag is set, and a chosen threshold is computed
+/// from the matrix. The values must not be NaN (rows are finite at the door) and the rows must
+/// be below 2³¹.
 #[derive(Debug, Clone)]
 pub struct ExactIndex {
     n_rows: usize,
-    order: Vec<u32>,
-    vals: Vec<f64>,
+    cells: Vec<u32>,
 }
 
 impl ExactIndex {
@@ -191,34 +203,33 @@ impl ExactIndex {
     #[must_use]
     pub fn build(x: &Matrix, features: &[usize], threads: usize) -> Self {
         let n = x.n_rows();
+        debug_assert!(
+            n <= ROW as usize + 1,
+            "rows of the exact index must be below 2^31"
+        );
         let parts = par_map(threads, features, |_, &f| {
             let col = x.col(f);
             let mut idx = super::data::all_rows(n);
             idx.sort_unstable_by(|&a, &b| {
                 col[a as usize].total_cmp(&col[b as usize]).then(a.cmp(&b))
             });
-            let vals: Vec<f64> = idx.iter().map(|&r| col[r as usize]).collect();
-            (idx, vals)
+            let mut prev = f64::INFINITY;
+            for c in &mut idx {
+                let v = col[*c as usize];
+                *c = (*c & ROW) | if v > prev { NEW_VALUE } else { 0 };
+                prev = v;
+            }
+            idx
         });
-        let mut order = Vec::with_capacity(n * features.len());
-        let mut vals = Vec::with_capacity(n * features.len());
-        for (o, v) in parts {
-            order.extend(o);
-            vals.extend(v);
+        let mut cells = Vec::with_capacity(n * features.len());
+        for c in parts {
+            cells.extend(c);
         }
-        Self {
-            n_rows: n,
-            order,
-            vals,
-        }
+        Self { n_rows: n, cells }
     }
 
-    fn order(&self, k: usize) -> &[u32] {
-        &self.order[k * self.n_rows..(k + 1) * self.n_rows]
-    }
-
-    fn vals(&self, k: usize) -> &[f64] {
-        &self.vals[k * self.n_rows..(k + 1) * self.n_rows]
+    fn cells(&self, k: usize) -> &[u32] {
+        &self.cells[k * self.n_rows..(k + 1) * self.n_rows]
     }
 }
 
@@ -598,12 +609,13 @@ fn midpoint(lo: f64, hi: f64) -> f64 {
 }
 
 /// A tree's working column (exact method): the sampled training rows in ascending order of the
-/// feature, as two parallel arrays (value, row): 12 bytes per row, so a model's columns stay a
-/// small multiple of its data (a gradient beside each value ran faster but doubled the memory
-/// of k-fold training, above the 5·B + 32 MiB the service holds a request to).
+/// feature, one 4-byte cell each (row and [`NEW_VALUE`] flag, as in [`ExactIndex`]): a column
+/// of 10⁵ rows (400 KB) stays in a core's L2 cache beside the gradients, and a model's columns
+/// are half of its data. (The earlier 12-byte (value, row) cells made the cost per row grow by a
+/// quarter from 10⁴ to 10⁵ rows; a gradient beside each cell keeps the scan sequential but moves
+/// three times the bytes per partition and was slower at 10⁴ rows: benches/RESULTS.md.)
 #[derive(Debug, Default)]
 struct Column {
-    x: Vec<f64>,
     r: Vec<u32>,
 }
 
@@ -614,56 +626,88 @@ fn lock(c: &Mutex<Column>) -> MutexGuard<'_, Column> {
 }
 
 /// Stable partition of every segment `start..end` of `col` in `splits`: rows with `left[r]`
-/// first, each side in its previous (ascending value) order.
-fn partition(col: &mut Column, splits: &[(usize, usize)], left: &[bool], tmp: &mut Column) {
+/// first, each side in its previous (ascending value) order. The [`NEW_VALUE`] flags stay true
+/// of each side: a cell's value is greater than that of the previous cell of its side exactly
+/// when some cell from there to it (itself included) had its flag set (the values ascend), so
+/// each side ORs the flags it passes over into the next cell it receives.
+fn partition(col: &mut Column, splits: &[(usize, usize)], left: &[u64], tmp: &mut Vec<u32>) {
     for &(start, end) in splits {
         // Branch-free (the sides are as good as random): both sides are written, the index of
         // the other side stays.
-        tmp.x.clear();
-        tmp.x.resize(end - start, 0.0);
-        tmp.r.clear();
-        tmp.r.resize(end - start, 0);
-        let (mut w, mut t) = (start, 0);
-        for i in start..end {
-            let (x, r) = (col.x[i], col.r[i]);
-            let l = left[r as usize];
-            col.x[w] = x;
-            col.r[w] = r;
-            tmp.x[t] = x;
-            tmp.r[t] = r;
+        if tmp.len() < end - start {
+            tmp.resize(end - start, 0);
+        }
+        let run = &mut col.r[start..end];
+        let (mut w, mut t) = (0, 0);
+        // The flags passed over since each side's last cell.
+        let (mut fl, mut fr) = (0u32, 0u32);
+        for i in 0..run.len() {
+            let c = run[i];
+            let l = is_left(left, c & ROW);
+            run[w] = c | fl;
+            tmp[t] = c | fr;
+            // The side that took the cell starts over: all ones keep, zero clears.
+            let keep_l = u32::from(l).wrapping_sub(1);
+            let f = c & NEW_VALUE;
+            fl = (fl | f) & keep_l;
+            fr = (fr | f) & !keep_l;
             w += usize::from(l);
             t += usize::from(!l);
         }
-        col.x[w..end].copy_from_slice(&tmp.x[..t]);
-        col.r[w..end].copy_from_slice(&tmp.r[..t]);
+        run[w..].copy_from_slice(&tmp[..t]);
     }
 }
 
-/// Exact search over one node's run of a working column (ascending values): every boundary
-/// between consecutive distinct values, ascending; the first of tied candidates wins.
+/// The fewest rows a child needs: a count c satisfies c ≥ `min_child_weight` (as f64, exactly)
+/// when c ≥ this (never for NaN).
+#[expect(
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss,
+    reason = "a positive integral value, saturating above u64::MAX (no count reaches it)"
+)]
+fn least_count(min_child_weight: f64) -> u64 {
+    if min_child_weight.is_nan() {
+        u64::MAX
+    } else if min_child_weight <= 0.0 {
+        0
+    } else {
+        min_child_weight.ceil() as u64
+    }
+}
+
+/// Bit `r` of the bit set `bits`.
+fn is_left(bits: &[u64], r: u32) -> bool {
+    (bits[(r >> 6) as usize] >> (r & 63)) & 1 != 0
+}
+
+/// Exact search over one node's run `cells` of a working column (ascending values of `xs`, the
+/// feature's column of the matrix): every boundary between consecutive distinct values (a cell
+/// flagged [`NEW_VALUE`]), ascending; the first of tied candidates wins. The threshold is the
+/// midpoint of the values either side of the best boundary, read from `xs` once at the end.
 fn scan_exact(
-    (xs, rs): (&[f64], &[u32]),
+    cells: &[u32],
+    xs: &[f64],
     g: &[f64],
     node: &BNode,
     parent_score: f64,
     p: &BoostParams,
     inv: &[f64],
 ) -> Option<Cand> {
-    let (mut gl, mut nl, mut last) = (0.0, 0u32, 0.0);
+    let (mut gl, mut nl) = (0.0, 0u32);
     let mut best: Option<Cand> = None;
     let mut need = f64::NEG_INFINITY;
-    for (&x, &r) in xs.iter().zip(rs) {
-        if nl > 0 && x > last {
+    let least = least_count(p.min_child_weight);
+    for &c in cells {
+        if nl > 0 && c & NEW_VALUE != 0 {
             let nr = node.n - nl;
-            let (hl, hr) = (f64::from(nl), f64::from(nr));
-            if hl >= p.min_child_weight && hr >= p.min_child_weight {
+            if u64::from(nl) >= least && u64::from(nr) >= least {
                 let gain = fast_score(gl, nl, inv, p.reg_alpha)
                     + fast_score(node.g - gl, nr, inv, p.reg_alpha)
                     - parent_score;
                 if gain > need {
                     best = Some(Cand {
                         gain,
-                        threshold: midpoint(last, x),
+                        threshold: 0.0,
                         gl,
                         nl,
                     });
@@ -671,11 +715,16 @@ fn scan_exact(
                 }
             }
         }
-        gl += g[r as usize];
+        gl += g[(c & ROW) as usize];
         nl += 1;
-        last = x;
     }
-    best
+    best.map(|mut b| {
+        // nl ≥ 1 and nl < cells.len() for every candidate.
+        let value = |i: usize| cells.get(i).map_or(0.0, |&c| xs[(c & ROW) as usize]);
+        let i = b.nl as usize;
+        b.threshold = midpoint(value(i - 1), value(i));
+        b
+    })
 }
 
 /// Grows one tree by the exact method over the sampled candidate features `cols` (positions in
@@ -683,7 +732,9 @@ fn scan_exact(
 /// output to the margins of all training rows.
 ///
 /// Each sampled feature has a working column: the tree's sampled rows in ascending order of the
-/// feature (the pre-sorted index filtered once per tree), gradients read by row. Every node's rows
+/// feature (the pre-sorted index filtered once per tree, or copied when every row of the matrix
+/// is used), gradients read by row, the side of each row of a split in a bit set (an L1-sized
+/// random lookup for the partitions). Every node's rows
 /// are one run `start..end` of every column, and a split partitions its run stably, so a level
 /// scans only the rows of its open nodes, sequentially, and in the order the whole-column scan
 /// visited them (the same sums, the same trees to the bit). The per-feature work (partition of
@@ -724,15 +775,25 @@ fn grow_exact(
         let used = &used;
         par_map(fill_threads, cols, |_, &k| {
             let mut c = lock(&ws.columns[k]);
-            let c = &mut *c;
-            c.x.clear();
-            c.r.clear();
-            for (&r, &x) in ix.order(k).iter().zip(ix.vals(k)) {
-                if used[r as usize] {
-                    c.x.push(x);
-                    c.r.push(r);
-                }
+            let c = &mut c.r;
+            let cells = ix.cells(k);
+            if n0 as usize == n {
+                c.clear();
+                c.extend_from_slice(cells);
+                return;
             }
+            // The filtered cells, their flags ORed over the rows left out (as in `partition`):
+            // branch-free, every cell written and the position advanced for used rows only.
+            c.clear();
+            c.resize(n + 1, 0);
+            let (mut w, mut f) = (0, 0u32);
+            for &cell in cells {
+                let u = used[(cell & ROW) as usize];
+                c[w] = cell | f;
+                f = (f | (cell & NEW_VALUE)) & u32::from(u).wrapping_sub(1);
+                w += usize::from(u);
+            }
+            c.truncate(w);
         });
     }
     let mut nodes = vec![BNode {
@@ -754,7 +815,7 @@ fn grow_exact(
     // Runs split by the previous level (partitioned at the start of the next one) and the side
     // of each of their rows.
     let mut splits: Vec<(usize, usize)> = Vec::new();
-    let mut left = vec![false; n];
+    let mut left = vec![0u64; n.div_ceil(64)];
     while !level.is_empty() {
         let stats: Vec<(BNode, f64)> = level
             .iter()
@@ -775,7 +836,8 @@ fn grow_exact(
             let (splits, left, inv, g) = (&splits, &left, &ws.inv, &ws.g);
             par_map(t, cols, |_, &k| {
                 let mut c = lock(&ws.columns[k]);
-                let mut tmp = Column::default();
+                let xs = data.x.col(data.features[k]);
+                let mut tmp = Vec::new();
                 // Each run is partitioned just before its children are scanned, while it is
                 // still in cache (runs and nodes are both in ascending position order).
                 let mut done = 0;
@@ -785,8 +847,7 @@ fn grow_exact(
                         let upto = done + splits[done..].partition_point(|sp| sp.0 <= b.start);
                         partition(&mut c, &splits[done..upto], left, &mut tmp);
                         done = upto;
-                        let run = (&c.x[b.start..b.end], &c.r[b.start..b.end]);
-                        scan_exact(run, g, b, *ps, p, inv)
+                        scan_exact(&c.r[b.start..b.end], xs, g, b, *ps, p, inv)
                     })
                     .collect();
                 partition(&mut c, &splits[done..], left, &mut tmp);
@@ -816,11 +877,13 @@ fn grow_exact(
             {
                 let col = lock(&ws.columns[k]);
                 let mid = parent.start + c.nl as usize;
-                for &r in &col.r[parent.start..mid] {
-                    left[r as usize] = true;
+                for &c in &col.r[parent.start..mid] {
+                    let r = c & ROW;
+                    left[(r >> 6) as usize] |= 1 << (r & 63);
                 }
-                for &r in &col.r[mid..parent.end] {
-                    left[r as usize] = false;
+                for &c in &col.r[mid..parent.end] {
+                    let r = c & ROW;
+                    left[(r >> 6) as usize] &= !(1 << (r & 63));
                 }
             }
             splits.push((parent.start, parent.end));
@@ -848,12 +911,12 @@ fn grow_exact(
     // The margins, from the runs of the unsplit nodes in one column (the last level's splits
     // partitioned there first).
     let mut col = lock(&ws.columns[cols[0]]);
-    partition(&mut col, &splits, &left, &mut Column::default());
+    partition(&mut col, &splits, &left, &mut Vec::new());
     for (i, b) in nodes.iter().enumerate() {
         if b.left == LEAF {
             let v = tree.nodes[leaf_of[i] as usize].value;
-            for &r in &col.r[b.start..b.end] {
-                ws.margin[r as usize] += v;
+            for &c in &col.r[b.start..b.end] {
+                ws.margin[(c & ROW) as usize] += v;
             }
         }
     }
