@@ -50,10 +50,12 @@
 //!   2-core machine, alternating with shap 0.51 on one thread and the full background):
 //!   path-dependent 593 µs/row against shap's 1600 (2.7×), interventional 3.1× / 16× / 24× shap
 //!   at |B| = 10 / 100 / 850, interactions 2.8×.
-//! * Memory: the feature matrix (8 bytes per cell) plus the exact index (12 bytes per cell: row
-//!   order and sorted values, shared by the holdout model and every CV fold; 400 MB in all for
-//!   100 000 × 200) or the hist bins (2 bytes per cell per model being
-//!   trained), O(rows) per model, and O(2^depth · bins) histogram space per thread.
+//! * Memory: the feature matrix (8 bytes per cell) plus the exact index (4 bytes per cell: the row
+//!   order with a new-value flag, shared by the holdout model and every CV fold; 240 MB in all
+//!   for 100 000 × 200) and 4 bytes per sampled cell of working columns per model being trained,
+//!   or the hist bins (1 byte per cell when every feature has at most 256 bins, else 2, per model
+//!   being trained), O(rows) per model, and histograms capped at 8 bytes per training cell (at
+//!   least 4 MiB).
 //! * Outside the range: a 422 with a pointer (`INVALID_INPUT`, `TOO_LARGE`, `MODEL_INVALID`,
 //!   `UNSUPPORTED_MODEL`, `SMOGN_DEGENERATE_RELEVANCE`, `GRA_ZERO_MEAN`, `DEADLINE_EXCEEDED`).
 
