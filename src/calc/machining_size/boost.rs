@@ -187,7 +187,7 @@ const NEW_VALUE: u32 = 1 << 31;
 const ROW: u32 = NEW_VALUE - 1;
 
 /// Pre-sorted columns for the exact method: for each candidate feature, every row of the matrix
-/// in ascending order of its value, one 4-byte cell per row: the row, and in [`NEW_VALUE`]
+/// in ascending order of its value, one 4-byte cell per row: the row, and in its top bit
 /// whether its value is greater than the previous cell's. The split search never reads the
 /// values themselves: a boundary is wherever the flag is set, and a chosen threshold is computed
 /// from the matrix. The values must not be NaN (rows are finite at the door) and the rows must
